@@ -1,0 +1,3 @@
+from matcad.cli import main
+
+raise SystemExit(main())

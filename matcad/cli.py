@@ -1,0 +1,109 @@
+"""Command line. Thin: parse, call one function, print text or --json, map errors to exit codes.
+
+Exit codes: 0 ok; 1 design-rule failure (or, for loop commands, no usable result); 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+from matcad import __version__
+
+EXIT_OK, EXIT_RULES, EXIT_INPUT = 0, 1, 2
+
+
+def _print_json(data) -> None:
+    print(json.dumps(data, indent=2, allow_nan=False))
+
+
+def _format_prediction(spec, p) -> str:
+    cav, neck = spec.cavity, spec.neck
+    lines = [
+        f"{spec.name}: cavity D {cav.diameter:g} x L {cav.length:g} mm, neck d {neck.diameter:g} x "
+        f"l {neck.length:g} mm, mouth {neck.mouth}, wall {spec.wall.model}",
+        f"  cavity volume   {p.cavity_volume_mm3:10.4f} mm^3    neck area {p.neck_area_mm2:.4f} mm^2",
+        f"  A*l/V           {p.neck_air_ratio:10.4f}         xi = d/D  {p.diameter_ratio:.4f}",
+        f"  speed of sound  {p.speed_of_sound_m_s:10.2f} m/s     end corrections: outer "
+        f"{p.outer_end_correction_mm:.3f} mm, inner {p.inner_end_correction_mm:.3f} mm",
+        "",
+        f"  {'model':<18} {'f0 [Hz]':>9}  {'valid':<5}  failed checks",
+    ]
+    for name, r in p.models.items():
+        failed = ", ".join(k for k, ok in r.checks.items() if not ok) or "-"
+        mark = "*" if name == p.model else " "
+        lines.append(f"{mark} {name:<18} {r.f0_hz:9.1f}  {'yes' if r.valid else 'no':<5}  {failed}")
+    lines += ["", f"  f0 = {p.f0_hz:.0f} Hz ({p.model}), band {p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz"]
+    if p.load_curve:
+        lines += ["", f"  load curve, paper Eq. 5, calibration {p.calibration}:", f"  {'F [N]':>9} {'f [Hz]':>9}"]
+        for pt in p.load_curve:
+            value = f"{pt.f_hz:9.1f}" if pt.f_hz is not None else f"{'n/a':>9}  {pt.reason}"
+            lines.append(f"  {pt.force_n:9.3f} {value}")
+    if p.warnings:
+        lines += ["", "  warnings:"] + [f"  - {w}" for w in p.warnings]
+    return "\n".join(lines)
+
+
+def cmd_predict(args) -> int:
+    from matcad import spec as spec_mod
+    from matcad.acoustics.predict import predict
+
+    spec = spec_mod.load(args.spec)
+    result = predict(spec, forces_n=args.force or (), model=args.model)
+    if args.json:
+        _print_json(result.to_dict())
+    else:
+        print(_format_prediction(spec, result))
+    return EXIT_OK
+
+
+def cmd_schema(args) -> int:
+    from matcad.spec import schema
+
+    rows = schema()
+    if args.json:
+        _print_json(rows)
+        return EXIT_OK
+    for row in rows:
+        default = "(required)" if row["required"] else f"default {row['default']!r}"
+        unit = f" [{row['unit']}]" if row["unit"] else ""
+        print(f"{row['key']}{unit}  {default}\n    {row['doc']}\n    allowed: {row['allowed']}")
+    return EXIT_OK
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="matcad", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"matcad {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("predict", help="predict the taxel's resonance frequency from a spec")
+    p.add_argument("spec", help="spec TOML file")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.add_argument("--force", type=float, nargs="+", metavar="F",
+                   help="normal loads in N: add paper Eq. 5 f(F) using the spec's [calibration]")
+    p.add_argument("--model", help="use this model's f0 instead of the automatic choice")
+    p.set_defaults(func=cmd_predict)
+
+    s = sub.add_parser("schema", help="print every spec field with unit, default and allowed range")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_schema)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    from matcad.spec import SpecError
+
+    try:
+        return args.func(args)
+    except SpecError as exc:
+        print(f"matcad: spec error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except ValueError as exc:
+        print(f"matcad: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours
+        sys.stdout = open(os.devnull, "w")
+        return EXIT_OK

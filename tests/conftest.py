@@ -1,0 +1,37 @@
+"""Shared test helpers: paths, a spec writer, and a CLI runner in a fresh interpreter."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
+PAPER = ROOT / "templates" / "mat-paper.toml"
+
+MINIMAL = """name = "t"
+[cavity]
+diameter = 3.18
+length = 4.76
+[neck]
+diameter = 2.1
+length = 6.35
+"""
+
+
+def run_cli(*args, cwd=None):
+    """Run `python -m matcad ARGS` in a fresh process: (exit code, stdout, stderr)."""
+    proc = subprocess.run([sys.executable, "-m", "matcad", *map(str, args)], capture_output=True,
+                          text=True, cwd=cwd or ROOT)
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+@pytest.fixture
+def write_spec(tmp_path):
+    """Write TOML text to a file and return its path."""
+    def _write(text, name="spec.toml"):
+        path = tmp_path / name
+        path.write_text(text, encoding="utf-8")
+        return path
+    return _write
