@@ -38,7 +38,7 @@ class SpecError(ValueError):
 def _param(doc: str, unit: str = "", default: Any = dataclasses.MISSING, *, kind: str = "number",
            lo: float | None = None, hi: float | None = None, lo_open: bool = True,
            choices: tuple[str, ...] = ()) -> Any:
-    """Declare one spec field. ``kind`` is number | range | choice | name."""
+    """Declare one spec field. ``kind`` is number | integer | bool | text | range | choice | name."""
     meta = {"doc": doc, "unit": unit, "kind": kind, "lo": lo, "hi": hi, "lo_open": lo_open,
             "choices": choices}
     return field(default=default, metadata=meta)
@@ -72,8 +72,26 @@ class Neck:
 class Plate:
     """The laser-cut neck plate outline; the mount gap under it vents at its edges."""
 
-    width: float = _length("neck plate width (x), neck at its centre", 20.0)
-    depth: float = _length("neck plate depth (y), neck at its centre", 20.0)
+    width: float = _length("neck plate width (x), neck at its centre", 24.0)
+    depth: float = _length("neck plate depth (y), neck at its centre", 24.0)
+    thickness_measured: bool = _param("true if neck.length is the measured sheet thickness (cast acrylic "
+                                      "varies +-(0.4 + 0.1 t) mm, ISO 7823-1)", default=False, kind="bool")
+    label: str = _param("text engraved on the neck plate ('' for none)", default="", kind="text")
+    neck_pilot: bool = _param("cut the neck as an undersize pilot, to be drilled to neck.diameter "
+                              "(avoids the laser's taper in thick sheet)", default=False, kind="bool")
+    pilot_undersize: float = _param("pilot hole is this much smaller than the neck", "mm", 0.3, lo=0.0,
+                                    hi=LENGTH_MAX_MM)
+    bolt_inset: float = _param("bolt and dowel centres inset from the plate edges", "mm", 2.5, lo=0.0,
+                               hi=LENGTH_MAX_MM)
+
+
+@dataclass(frozen=True)
+class Guide:
+    """Laser-cut guides over the plate: a locator around the cap's flange and a clamp over it (paper Sec. II)."""
+
+    thickness: float = _length("guide sheet thickness (paper: 1.5 mm acrylic)", 1.5)
+    thickness_measured: bool = _param("true if guide.thickness is a measured value", default=False,
+                                      kind="bool")
 
 
 @dataclass(frozen=True)
@@ -81,6 +99,116 @@ class Spacer:
     """Spacers between the neck plate and the air-supply mount (paper: 1.59 mm, for ventilation)."""
 
     height: float = _length("gap between neck plate and mount; the 'mount' mouth's gap height", 1.59)
+    style: str = _param("'laser' (square spacers cut from a sheet of this thickness) or 'standoff' "
+                        "(printed on the needle mount)", default="laser", kind="choice",
+                        choices=("laser", "standoff"))
+    size: float = _length("spacer square side / standoff diameter", 5.0)
+    thickness_measured: bool = _param("true if spacer.height is a measured sheet thickness", default=False,
+                                      kind="bool")
+
+
+@dataclass(frozen=True)
+class Fasteners:
+    """Bolts clamping guide, plate, spacers and mount; dowel pins aligning them."""
+
+    bolt: str = _param("metric bolt size", default="M2", kind="choice", choices=("M2", "M2.5", "M3"))
+    bolt_fit: str = _param("ISO 273 clearance class", default="normal", kind="choice",
+                           choices=("close", "normal", "loose"))
+    dowel_diameter: float = _length("dowel pin diameter", 1.5)
+    dowel_fit_laser: str = _param("dowel fit in laser-cut parts (press fits are not achievable in "
+                                  "laser-cut acrylic)", default="slip", kind="choice",
+                                  choices=("clearance", "slip", "press"))
+    dowel_fit_printed: str = _param("dowel fit in the printed needle mount", default="press", kind="choice",
+                                    choices=("clearance", "slip", "press"))
+
+
+@dataclass(frozen=True)
+class Needle:
+    """The air-supply needle (paper: 1.52 mm, theta = 75 deg)."""
+
+    outer_diameter: float = _length("needle outer diameter", 1.52)
+    theta_deg: float = _param("needle axis angle to the plate surface", "deg", 75.0, lo=0.0, hi=90.0)
+    y: float = _param("distance, in the plane of the plate's underside, from the point where the needle "
+                      "axis meets that plane to the nearest edge of the neck opening", "mm", 1.0,
+                      lo=-LENGTH_MAX_MM, hi=LENGTH_MAX_MM, lo_open=False)
+    tip_clearance: float = _param("gap between the needle's end face and the plate underside", "mm", 0.3,
+                                  lo=0.0, hi=LENGTH_MAX_MM)
+    length: float = _length("exposed needle length modelled for collision checks", 25.0)
+    fit: str = _param("needle fit in the printed bore", default="slip", kind="choice",
+                      choices=("clearance", "slip", "press"))
+
+
+@dataclass(frozen=True)
+class Mount:
+    """The printed air-supply (needle) mount under the plate."""
+
+    thickness: float = _length("mount block thickness", 8.0)
+
+
+@dataclass(frozen=True)
+class Mold:
+    """Two-part printed mold for the silicone end cap (base + lid carrying the core pin)."""
+
+    draft_deg: float = _param("core-pin draft; narrows the cavity toward its closed end (reported)", "deg",
+                              0.0, lo=0.0, hi=10.0, lo_open=False)
+    wall: float = _length("mold wall around each cap and between caps", 4.0)
+    floor: float = _length("mold floor under the cap top", 2.0)
+    lid_thickness: float = _length("lid plate thickness", 3.0)
+    count: int = _param("caps per mold", default=1, kind="integer", lo=1, hi=50)
+    fill_port: float = _length("fill port diameter (>= 2 mm for syringe filling)", 2.0)
+    vent: float = _length("vent diameter", 1.0)
+    bolt: str = _param("mold clamp bolt size", default="M3", kind="choice", choices=("M2", "M2.5", "M3"))
+    key_height: float = _length("registration key (truncated cone) height", 2.0)
+    key_diameter: float = _length("registration key base diameter", 4.0)
+
+
+@dataclass(frozen=True)
+class Machine:
+    """The user's laser cutter and printer; fits and compensation come from here."""
+
+    laser_kerf: float = _param("full kerf width of the laser (measure with `matcad coupon`)", "mm", 0.2,
+                               lo=0.0, hi=5.0, lo_open=False)
+    laser_min_feature: float = _length("smallest laser-cut feature or web that survives", 1.0)
+    printer: str = _param("printer process for the mold and mount", default="fdm", kind="choice",
+                          choices=("fdm", "sla"))
+    nozzle: float = _length("FDM nozzle diameter (walls >= 2 nozzles)", 0.4)
+    key_clearance: float | None = _param("registration-key clearance per side; default by printer "
+                                         "(fdm 0.2, sla 0.1)", "mm", None, lo=0.0, hi=5.0)
+    stl_tolerance: float = _param("STL chordal deviation", "mm", 0.01, lo=1e-5, hi=10.0)
+    stl_angular_tolerance: float = _param("STL angular deviation", "rad", 0.2, lo=1e-3, hi=1.0)
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """What `matcad build` writes; only what is asked for is built."""
+
+    end_cap_mold: bool = _param("STL + STEP mold base and lid", default=True, kind="bool")
+    neck_plate: bool = _param("DXF + SVG neck plate", default=True, kind="bool")
+    guides: bool = _param("DXF + SVG locator and clamp guides", default=True, kind="bool")
+    spacers: bool = _param("DXF + SVG spacers (when spacer.style = 'laser')", default=True, kind="bool")
+    needle_mount: bool = _param("STL + STEP needle mount", default=True, kind="bool")
+    assembly: bool = _param("assembly.step and section.svg", default=True, kind="bool")
+    reference_square: bool = _param("10 mm reference square on its own layer in every DXF/SVG",
+                                    default=True, kind="bool")
+
+
+@dataclass(frozen=True)
+class Microphone:
+    """The recording chain."""
+
+    sample_rate_hz: float = _param("microphone sample rate (band must stay < 0.45 x this)", "Hz", 44100.0,
+                                   lo=0.0, hi=1e7)
+    floor_hz: float = _param("lowest frequency worth designing for (room noise, hum)", "Hz", 1000.0,
+                             lo=0.0, hi=1e7, lo_open=False)
+
+
+@dataclass(frozen=True)
+class Silicone:
+    """Cast silicone (Dragon Skin 30: specific gravity 1.08)."""
+
+    density_g_cm3: float = _param("density of the cured silicone", "g/cm^3", 1.08, lo=0.0, hi=30.0)
+    waste_factor: float = _param("batch volume / cast volume (cups, sprues, vents)", "", 1.3, lo=1.0,
+                                 hi=100.0, lo_open=False)
 
 
 @dataclass(frozen=True)
@@ -91,6 +219,9 @@ class EndCap:
         f"outer diameter of the silicone end cap body; default {CAP_OUTER_PER_D} x cavity.diameter", None)
     top_thickness: float | None = _length(
         f"silicone thickness above the cavity's closed end; default {CAP_TOP_PER_D} x cavity.diameter", None)
+    flange_width: float = _length("width of the base flange the clamp guide holds, beyond the body", 2.0)
+    flange_squeeze: float = _param("flange is this much thicker than the guide, so the clamp seals it",
+                                   "mm", 0.1, lo=0.0, hi=LENGTH_MAX_MM, lo_open=False)
 
 
 @dataclass(frozen=True)
@@ -136,15 +267,27 @@ class Spec:
     cavity: Cavity = field(default=None)  # type: ignore[assignment]
     neck: Neck = field(default=None)  # type: ignore[assignment]
     plate: Plate = field(default_factory=Plate)
+    guide: Guide = field(default_factory=Guide)
     spacer: Spacer = field(default_factory=Spacer)
     end_cap: EndCap = field(default_factory=EndCap)
+    fasteners: Fasteners = field(default_factory=Fasteners)
+    needle: Needle = field(default_factory=Needle)
+    mount: Mount = field(default_factory=Mount)
+    mold: Mold = field(default_factory=Mold)
+    machine: Machine = field(default_factory=Machine)
+    outputs: Outputs = field(default_factory=Outputs)
     air: Air = field(default_factory=Air)
     wall: Wall = field(default_factory=Wall)
+    microphone: Microphone = field(default_factory=Microphone)
+    silicone: Silicone = field(default_factory=Silicone)
     calibration: Calibration | None = None
 
 
-SECTIONS: dict[str, type] = {"cavity": Cavity, "neck": Neck, "plate": Plate, "spacer": Spacer,
-                             "end_cap": EndCap, "air": Air, "wall": Wall, "calibration": Calibration}
+SECTIONS: dict[str, type] = {
+    "cavity": Cavity, "neck": Neck, "plate": Plate, "guide": Guide, "spacer": Spacer, "end_cap": EndCap,
+    "fasteners": Fasteners, "needle": Needle, "mount": Mount, "mold": Mold, "machine": Machine,
+    "outputs": Outputs, "air": Air, "wall": Wall, "microphone": Microphone, "silicone": Silicone,
+    "calibration": Calibration}
 REQUIRED_SECTIONS = ("cavity", "neck")
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
 
@@ -161,6 +304,21 @@ def _range_text(meta: dict) -> str:
     return f"a finite number, {lo:g} {op} value <= {hi:g}{unit}"
 
 
+def _allowed_text(meta: dict) -> str:
+    kind = meta["kind"]
+    if kind == "choice":
+        return " | ".join(meta["choices"])
+    if kind == "range":
+        return "[low, high], each " + _range_text(meta)
+    if kind == "integer":
+        return f"a whole number, {meta['lo']:g} <= value <= {meta['hi']:g}"
+    if kind == "bool":
+        return "true | false"
+    if kind == "text":
+        return "at most 40 printable ASCII characters"
+    return _range_text(meta)
+
+
 def _number(path: str, value: Any, meta: dict) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise SpecError(path, value, f"must be {_range_text(meta)}")
@@ -175,6 +333,18 @@ def _convert(path: str, value: Any, meta: dict) -> Any:
     kind = meta["kind"]
     if kind == "number":
         return _number(path, value, meta)
+    if kind == "integer":
+        if isinstance(value, bool) or not isinstance(value, int) or not meta["lo"] <= value <= meta["hi"]:
+            raise SpecError(path, value, f"must be a whole number, {meta['lo']:g} <= value <= {meta['hi']:g}")
+        return value
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise SpecError(path, value, "must be true or false")
+        return value
+    if kind == "text":
+        if not isinstance(value, str) or len(value) > 40 or not all(32 <= ord(ch) < 127 for ch in value):
+            raise SpecError(path, value, "must be at most 40 printable ASCII characters")
+        return value
     if kind == "choice":
         if value not in meta["choices"]:
             raise SpecError(path, value, f"must be one of {', '.join(map(repr, meta['choices']))}")
@@ -215,6 +385,11 @@ def _cross_checks(spec: Spec) -> None:
         raise SpecError("neck.diameter", spec.neck.diameter,
                         f"must be <= cavity.diameter = {spec.cavity.diameter:g} mm (a neck cannot be "
                         "wider than its cavity)")
+    tip = spec.cavity.diameter - 2 * spec.cavity.length * math.tan(math.radians(spec.mold.draft_deg))
+    if tip <= 0:
+        raise SpecError("mold.draft_deg", spec.mold.draft_deg,
+                        f"must leave the cavity open: draft closes a {spec.cavity.diameter:g} mm cavity within "
+                        f"its {spec.cavity.length:g} mm length")
     if spec.end_cap.outer_diameter <= spec.cavity.diameter:
         raise SpecError("end_cap.outer_diameter", spec.end_cap.outer_diameter,
                         f"must be > cavity.diameter = {spec.cavity.diameter:g} mm")
@@ -241,14 +416,21 @@ def from_dict(data: dict) -> Spec:
     return spec
 
 
+KEY_CLEARANCE_MM = {"fdm": 0.2, "sla": 0.1}
+"""Registration-key clearance per side by printer process (DIGEST, shop practice)."""
+
+
 def _resolve_defaults(spec: Spec) -> Spec:
-    """Fill defaults that scale with the design (cap body proportional to the cavity)."""
+    """Fill defaults that depend on other fields (cap body proportional to the cavity; key clearance)."""
     cap = spec.end_cap
     d = spec.cavity.diameter
     cap = dataclasses.replace(
         cap, outer_diameter=cap.outer_diameter if cap.outer_diameter is not None else CAP_OUTER_PER_D * d,
         top_thickness=cap.top_thickness if cap.top_thickness is not None else CAP_TOP_PER_D * d)
-    return dataclasses.replace(spec, end_cap=cap)
+    machine = spec.machine
+    if machine.key_clearance is None:
+        machine = dataclasses.replace(machine, key_clearance=KEY_CLEARANCE_MM[machine.printer])
+    return dataclasses.replace(spec, end_cap=cap, machine=machine)
 
 
 def load(path: str | Path) -> Spec:
@@ -274,12 +456,7 @@ def schema() -> list[dict]:
     for section, cls in SECTIONS.items():
         for f in dataclasses.fields(cls):
             meta = f.metadata
-            if meta["kind"] == "choice":
-                allowed = " | ".join(meta["choices"])
-            elif meta["kind"] == "range":
-                allowed = "[low, high], each " + _range_text(dict(meta))
-            else:
-                allowed = _range_text(dict(meta))
+            allowed = _allowed_text(dict(meta))
             default = None if f.default is dataclasses.MISSING else f.default
             required = f.default is dataclasses.MISSING and section in REQUIRED_SECTIONS
             rows.append({"key": f"{section}.{f.name}", "unit": meta["unit"],

@@ -149,16 +149,30 @@ def test_paper_template_prediction_in_measured_band():
     (0.1, 20e3, 80e3),     # sub-mm taxel: ultrasonic
 ])
 def test_any_physical_scale_predicts(scale, lo, hi):
+    paper = spec_mod.load(PAPER)
     s = spec_mod.from_dict({"name": "x", "cavity": {"diameter": D * scale, "length": L * scale},
                             "neck": {"diameter": d * scale, "length": l * scale},
-                            "plate": {"width": 20 * scale, "depth": 20 * scale},
-                            "spacer": {"height": 1.59 * scale}})
+                            "plate": {"width": paper.plate.width * scale, "depth": paper.plate.depth * scale},
+                            "spacer": {"height": paper.spacer.height * scale}})
     p = predict(s)
     assert all(np.isfinite(r.f0_hz) for r in p.models.values())
     # geometric similarity: f scales as 1/scale
     assert p.f0_hz * scale == pytest.approx(predict(spec_mod.load(PAPER)).models["transmission_line"].f0_hz,
                                             rel=1e-9)
     assert lo < p.f0_hz < hi
+
+
+def test_draft_shrinks_cavity_and_raises_f():
+    straight = predict(_spec())
+    drafted = predict(_spec(mold__draft_deg=1.0))
+    tip = D - 2 * L * np.tan(np.radians(1.0))
+    assert drafted.cavity_volume_mm3 == pytest.approx(np.pi * L * (D * D + D * tip + tip * tip) / 12, rel=1e-12)
+    assert 1 - drafted.cavity_volume_mm3 / straight.cavity_volume_mm3 == pytest.approx(0.051, abs=0.002)
+    # DIGEST: 1° ≈ +2.7 % in f, the lumped V^-1/2 law; the t-line, whose neck air is compressible too, moves less
+    lumped_ratio = drafted.models["lumped"].f0_hz / straight.models["lumped"].f0_hz
+    assert lumped_ratio == pytest.approx(np.sqrt(straight.cavity_volume_mm3 / drafted.cavity_volume_mm3), rel=1e-12)
+    assert lumped_ratio - 1 == pytest.approx(0.027, abs=0.002)
+    assert 0.015 < drafted.f0_hz / straight.f0_hz - 1 < lumped_ratio - 1
 
 
 def test_vectorised_matches_scalar():

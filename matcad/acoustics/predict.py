@@ -17,8 +17,6 @@ from matcad.acoustics.load import MAT_PAPER_2024, LoadCalibration, frequency_at_
 MODEL_ERROR = 0.03
 """Relative model-error allowance on the chosen f0 (±3 %): the DIGEST's viscous boundary-layer shift (~−2 %)
 plus the mount correction's roughness; to be replaced by the error measured against the FEM reference."""
-SILICONE_DENSITY_KG_M3 = 1080.0
-"""Dragon Skin 30, specific gravity 1.08 (Smooth-On technical bulletin)."""
 PLANE_WAVE_CUTOFF_KA = 1.8412
 """First non-planar (1,1) mode of a circular duct cuts on at k·a = 1.8412 (zero of J1')."""
 PANCAKE_L_OVER_D = 0.3
@@ -85,10 +83,10 @@ def spec_calibration(spec) -> LoadCalibration | None:
     return LoadCalibration(*values, name="spec")
 
 
-def _checks_plane_wave(f_hz, c_m_s, spec) -> dict[str, bool]:
+def _checks_plane_wave(f_hz, c_m_s, cavity_diameter_mm, cavity_length_mm) -> dict[str, bool]:
     k = 2 * np.pi * f_hz / (c_m_s * models.MM_PER_M)
-    return {"plane_waves_in_cavity": bool(k * spec.cavity.diameter / 2 < PLANE_WAVE_CUTOFF_KA),
-            "not_pancake": bool(spec.cavity.length / spec.cavity.diameter >= PANCAKE_L_OVER_D)}
+    return {"plane_waves_in_cavity": bool(k * cavity_diameter_mm / 2 < PLANE_WAVE_CUTOFF_KA),
+            "not_pancake": bool(cavity_length_mm / cavity_diameter_mm >= PANCAKE_L_OVER_D)}
 
 
 def _model_warnings(name: str, result: ModelResult, diameter_ratio: float) -> list[str]:
@@ -113,15 +111,17 @@ def predict(spec, forces_n=(), model: str | None = None) -> Prediction:
     """
     cav, neck = spec.cavity, spec.neck
     c = float(spec.air.speed_of_sound or speed_of_sound_m_s(spec.air.temperature_c))
-    volume = float(geometry.cavity_volume_mm3(cav.diameter, cav.length))
+    # as cast: core-pin draft narrows the cavity; the 1-D models see the equal-volume cylinder
+    volume = float(geometry.drafted_cavity_volume_mm3(cav.diameter, cav.length, spec.mold.draft_deg))
+    cav_diameter = float(geometry.equivalent_diameter_mm(volume, cav.length))
     area = float(geometry.neck_area_mm2(neck.diameter))
-    cav_area = float(geometry.circle_area_mm2(cav.diameter))
-    xi = float(geometry.diameter_ratio(neck.diameter, cav.diameter))
-    air_ratio = float(geometry.neck_air_ratio(neck.diameter, neck.length, cav.diameter, cav.length))
+    cav_area = float(geometry.circle_area_mm2(cav_diameter))
+    xi = float(geometry.diameter_ratio(neck.diameter, cav_diameter))
+    air_ratio = area * neck.length / volume
     gap_radius = min(spec.plate.width, spec.plate.depth) / 2.0
     outer = float(models.mouth_end_correction_mm(neck.mouth, neck.diameter / 2, spec.spacer.height, gap_radius))
-    inner_ingard = float(models.ingard_end_correction_mm(neck.diameter, cav.diameter))
-    inner_step = float(models.step_end_correction_mm(neck.diameter, cav.diameter))
+    inner_ingard = float(models.ingard_end_correction_mm(neck.diameter, cav_diameter))
+    inner_step = float(models.step_end_correction_mm(neck.diameter, cav_diameter))
     neck_eff = neck.length + outer + inner_step
 
     lumped_ok = air_ratio < LUMPED_NECK_AIR_RATIO
@@ -136,7 +136,7 @@ def predict(spec, forces_n=(), model: str | None = None) -> Prediction:
     }
     f_tl = float(models.transmission_line_hz(c, area, cav_area, neck_eff, cav.length))
     results["transmission_line"] = ModelResult(
-        f_tl, _checks_plane_wave(f_tl, c, spec),
+        f_tl, _checks_plane_wave(f_tl, c, cav_diameter, cav.length),
         "Selamet et al. 1997 transmission line, Kergomard & Garcia 1987 step correction")
     chosen = "transmission_line"
     band_model = (f_tl, f_tl)
@@ -144,11 +144,12 @@ def predict(spec, forces_n=(), model: str | None = None) -> Prediction:
     if spec.wall.model == "silicone":
         g_lo, g_hi = (x * 1e6 for x in spec.wall.shear_modulus_mpa)
         shear = np.array([g_lo, np.sqrt(g_lo * g_hi), g_hi])
-        n, extra = models.soft_wall_length_scale(shear, cav.diameter, spec.end_cap.outer_diameter)
+        n, extra = models.soft_wall_length_scale(shear, cav_diameter, spec.end_cap.outer_diameter)
         f_lo, f_mid, f_hi = models.transmission_line_hz(c, area, cav_area, neck_eff, cav.length, n, extra)
-        breathing = float(models.wall_breathing_hz(shear[1], SILICONE_DENSITY_KG_M3, cav.diameter,
-                                                   spec.end_cap.outer_diameter))
-        checks = _checks_plane_wave(f_mid, c, spec) | {"quasi_static_wall": bool(f_mid < breathing)}
+        density = spec.silicone.density_g_cm3 * 1000.0
+        breathing = float(models.wall_breathing_hz(shear[1], density, cav_diameter, spec.end_cap.outer_diameter))
+        checks = (_checks_plane_wave(f_mid, c, cav_diameter, cav.length)
+                  | {"quasi_static_wall": bool(f_mid < breathing)})
         results["soft_wall"] = ModelResult(
             float(f_mid), checks,
             f"transmission line with quasi-static silicone wall (Lame cylinder + half-space end) at "

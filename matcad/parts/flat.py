@@ -1,0 +1,88 @@
+"""Flat (laser-cut) parts as data, and the one place where kerf is applied. Lengths in mm.
+
+A :class:`Flat` holds design intent: the finished outline and finished hole diameters. :func:`cut_plan`
+turns it into what the laser must follow — outlines grow and holes shrink by kerf/2 — and records the
+compensation per feature, so exporters draw it and the report declares it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+REFERENCE_SQUARE_MM = 10.0
+
+
+@dataclass(frozen=True)
+class Hole:
+    """A round hole: centre (x, y), finished diameter, what it is for and what it must fit (mm)."""
+
+    x: float
+    y: float
+    diameter: float
+    purpose: str  # neck | neck_pilot | dowel | bolt | cap
+    fit: str = ""
+
+
+@dataclass(frozen=True)
+class Flat:
+    """A laser-cut part: rectangular outline centred on the origin, holes, engraved text (mm)."""
+
+    name: str
+    thickness: float
+    thickness_measured: bool
+    width: float
+    depth: float
+    holes: tuple[Hole, ...]
+    engrave: str = ""
+    quantity: int = 1
+    corner_radius: float = 0.5
+
+    @property
+    def area_mm2(self) -> float:
+        return self.width * self.depth
+
+
+@dataclass(frozen=True)
+class CutCircle:
+    x: float
+    y: float
+    diameter: float
+    finished_diameter: float
+    compensation: float
+    purpose: str
+
+
+@dataclass(frozen=True)
+class CutPlan:
+    """What the laser follows: outline(s), inner circles, engraving, reference, with compensation declared."""
+
+    flat: Flat
+    kerf: float
+    outlines: tuple[tuple[float, float, float, float, float], ...]  # x0, y0, x1, y1, corner radius
+    circles: tuple[CutCircle, ...]
+    texts: tuple[tuple[float, float, float, str], ...] = ()  # x, y, height, text
+    reference_square: tuple[float, float, float] | None = None  # x0, y0, side
+    extents: tuple[float, float, float, float] = field(default=(0, 0, 0, 0))
+
+
+def cut_plan(flat: Flat, kerf: float, reference_square: bool, spacing: float = 3.0) -> CutPlan:
+    """Apply kerf compensation (outline +kerf/2, holes −kerf/2) and lay out ``quantity`` copies in a row."""
+    half = kerf / 2
+    outlines, circles = [], []
+    for i in range(flat.quantity):
+        dx = i * (flat.width + kerf + spacing)
+        outlines.append((dx - flat.width / 2 - half, -flat.depth / 2 - half,
+                         dx + flat.width / 2 + half, flat.depth / 2 + half, flat.corner_radius + half))
+        circles += [CutCircle(dx + h.x, h.y, h.diameter - kerf, h.diameter, -kerf, h.purpose) for h in flat.holes]
+    x_max = outlines[-1][2]
+    texts = ()
+    if flat.engrave:
+        height = min(2.5, flat.depth / 10)
+        texts = ((-flat.width / 2 + 1.0, -flat.depth / 2 + 1.0, height, flat.engrave),)
+    square = None
+    if reference_square:
+        square = (x_max + spacing, -flat.depth / 2, REFERENCE_SQUARE_MM)
+        x_max = square[0] + REFERENCE_SQUARE_MM
+    y_max = max(flat.depth / 2 + half, -flat.depth / 2 + REFERENCE_SQUARE_MM if square else 0)
+    extents = (outlines[0][0], -flat.depth / 2 - half, x_max, y_max)
+    return CutPlan(flat, kerf, tuple(outlines), tuple(circles), texts, square, extents)

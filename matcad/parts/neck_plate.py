@@ -1,0 +1,15 @@
+"""The acrylic neck plate: its thickness is the neck length l, its centre hole the neck d (paper Fig. 2)."""
+
+from matcad.parts.features import laser_stack_holes
+from matcad.parts.flat import Flat, Hole
+
+
+def neck_plate(spec) -> Flat:
+    """Neck plate: outline plate.width x plate.depth, neck hole (or undersize pilot), dowel and bolt holes (mm)."""
+    if spec.plate.neck_pilot:
+        neck = Hole(0.0, 0.0, spec.neck.diameter - spec.plate.pilot_undersize, "neck_pilot")
+    else:
+        neck = Hole(0.0, 0.0, spec.neck.diameter, "neck")
+    return Flat(name="neck_plate", thickness=spec.neck.length, thickness_measured=spec.plate.thickness_measured,
+                width=spec.plate.width, depth=spec.plate.depth, holes=(neck, *laser_stack_holes(spec)),
+                engrave=spec.plate.label)

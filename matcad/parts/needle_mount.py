@@ -1,0 +1,55 @@
+"""Printed air-supply mount: holds the needle at θ and y under the neck (paper Fig. 2), below a spacer gap.
+
+Assembly frame (shared with every part): plate underside z = 0, neck axis = z axis. The mount's top face is
+at z = −spacer.height and it is ``mount.thickness`` thick. Bolts from the stack thread into self-tapping
+pilots; dowels press into it; with ``spacer.style = "standoff"`` the spacers are printed on it.
+"""
+
+import math
+
+from build123d import Align, Box, Cylinder, Location, Pos, Rot
+
+from matcad.parts.features import (SELF_TAP_PILOT_MM, needle_tip_mm, pin_hole_diameter_mm, plate_bolt_positions_mm,
+                                   plate_dowel_positions_mm)
+from matcad.parts.solid import TOP, cylinder_up
+
+
+def needle_bore_diameter_mm(spec) -> float:
+    """Bore diameter for the needle: outer diameter plus the printer's allowance for needle.fit (mm)."""
+    return pin_hole_diameter_mm(spec.needle.outer_diameter, spec.machine.printer, spec.needle.fit)
+
+
+def needle_cylinder(spec, radius: float, length: float):
+    """Cylinder of ``radius`` on the needle axis, from the needle tip back ``length`` mm (mm)."""
+    tip = needle_tip_mm(spec)
+    tilt = 90.0 - spec.needle.theta_deg  # rotating +z about y by (90 − θ) gives (cos θ, 0, sin θ)
+    return Location(tip) * Rot(0, tilt, 0) * Cylinder(radius, length, align=(Align.CENTER, Align.CENTER,
+                                                                             Align.MAX))
+
+
+def needle(spec):
+    """The needle itself, ``needle.length`` long, ending at its tip (for collision checks and assembly)."""
+    return needle_cylinder(spec, spec.needle.outer_diameter / 2, spec.needle.length)
+
+
+def needle_mount(spec):
+    """The mount solid in the assembly frame (mm)."""
+    gap, thick = spec.spacer.height, spec.mount.thickness
+    top = -gap
+    body = Pos(0, 0, top) * Box(spec.plate.width, spec.plate.depth, thick, align=TOP)
+    if spec.spacer.style == "standoff":
+        for x, y in plate_bolt_positions_mm(spec):
+            body += cylinder_up(spec.spacer.size / 2, gap, x, y, top)
+    pilot = SELF_TAP_PILOT_MM[spec.fasteners.bolt] / 2
+    for x, y in plate_bolt_positions_mm(spec):
+        body -= cylinder_up(pilot, thick + gap, x, y, top - thick)
+    dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
+                                 spec.fasteners.dowel_fit_printed) / 2
+    for x, y in plate_dowel_positions_mm(spec):
+        body -= cylinder_up(dowel, thick, x, y, top - thick)
+    # the bore runs from the tip back through the whole block, whatever θ
+    reach = (thick + gap + spec.plate.width + spec.plate.depth) / max(math.sin(math.radians(
+        spec.needle.theta_deg)), 1e-3)
+    body -= needle_cylinder(spec, needle_bore_diameter_mm(spec) / 2, reach)
+    return body
+
