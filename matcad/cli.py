@@ -9,6 +9,7 @@ import argparse
 import json
 import os
 import sys
+from pathlib import Path
 
 from matcad import __version__
 
@@ -59,6 +60,57 @@ def cmd_predict(args) -> int:
     return EXIT_OK
 
 
+def _format_findings(findings) -> str:
+    if not findings:
+        return "  no findings"
+    return "\n".join(f"  {f.level:<7} {f.id:<24} {f.message}" + (f"\n  {'':<7} {'':<24} fix: {f.fix}" if f.fix
+                                                                  and f.level != "info" else "")
+                     for f in findings)
+
+
+def cmd_check(args) -> int:
+    from matcad import spec as spec_mod
+    from matcad.rules import check, errors
+
+    findings = check(spec_mod.load(args.spec))
+    if args.json:
+        _print_json({"findings": [f.to_dict() for f in findings],
+                     "verdict": "fail" if errors(findings) else "pass"})
+    else:
+        print(_format_findings(findings))
+    return EXIT_RULES if errors(findings) else EXIT_OK
+
+
+def cmd_build(args) -> int:
+    from matcad import spec as spec_mod
+    from matcad.build import DesignRuleFailure, build
+
+    spec = spec_mod.load(args.spec)
+    try:
+        result = build(spec, out_dir=args.out, force=args.force)
+    except DesignRuleFailure as exc:
+        if args.json:
+            _print_json({"verdict": "fail", "written": [], "findings": [f.to_dict() for f in exc.findings]})
+        else:
+            print(_format_findings([f for f in exc.findings if f.level == "error"]))
+            print("matcad: design-rule errors: nothing written (fix the spec or use --force)", file=sys.stderr)
+        return EXIT_RULES
+    if args.json:
+        _print_json({"verdict": result.report["verdict"], "out_dir": str(result.out_dir),
+                     "written": list(result.files), "f0_hz": result.prediction.f0_hz,
+                     "band_hz": list(result.prediction.band_hz),
+                     "findings": [f.to_dict() for f in result.findings]})
+    else:
+        p = result.prediction
+        print(f"{spec.name}: {len(result.files)} files in {result.out_dir}/")
+        for name in result.files:
+            print(f"  {name}")
+        print(f"f0 = {p.f0_hz:.0f} Hz ({p.model}), band {p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz; "
+              f"verdict {result.report['verdict']}")
+        print(_format_findings([f for f in result.findings if f.level != "info"]))
+    return EXIT_OK
+
+
 def cmd_schema(args) -> int:
     from matcad.spec import schema
 
@@ -86,6 +138,18 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--model", help="use this model's f0 instead of the automatic choice")
     p.set_defaults(func=cmd_predict)
 
+    c = sub.add_parser("check", help="run the design rules without building (exit 1 on errors)")
+    c.add_argument("spec", help="spec TOML file")
+    c.add_argument("--json", action="store_true")
+    c.set_defaults(func=cmd_check)
+
+    b = sub.add_parser("build", help="write the fabrication kit and report to out/<name>/")
+    b.add_argument("spec", help="spec TOML file")
+    b.add_argument("--out", type=Path, help="output folder (default out/<name>)")
+    b.add_argument("--force", action="store_true", help="build despite design-rule errors")
+    b.add_argument("--json", action="store_true")
+    b.set_defaults(func=cmd_build)
+
     s = sub.add_parser("schema", help="print every spec field with unit, default and allowed range")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_schema)
@@ -94,12 +158,16 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    from matcad.errors import OutputError
     from matcad.spec import SpecError
 
     try:
         return args.func(args)
     except SpecError as exc:
         print(f"matcad: spec error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except OutputError as exc:
+        print(f"matcad: error: {exc}", file=sys.stderr)
         return EXIT_INPUT
     except ValueError as exc:
         print(f"matcad: error: {exc}", file=sys.stderr)

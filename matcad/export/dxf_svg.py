@@ -49,8 +49,8 @@ def write_dxf(plan: CutPlan, path: Path) -> None:
     msp = doc.modelspace()
     for c in plan.circles:
         msp.add_circle((c.x, c.y), c.diameter / 2, dxfattribs={"layer": "CUT_INNER"})
-    for x, y, height, text in plan.texts:
-        msp.add_text(text, height=height, dxfattribs={"layer": "ENGRAVE", "insert": (x, y)})
+    for t in plan.texts:
+        msp.add_text(t.text, height=t.height, dxfattribs={"layer": "ENGRAVE", "insert": (t.x, t.y)})
     for x0, y0, x1, y1, r in plan.outlines:
         msp.add_lwpolyline(rounded_rect_points(x0, y0, x1, y1, r), format="xyb", close=True,
                            dxfattribs={"layer": "CUT_OUTER"})
@@ -83,14 +83,14 @@ def write_svg(plan: CutPlan, path: Path) -> None:
            f'viewBox="{vx:.6f} {vy:.6f} {w:.6f} {h:.6f}">',
            f"<title>{escape(plan.flat.name)} ({plan.flat.thickness:g} mm sheet, kerf {plan.kerf:g} mm "
            "compensated)</title>"]
-    group = f'fill="none" stroke-width="0.1"'
+    group = 'fill="none" stroke-width="0.1"'
     out.append(f'<g id="CUT_INNER" stroke="{stroke["CUT_INNER"]}" {group}>')
     out += [f'<circle cx="{c.x:.6f}" cy="{-c.y:.6f}" r="{c.diameter / 2:.6f}"/>' for c in plan.circles]
     out.append("</g>")
     if plan.texts:
         out.append(f'<g id="ENGRAVE" fill="{stroke["ENGRAVE"]}" stroke="none">')
-        out += [f'<text x="{x:.6f}" y="{-y:.6f}" font-size="{hgt:.6f}" font-family="sans-serif">'
-                f"{escape(text)}</text>" for x, y, hgt, text in plan.texts]
+        out += [f'<text x="{t.x:.6f}" y="{-t.y:.6f}" font-size="{t.height:.6f}" font-family="sans-serif">'
+                f"{escape(t.text)}</text>" for t in plan.texts]
         out.append("</g>")
     out.append(f'<g id="CUT_OUTER" stroke="{stroke["CUT_OUTER"]}" {group}>')
     out += [f'<path d="{_svg_rounded_rect(*o)}"/>' for o in plan.outlines]

@@ -88,6 +88,18 @@ def cap_flange_thickness_mm(spec) -> float:
     return spec.guide.thickness + spec.end_cap.flange_squeeze
 
 
+def cap_volume_mm3(spec) -> float:
+    """Cast silicone volume of one end cap: flange + body − drafted cavity (mm³)."""
+    import math
+
+    from matcad.acoustics.geometry import drafted_cavity_volume_mm3
+
+    flange_d, tf = cap_flange_diameter_mm(spec), cap_flange_thickness_mm(spec)
+    envelope = math.pi / 4 * (flange_d**2 * tf + spec.end_cap.outer_diameter**2 * (cap_height_mm(spec) - tf))
+    return envelope - float(drafted_cavity_volume_mm3(spec.cavity.diameter, spec.cavity.length,
+                                                      spec.mold.draft_deg))
+
+
 def cap_height_mm(spec) -> float:
     """End cap height from its base (on the plate) to its top: L + top thickness (mm)."""
     return spec.cavity.length + spec.end_cap.top_thickness

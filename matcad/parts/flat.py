@@ -24,6 +24,16 @@ class Hole:
 
 
 @dataclass(frozen=True)
+class Engraving:
+    """Text to engrave: baseline start (x, y) and cap height (mm)."""
+
+    x: float
+    y: float
+    height: float
+    text: str
+
+
+@dataclass(frozen=True)
 class Flat:
     """A laser-cut part: rectangular outline centred on the origin, holes, engraved text (mm)."""
 
@@ -33,7 +43,7 @@ class Flat:
     width: float
     depth: float
     holes: tuple[Hole, ...]
-    engrave: str = ""
+    engrave: tuple[Engraving, ...] = ()
     quantity: int = 1
     corner_radius: float = 0.5
 
@@ -60,7 +70,7 @@ class CutPlan:
     kerf: float
     outlines: tuple[tuple[float, float, float, float, float], ...]  # x0, y0, x1, y1, corner radius
     circles: tuple[CutCircle, ...]
-    texts: tuple[tuple[float, float, float, str], ...] = ()  # x, y, height, text
+    texts: tuple[Engraving, ...] = ()
     reference_square: tuple[float, float, float] | None = None  # x0, y0, side
     extents: tuple[float, float, float, float] = field(default=(0, 0, 0, 0))
 
@@ -75,14 +85,10 @@ def cut_plan(flat: Flat, kerf: float, reference_square: bool, spacing: float = 3
                          dx + flat.width / 2 + half, flat.depth / 2 + half, flat.corner_radius + half))
         circles += [CutCircle(dx + h.x, h.y, h.diameter - kerf, h.diameter, -kerf, h.purpose) for h in flat.holes]
     x_max = outlines[-1][2]
-    texts = ()
-    if flat.engrave:
-        height = min(2.5, flat.depth / 10)
-        texts = ((-flat.width / 2 + 1.0, -flat.depth / 2 + 1.0, height, flat.engrave),)
     square = None
     if reference_square:
         square = (x_max + spacing, -flat.depth / 2, REFERENCE_SQUARE_MM)
         x_max = square[0] + REFERENCE_SQUARE_MM
     y_max = max(flat.depth / 2 + half, -flat.depth / 2 + REFERENCE_SQUARE_MM if square else 0)
     extents = (outlines[0][0], -flat.depth / 2 - half, x_max, y_max)
-    return CutPlan(flat, kerf, tuple(outlines), tuple(circles), texts, square, extents)
+    return CutPlan(flat, kerf, tuple(outlines), tuple(circles), flat.engrave, square, extents)

@@ -1,0 +1,126 @@
+"""spec → only the parts it asks for → a temporary folder → one atomic move into place → report.
+
+Nothing is ever half-written: files go to a hidden sibling folder of the target, and only a complete build
+replaces the target (the previous build is kept until the new one is in place). A spec whose outputs are all
+laser parts never imports the CAD kernel.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from matcad.acoustics.predict import Prediction, predict
+from matcad.errors import OutputError
+from matcad.export.dxf_svg import write_dxf, write_svg
+from matcad.parts.catalogue import laser_parts, needs_cad_kernel, printed_parts
+from matcad.parts.flat import cut_plan
+from matcad.rules import Finding, check, errors
+
+
+class DesignRuleFailure(Exception):
+    """The spec breaks at least one design rule at level error."""
+
+    def __init__(self, findings: list[Finding]):
+        self.findings = findings
+        super().__init__("; ".join(f"{f.id}: {f.message}" for f in errors(findings)))
+
+
+@dataclass(frozen=True)
+class BuildResult:
+    out_dir: Path
+    files: tuple[str, ...]
+    findings: tuple[Finding, ...]
+    prediction: Prediction
+    report: dict
+
+
+def default_out_dir(spec, root: Path = Path("out")) -> Path:
+    return root / spec.name
+
+
+def _check_target(target: Path) -> None:
+    """Refuse to replace anything that is not an earlier matcad build (or an empty folder)."""
+    if not target.exists() and not target.is_symlink():
+        return
+    if target.is_symlink() or not target.is_dir():
+        raise OutputError(f"--out {target}: exists and is not a folder; refusing to replace it")
+    if any(target.iterdir()) and not (target / "report.json").is_file():
+        raise OutputError(f"--out {target}: exists and is not a matcad build folder (no report.json); "
+                          "refusing to replace it")
+
+
+def _replace(tmp: Path, target: Path) -> None:
+    """Move the finished build into place; the previous build survives any failure."""
+    backup = None
+    if target.exists():
+        backup = target.with_name(f".{target.name}.old-{os.getpid()}")
+        os.rename(target, backup)
+    try:
+        os.rename(tmp, target)
+    except OSError:
+        if backup is not None:
+            os.rename(backup, target)
+        raise
+    if backup is not None:
+        shutil.rmtree(backup, ignore_errors=True)
+
+
+def _write_laser(spec, folder: Path) -> list[dict]:
+    """DXF + SVG per laser part; returns each hole as cut, with its compensation."""
+    holes = []
+    for flat in laser_parts(spec):
+        plan = cut_plan(flat, spec.machine.laser_kerf, spec.outputs.reference_square)
+        write_dxf(plan, folder / f"{flat.name}.dxf")
+        write_svg(plan, folder / f"{flat.name}.svg")
+        holes += [{"part": flat.name, "purpose": c.purpose, "x_mm": c.x, "y_mm": c.y,
+                   "finished_mm": c.finished_diameter, "drawn_mm": c.diameter, "compensation_mm": c.compensation}
+                  for c in plan.circles]
+    return holes
+
+
+def _write_solids(spec, folder: Path) -> dict[str, dict]:
+    """STL + STEP per printed part, assembly.step and section.svg; returns the STL read-back checks."""
+    from matcad.export.mesh import mesh_checks, write_step, write_stl
+
+    checks = {}
+    for name, solid in printed_parts(spec).items():
+        stl = folder / f"{name}.stl"
+        write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance)
+        write_step(solid, folder / f"{name}.step")
+        checks[stl.name] = mesh_checks(stl) | {"brep_volume_mm3": float(solid.volume)}
+    if spec.outputs.assembly:
+        from matcad.parts.assembly import assembled_parts, assembly, write_section_svg
+
+        parts = assembled_parts(spec)
+        write_step(assembly(spec), folder / "assembly.step")
+        write_section_svg(spec, folder / "section.svg", parts)
+    return checks
+
+
+def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:
+    """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
+    from matcad.report import make_report, write_report
+
+    prediction = predict(spec)
+    findings = check(spec, prediction)
+    if errors(findings) and not force:
+        raise DesignRuleFailure(findings)
+    target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
+    _check_target(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
+    try:
+        holes = _write_laser(spec, tmp)
+        meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
+        report = make_report(spec, prediction, findings, holes, meshes, tmp)
+        write_report(report, tmp)
+        _replace(tmp, target)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    files = tuple(sorted(p.name for p in target.iterdir()))
+    return BuildResult(target, files, tuple(findings), prediction, report)
