@@ -9,8 +9,8 @@ import math
 
 from build123d import Align, Box, Cylinder, Location, Pos, Rot
 
-from matcad.parts.features import (SELF_TAP_PILOT_MM, needle_tip_mm, pin_hole_diameter_mm, plate_bolt_positions_mm,
-                                   plate_dowel_positions_mm)
+from matcad.parts.features import (SELF_TAP_PILOT_MM, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
+                                   plate_bolt_positions_mm, plate_dowel_positions_mm)
 from matcad.parts.solid import TOP, cylinder_up
 
 
@@ -19,17 +19,16 @@ def needle_bore_diameter_mm(spec) -> float:
     return pin_hole_diameter_mm(spec.needle.outer_diameter, spec.machine.printer, spec.needle.fit)
 
 
-def needle_cylinder(spec, radius: float, length: float):
-    """Cylinder of ``radius`` on the needle axis, from the needle tip back ``length`` mm (mm)."""
-    tip = needle_tip_mm(spec)
+def _on_needle_axis(spec, start, radius: float, length: float):
+    """Cylinder of ``radius`` on the needle axis, from point ``start`` on it back ``length`` mm (mm)."""
     tilt = 90.0 - spec.needle.theta_deg  # rotating +z about y by (90 − θ) gives (cos θ, 0, sin θ)
-    return Location(tip) * Rot(0, tilt, 0) * Cylinder(radius, length, align=(Align.CENTER, Align.CENTER,
-                                                                             Align.MAX))
+    return Location(start) * Rot(0, tilt, 0) * Cylinder(radius, length, align=(Align.CENTER, Align.CENTER,
+                                                                               Align.MAX))
 
 
 def needle(spec):
     """The needle itself, ``needle.length`` long, ending at its tip (for collision checks and assembly)."""
-    return needle_cylinder(spec, spec.needle.outer_diameter / 2, spec.needle.length)
+    return _on_needle_axis(spec, needle_tip_mm(spec), spec.needle.outer_diameter / 2, spec.needle.length)
 
 
 def needle_mount(spec):
@@ -47,9 +46,11 @@ def needle_mount(spec):
                                  spec.fasteners.dowel_fit_printed) / 2
     for x, y in plate_dowel_positions_mm(spec):
         body -= cylinder_up(dowel, thick, x, y, top - thick)
-    # the bore runs from the tip back through the whole block, whatever θ
+    # the bore runs along the whole axis, from the plate-underside plane back through the block: wherever
+    # the tip stands, the jet's path to the neck is open
+    mouth_point, _ = needle_axis_mm(spec)
     reach = (thick + gap + spec.plate.width + spec.plate.depth) / max(math.sin(math.radians(
         spec.needle.theta_deg)), 1e-3)
-    body -= needle_cylinder(spec, needle_bore_diameter_mm(spec) / 2, reach)
+    body -= _on_needle_axis(spec, mouth_point, needle_bore_diameter_mm(spec) / 2, reach)
     return body
 

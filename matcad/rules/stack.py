@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 from matcad.parts.features import needle_tip_mm
 from matcad.rules import Finding
 
@@ -13,18 +11,19 @@ PAPER_Y_MM = (0.0, 3.47)
 
 
 def needle_clearance(spec) -> list[Finding]:
+    """The needle end must not touch the plate, and must still be held by the mount (the bore runs along
+    the whole axis, so a tip standing inside the bore still has a clear jet path)."""
     n = spec.needle
-    tip_z = needle_tip_mm(spec)[2]
-    lowest_face = tip_z - n.outer_diameter / 2 * math.cos(math.radians(n.theta_deg))
     out = []
     if n.tip_clearance <= 0:
         out.append(Finding("needle.collision", "error", n.tip_clearance, "> 0",
                            "the needle end touches the neck plate", "set needle.tip_clearance > 0"))
-    if lowest_face <= -spec.spacer.height:
-        out.append(Finding("needle.collision", "error", round(-lowest_face, 4), spec.spacer.height,
-                           f"the needle end reaches {-lowest_face:.2f} mm below the plate, into the mount "
-                           f"(gap {spec.spacer.height:g} mm): it cannot stand in the gap",
-                           "raise spacer.height or theta, or reduce needle.tip_clearance"))
+    tip_z = needle_tip_mm(spec)[2]
+    bottom = -(spec.spacer.height + spec.mount.thickness)
+    if tip_z <= bottom:
+        out.append(Finding("needle.collision", "error", round(-tip_z, 4), round(-bottom, 4),
+                           f"the needle tip sits {-tip_z:.2f} mm below the plate, under the mount: nothing "
+                           "holds it", "reduce needle.tip_clearance or raise theta"))
     return out
 
 

@@ -1,0 +1,127 @@
+"""Every template built once; its files read back with the libraries a fabricator's software uses."""
+
+import hashlib
+import json
+import math
+import re
+import xml.etree.ElementTree as ET
+
+import ezdxf
+import pytest
+import trimesh
+
+from matcad import spec as spec_mod
+from matcad.build import build
+from matcad.export.dxf_svg import LAYERS
+from matcad.parts.catalogue import laser_parts
+from matcad.parts.features import cap_volume_mm3
+from tests.conftest import TEMPLATES
+
+
+@pytest.fixture(scope="module", params=TEMPLATES, ids=lambda p: p.stem)
+def built(request, tmp_path_factory):
+    spec = spec_mod.load(request.param)
+    out = tmp_path_factory.mktemp(spec.name) / spec.name
+    result = build(spec, out)
+    return spec, out, result
+
+
+def _laser(spec):
+    return {flat.name: flat for flat in laser_parts(spec)}
+
+
+def test_report_manifest_matches_files(built):
+    spec, out, result = built
+    report = json.loads((out / "report.json").read_text())
+    listed = {f["file"]: f for f in report["files"]}
+    on_disk = {p.name for p in out.iterdir()} - {"report.json", "report.md"}
+    assert set(listed) == on_disk
+    for name, row in listed.items():
+        data = (out / name).read_bytes()
+        assert row["bytes"] == len(data) and row["sha256"] == hashlib.sha256(data).hexdigest()
+    assert report["matcad_version"] and report["spec"]["name"] == spec.name
+    assert report["prediction"]["f0_hz"] == pytest.approx(result.prediction.f0_hz)
+    assert (out / "report.md").read_text().startswith(f"# {spec.name}")
+
+
+def test_dxf_units_layers_holes_outlines(built):
+    spec, out, _ = built
+    kerf = spec.machine.laser_kerf
+    for name, flat in _laser(spec).items():
+        doc = ezdxf.readfile(out / f"{name}.dxf")
+        assert doc.header["$INSUNITS"] == 4
+        auditor = doc.audit()
+        assert not auditor.has_errors, auditor.errors
+        colours = {layer: doc.layers.get(layer).color for layer in LAYERS}
+        assert len(set(colours.values())) == len(LAYERS)
+        msp = doc.modelspace()
+        assert not msp.query("SPLINE ELLIPSE")
+        circles = sorted(round(2 * c.dxf.radius, 9) for c in msp.query("CIRCLE[layer=='CUT_INNER']"))
+        expected = sorted(round(h.diameter - kerf, 9) for h in flat.holes) * flat.quantity
+        assert len(circles) == len(expected)
+        for got, want in zip(circles, sorted(expected)):
+            assert abs(got - want) <= 1e-6
+        outlines = msp.query("LWPOLYLINE[layer=='CUT_OUTER']")
+        assert len(outlines) == flat.quantity and all(p.closed for p in outlines)
+        xs = [x for x, y, *_ in outlines[0].get_points("xyb")]
+        ys = [y for x, y, *_ in outlines[0].get_points("xyb")]
+        assert max(xs) - min(xs) == pytest.approx(flat.width + kerf, abs=1e-6)
+        assert max(ys) - min(ys) == pytest.approx(flat.depth + kerf, abs=1e-6)
+        refs = msp.query("LWPOLYLINE[layer=='REFERENCE']")
+        if spec.outputs.reference_square:
+            pts = [p[:2] for p in refs[0].get_points("xy")]
+            assert max(p[0] for p in pts) - min(p[0] for p in pts) == pytest.approx(10.0, abs=1e-9)
+
+
+def test_neck_hole_is_spec_minus_kerf(built):
+    spec, out, _ = built
+    doc = ezdxf.readfile(out / "neck_plate.dxf")
+    neck = [c for c in doc.modelspace().query("CIRCLE") if abs(c.dxf.center.x) < 1e-9 and abs(c.dxf.center.y) < 1e-9]
+    cut = spec.neck.diameter - (spec.plate.pilot_undersize if spec.plate.neck_pilot else 0.0)
+    assert len(neck) == 1 and 2 * neck[0].dxf.radius == pytest.approx(cut - spec.machine.laser_kerf, abs=1e-6)
+
+
+def test_svg_mm_size_viewbox_and_colours(built):
+    spec, out, _ = built
+    for name in _laser(spec):
+        root = ET.parse(out / f"{name}.svg").getroot()
+        w, h = (float(re.fullmatch(r"([\d.]+)mm", root.get(k)).group(1)) for k in ("width", "height"))
+        vb = [float(v) for v in root.get("viewBox").split()]
+        assert vb[2] == pytest.approx(w) and vb[3] == pytest.approx(h)
+        groups = {g.get("id"): g for g in root.iter("{http://www.w3.org/2000/svg}g")}
+        assert groups["CUT_INNER"].get("stroke") != groups["CUT_OUTER"].get("stroke")
+        assert groups["CUT_INNER"].get("stroke") == LAYERS["CUT_INNER"][1]
+        radii = sorted(2 * float(c.get("r")) for c in groups["CUT_INNER"])
+        flat = _laser(spec)[name]
+        assert radii == pytest.approx(sorted(hh.diameter - spec.machine.laser_kerf for hh in flat.holes)
+                                      * flat.quantity, abs=1e-6)
+
+
+def test_stl_watertight_one_body_volume_matches_brep(built):
+    spec, out, result = built
+    meshes = result.report["meshes"]
+    stls = sorted(p.name for p in out.glob("*.stl"))
+    assert stls == sorted(meshes)
+    for name in stls:
+        mesh = trimesh.load_mesh(out / name)
+        assert mesh.is_watertight and mesh.is_volume
+        assert len(mesh.split(only_watertight=False)) == 1
+        assert mesh.volume == pytest.approx(meshes[name]["brep_volume_mm3"], rel=1e-3)
+
+
+def test_cap_volume_against_analytic(built):
+    spec, out, _ = built
+    if not spec.outputs.end_cap_mold:
+        return  # the laser-only template builds no cap; test_only_asked_outputs_written covers it
+    mesh = trimesh.load_mesh(out / "end_cap.stl")
+    assert mesh.volume == pytest.approx(cap_volume_mm3(spec), rel=5e-3)
+
+
+def test_only_asked_outputs_written(built):
+    spec, out, _ = built
+    names = {p.name for p in out.iterdir()}
+    o = spec.outputs
+    assert ("end_cap_mold_base.stl" in names) == o.end_cap_mold
+    assert ("needle_mount.stl" in names) == o.needle_mount
+    assert ("assembly.step" in names) == o.assembly
+    assert ("spacer.dxf" in names) == (o.spacers and spec.spacer.style == "laser")
