@@ -132,7 +132,7 @@ class Needle:
                       "axis meets that plane to the nearest edge of the neck opening", "mm", 1.0,
                       lo=-LENGTH_MAX_MM, hi=LENGTH_MAX_MM, lo_open=False)
     tip_clearance: float = _param("gap between the needle's end face and the plate underside", "mm", 0.3,
-                                  lo=0.0, hi=LENGTH_MAX_MM)
+                                  lo=0.0, hi=LENGTH_MAX_MM, lo_open=False)
     length: float = _length("exposed needle length modelled for collision checks", 25.0)
     fit: str = _param("needle fit in the printed bore", default="slip", kind="choice",
                       choices=("clearance", "slip", "press"))

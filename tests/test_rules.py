@@ -1,0 +1,68 @@
+"""Each design rule fires on a spec that breaks it, at the right level, and not on the paper's taxel."""
+
+import pytest
+
+from matcad import spec as spec_mod
+from matcad.rules import check
+from tests.conftest import PAPER
+
+
+def _paper_with(**over):
+    import tomllib
+    data = tomllib.loads(PAPER.read_text())
+    for key, value in over.items():
+        section, field = key.split("__")
+        data.setdefault(section, {})[field] = value
+    return spec_mod.from_dict(data)
+
+
+def _levels(spec, rule_id):
+    return {f.level for f in check(spec) if f.id == rule_id}
+
+
+@pytest.mark.parametrize("over,rule,level", [
+    ({"mold__wall": 0.6}, "print.wall", "error"),                       # < 2 x 0.4 mm nozzle
+    ({"machine__key_clearance": 0.05}, "print.key_clearance", "warning"),
+    ({"machine__key_clearance": 0.8}, "print.key_clearance", "warning"),
+    ({"mold__fill_port": 3.0}, "mold.fill_port_fit", "error"),          # wider than the 2.41 mm cap wall
+    ({"mold__fill_port": 1.5}, "mold.fill_port", "warning"),
+    ({"mold__vent": 2.5}, "mold.vents", "error"),                       # wider than the 2 mm flange ring
+    ({"plate__width": 13.0}, "laser.web", "error"),                     # bolt holes run into the flange hole
+    ({"machine__laser_min_feature": 1.6}, "laser.feature", "warning"),  # 1.55 mm dowel holes
+    ({"neck__length": 6.0}, "laser.stock", "info"),                     # 6 mm is stock
+    ({"neck__length": 6.1}, "laser.stock", "warning"),                  # 6.1 mm is not
+    ({"fasteners__dowel_fit_laser": "press"}, "fit.dowel_laser", "error"),
+    ({"fasteners__dowel_fit_printed": "clearance"}, "fit.dowel_printed", "warning"),
+    ({"needle__tip_clearance": 0.0}, "needle.collision", "error"),
+    ({"needle__tip_clearance": 12.0}, "needle.collision", "error"),     # tip below the mount
+    ({"needle__theta_deg": 85.0}, "needle.theta", "warning"),
+    ({"needle__y": 4.0}, "needle.y", "warning"),
+    ({"microphone__sample_rate_hz": 8000.0}, "acoustic.band_high", "error"),
+    ({"microphone__floor_hz": 5000.0}, "acoustic.band_low", "warning"),
+    ({"end_cap__outer_diameter": 4.5}, "cap.wall", "warning"),
+])
+def test_rule_fires(over, rule, level):
+    assert level in _levels(_paper_with(**over), rule)
+
+
+@pytest.mark.parametrize("rule", ["print.wall", "mold.fill_port_fit", "mold.fill_port", "laser.web",
+                                  "fit.dowel_laser", "needle.collision", "needle.theta", "needle.y",
+                                  "acoustic.band_high", "acoustic.band_low", "cap.wall", "print.key_clearance"])
+def test_paper_taxel_passes(rule):
+    assert not _levels(spec_mod.load(PAPER), rule)
+
+
+def test_paper_neck_taper_warning_and_pilot_downgrades_it():
+    assert "warning" in {f.level for f in check(spec_mod.load(PAPER))
+                         if f.id == "laser.taper" and "neck hole" in f.message}
+    piloted = _paper_with(plate__neck_pilot=True)
+    neck = [f for f in check(piloted) if f.id == "laser.taper" and "neck" in f.message and "pilot" in f.message]
+    assert neck and all(f.level == "info" for f in neck)
+
+
+def test_silicone_batch_volume_and_mass():
+    spec = spec_mod.load(PAPER)
+    batch = next(f for f in check(spec) if f.id == "silicone.batch")
+    from matcad.parts.features import cap_volume_mm3
+    assert batch.value == pytest.approx(cap_volume_mm3(spec) * 1.3 / 1000, abs=1e-4)
+    assert f"{cap_volume_mm3(spec) * 1.3 / 1000 * 1.08:.2f} g" in batch.message
