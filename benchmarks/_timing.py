@@ -29,4 +29,4 @@ def median_ratio(argv, baseline, runs=15, warmup=2):
 
 def matcad(*args):
     """argv running matcad's console entry point in this interpreter."""
-    return [sys.executable, "-c", "import sys; from matcad.cli import main; sys.exit(main())", *args]
+    return [sys.executable, "-c", "from matcad.cli import run; run()", *args]

@@ -1,3 +1,3 @@
-from matcad.cli import main
+from matcad.cli import run
 
-raise SystemExit(main())
+run()

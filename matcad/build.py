@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -38,8 +39,8 @@ class BuildResult:
     report: dict
 
 
-def default_out_dir(spec, root: Path = Path("out")) -> Path:
-    return root / spec.name
+def default_out_dir(spec, suffix: str = "", root: Path = Path("out")) -> Path:
+    return root / f"{spec.name}{suffix}"
 
 
 def _check_target(target: Path) -> None:
@@ -69,34 +70,56 @@ def _replace(tmp: Path, target: Path) -> None:
         shutil.rmtree(backup, ignore_errors=True)
 
 
+@contextmanager
+def staged_output(target: Path):
+    """Yield a hidden temporary sibling of ``target``; on success it replaces ``target`` in one move, on any
+    failure it is deleted and ``target`` is left as it was."""
+    _check_target(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
+    try:
+        yield tmp
+        _replace(tmp, target)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def write_laser_part(flat, spec, folder: Path) -> list[dict]:
+    """DXF + SVG of one laser part, kerf compensated; returns each hole as cut, with its compensation."""
+    plan = cut_plan(flat, spec.machine.laser_kerf, spec.outputs.reference_square)
+    write_dxf(plan, folder / f"{flat.name}.dxf")
+    write_svg(plan, folder / f"{flat.name}.svg")
+    return [{"part": flat.name, "purpose": c.purpose, "x_mm": c.x, "y_mm": c.y, "finished_mm": c.finished_diameter,
+             "drawn_mm": c.diameter, "compensation_mm": c.compensation} for c in plan.circles]
+
+
+def write_printed_part(name: str, solid, spec, folder: Path) -> dict:
+    """STL + STEP of one solid; returns the STL's read-back checks and the B-rep volume."""
+    from matcad.export.mesh import mesh_checks, write_step, write_stl
+
+    stl = folder / f"{name}.stl"
+    write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance)
+    write_step(solid, folder / f"{name}.step")
+    return mesh_checks(stl) | {"brep_volume_mm3": float(solid.volume)}
+
+
 def _write_laser(spec, folder: Path) -> list[dict]:
-    """DXF + SVG per laser part; returns each hole as cut, with its compensation."""
-    holes = []
-    for flat in laser_parts(spec):
-        plan = cut_plan(flat, spec.machine.laser_kerf, spec.outputs.reference_square)
-        write_dxf(plan, folder / f"{flat.name}.dxf")
-        write_svg(plan, folder / f"{flat.name}.svg")
-        holes += [{"part": flat.name, "purpose": c.purpose, "x_mm": c.x, "y_mm": c.y,
-                   "finished_mm": c.finished_diameter, "drawn_mm": c.diameter, "compensation_mm": c.compensation}
-                  for c in plan.circles]
-    return holes
+    """DXF + SVG per laser part; returns every hole as cut."""
+    return [hole for flat in laser_parts(spec) for hole in write_laser_part(flat, spec, folder)]
 
 
 def _write_solids(spec, folder: Path) -> dict[str, dict]:
     """STL + STEP per printed part, assembly.step and section.svg; returns the STL read-back checks."""
-    from matcad.export.mesh import mesh_checks, write_step, write_stl
+    from matcad.export.mesh import write_step
 
-    checks = {}
-    for name, solid in printed_parts(spec).items():
-        stl = folder / f"{name}.stl"
-        write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance)
-        write_step(solid, folder / f"{name}.step")
-        checks[stl.name] = mesh_checks(stl) | {"brep_volume_mm3": float(solid.volume)}
+    checks = {f"{name}.stl": write_printed_part(name, solid, spec, folder)
+              for name, solid in printed_parts(spec).items()}
     if spec.outputs.assembly:
         from matcad.parts.assembly import assembled_parts, assembly, write_section_svg
 
         parts = assembled_parts(spec)
-        write_step(assembly(spec), folder / "assembly.step")
+        write_step(assembly(spec, parts), folder / "assembly.step")
         write_section_svg(spec, folder / "section.svg", parts)
     return checks
 
@@ -110,17 +133,28 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
     if errors(findings) and not force:
         raise DesignRuleFailure(findings)
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
-    _check_target(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
-    try:
+    with staged_output(target) as tmp:
         holes = _write_laser(spec, tmp)
         meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
         report = make_report(spec, prediction, findings, holes, meshes, tmp)
         write_report(report, tmp)
-        _replace(tmp, target)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     files = tuple(sorted(p.name for p in target.iterdir()))
     return BuildResult(target, files, tuple(findings), prediction, report)
+
+
+def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
+    """Write the laser and printed test coupons to ``out_dir`` (default out/<name>-coupon) with a hole table."""
+    import json
+
+    from matcad.parts.coupon import laser_coupon, printed_coupon, printed_coupon_holes
+
+    target = Path(out_dir) if out_dir is not None else default_out_dir(spec, "-coupon")
+    with staged_output(target) as tmp:
+        laser = write_laser_part(laser_coupon(spec), spec, tmp)
+        mesh = write_printed_part("coupon_printed", printed_coupon(spec), spec, tmp)
+        table = {"name": spec.name, "laser_kerf_mm": spec.machine.laser_kerf, "printer": spec.machine.printer,
+                 "laser_holes": laser, "mesh": mesh,
+                 "printed_holes": [{"purpose": h.purpose, "x_mm": h.x, "y_mm": h.y, "diameter_mm": h.diameter}
+                                   for h in printed_coupon_holes(spec)]}
+        (tmp / "report.json").write_text(json.dumps(table, indent=2) + "\n", encoding="utf-8")
+    return target, table

@@ -39,10 +39,10 @@ def assembled_parts(spec) -> dict[str, object]:
     return parts
 
 
-def assembly(spec) -> Compound:
-    """All parts as one labelled compound (for assembly.step)."""
+def assembly(spec, parts=None) -> Compound:
+    """All parts (``assembled_parts`` unless given) as one labelled compound (for assembly.step)."""
     children = []
-    for name, solid in assembled_parts(spec).items():
+    for name, solid in (parts or assembled_parts(spec)).items():
         solid.label = name
         children.append(solid)
     return Compound(label=spec.name, children=children)

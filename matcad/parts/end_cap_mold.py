@@ -76,15 +76,11 @@ def _upside_down(shape, x: float):
 def mold_base(spec):
     """Base block: top face at z = 0, cap negatives upside down, keys on top, bolt holes (mm)."""
     lay = layout(spec)
-    base = Box(lay.block_x, lay.block_y, lay.base_height, align=TOP)
-    for x in lay.cap_x:
-        base -= _upside_down(cap_envelope(spec), x)
-    for x, y in lay.keys:
-        base += _key(spec, 0.0, x, y)
     bolt_r = bolt_clearance_mm(spec.mold.bolt, "normal") / 2
-    for x, y in lay.bolts:
-        base -= cylinder_up(bolt_r, lay.base_height, x, y, -lay.base_height)
-    return base
+    block = Box(lay.block_x, lay.block_y, lay.base_height, align=TOP)
+    block = block.fuse(*(_key(spec, 0.0, x, y) for x, y in lay.keys))
+    return block.cut(*[_upside_down(cap_envelope(spec), x) for x in lay.cap_x],
+                     *[cylinder_up(bolt_r, lay.base_height, x, y, -lay.base_height) for x, y in lay.bolts])
 
 
 def mold_lid(spec):
@@ -92,16 +88,12 @@ def mold_lid(spec):
     lay = layout(spec)
     m = spec.mold
     lid = Box(lay.block_x, lay.block_y, m.lid_thickness, align=BOTTOM)
-    for x in lay.cap_x:
-        lid += _upside_down(core_pin(spec), x)
-    for x, y in lay.keys:
-        lid -= _key(spec, spec.machine.key_clearance, x, y)
+    lid = lid.fuse(*(_upside_down(core_pin(spec), x) for x in lay.cap_x))
     holes = ([(x, y, m.fill_port / 2) for x, y in lay.fill_ports]
              + [(x, y, m.vent / 2) for x, y in lay.vents]
              + [(x, y, bolt_clearance_mm(m.bolt, "normal") / 2) for x, y in lay.bolts])
-    for x, y, r in holes:
-        lid -= cylinder_up(r, m.lid_thickness, x, y, 0.0)
-    return lid
+    return lid.cut(*[_key(spec, spec.machine.key_clearance, x, y) for x, y in lay.keys],
+                   *[cylinder_up(r, m.lid_thickness, x, y, 0.0) for x, y, r in holes])
 
 
 def cast_caps(spec):

@@ -40,17 +40,15 @@ def needle_mount(spec):
         for x, y in plate_bolt_positions_mm(spec):
             body += cylinder_up(spec.spacer.size / 2, gap, x, y, top)
     pilot = SELF_TAP_PILOT_MM[spec.fasteners.bolt] / 2
-    for x, y in plate_bolt_positions_mm(spec):
-        body -= cylinder_up(pilot, thick + gap, x, y, top - thick)
     dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
                                  spec.fasteners.dowel_fit_printed) / 2
-    for x, y in plate_dowel_positions_mm(spec):
-        body -= cylinder_up(dowel, thick, x, y, top - thick)
     # the bore runs along the whole axis, from the plate-underside plane back through the block: wherever
     # the tip stands, the jet's path to the neck is open
     mouth_point, _ = needle_axis_mm(spec)
     reach = (thick + gap + spec.plate.width + spec.plate.depth) / max(math.sin(math.radians(
         spec.needle.theta_deg)), 1e-3)
-    body -= _on_needle_axis(spec, mouth_point, needle_bore_diameter_mm(spec) / 2, reach)
-    return body
+    holes = ([cylinder_up(pilot, thick + gap, x, y, top - thick) for x, y in plate_bolt_positions_mm(spec)]
+             + [cylinder_up(dowel, thick, x, y, top - thick) for x, y in plate_dowel_positions_mm(spec)]
+             + [_on_needle_axis(spec, mouth_point, needle_bore_diameter_mm(spec) / 2, reach)])
+    return body.cut(*holes)
 

@@ -21,6 +21,4 @@ def frustum_up(bottom_radius: float, top_radius: float, height: float, x=0.0, y=
 def flat_solid(flat, z0: float = 0.0):
     """A laser part (design intent, finished sizes) as a solid from z0 to z0 + thickness (mm)."""
     body = Pos(0, 0, z0) * Box(flat.width, flat.depth, flat.thickness, align=BOTTOM)
-    for h in flat.holes:
-        body -= cylinder_up(h.diameter / 2, flat.thickness, h.x, h.y, z0)
-    return body
+    return body.cut(*(cylinder_up(h.diameter / 2, flat.thickness, h.x, h.y, z0) for h in flat.holes))
