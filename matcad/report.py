@@ -27,6 +27,8 @@ def as_built(spec) -> dict:
         "cavity_diameter_mm": cav.diameter, "cavity_length_mm": cav.length, "draft_deg": spec.mold.draft_deg,
         "cavity_tip_diameter_mm": float(drafted_tip_diameter_mm(cav.diameter, cav.length, spec.mold.draft_deg)),
         "cavity_volume_mm3": float(drafted_cavity_volume_mm3(cav.diameter, cav.length, spec.mold.draft_deg)),
+        "draft_volume_change_pct": 100 * float(drafted_cavity_volume_mm3(cav.diameter, cav.length, spec.mold.draft_deg)
+                                               / drafted_cavity_volume_mm3(cav.diameter, cav.length, 0.0) - 1),
         "neck_diameter_as_cut_mm": spec.neck.diameter - spec.plate.pilot_undersize if pilot else spec.neck.diameter,
         "neck_diameter_finished_mm": spec.neck.diameter,
         "neck_finish": "drill pilot to size" if pilot else "as cut (kerf compensated)",

@@ -112,7 +112,8 @@ def test_stl_watertight_one_body_volume_matches_brep(built):
 def test_cap_volume_against_analytic(built):
     spec, out, _ = built
     if not spec.outputs.end_cap_mold:
-        return  # the laser-only template builds no cap; test_only_asked_outputs_written covers it
+        assert not (out / "end_cap.stl").exists()
+        return
     mesh = trimesh.load_mesh(out / "end_cap.stl")
     assert mesh.volume == pytest.approx(cap_volume_mm3(spec), rel=5e-3)
 
