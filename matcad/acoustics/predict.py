@@ -104,6 +104,25 @@ def _model_warnings(name: str, result: ModelResult, diameter_ratio: float) -> li
     return [text[check] for check, ok in result.checks.items() if not ok]
 
 
+def _fem(spec, c_m_s: float, f_guess_hz: float) -> tuple[ModelResult, tuple[float, float]]:
+    """The FEM reference for this spec (rigid, or at the shear-modulus range's ends and geometric mean)."""
+    from matcad.acoustics import fem
+
+    k_guess = 2 * np.pi * f_guess_hz / (c_m_s * models.MM_PER_M)
+    if spec.wall.model == "silicone":
+        g_lo, g_hi = (x * 1e6 for x in spec.wall.shear_modulus_mpa)
+        shears = [np.sqrt(g_lo * g_hi), g_lo, g_hi]
+    else:
+        shears = [None]
+    runs = [fem.solve(fem.geometry_from_spec(spec, g), k_guess, speed_of_sound_m_s=c_m_s) for g in shears]
+    mid = runs[0]
+    checks = {"mode_in_cavity": mid.cavity_energy_fraction > 0.3, "fundamental_found": mid.q > fem.MIN_Q}
+    source = (f"axisymmetric P2 FEM (scikit-fem), level {mid.level}, {mid.dofs} dofs, Q = {mid.q:.1f}, "
+              f"{sum(r.seconds for r in runs):.2f} s")
+    band = (runs[1].f0_hz, runs[2].f0_hz) if len(runs) == 3 else (mid.f0_hz, mid.f0_hz)
+    return ModelResult(mid.f0_hz, checks, source), band
+
+
 def predict(spec, forces_n=(), model: str | None = None) -> Prediction:
     """Predict the unloaded resonance of ``spec`` with every model; Eq. 5 at ``forces_n`` (N) if calibrated.
 
@@ -157,11 +176,13 @@ def predict(spec, forces_n=(), model: str | None = None) -> Prediction:
         chosen = "soft_wall"
         band_model = (float(f_lo), float(f_hi))
 
+    if model == "fem":
+        results["fem"], band_model = _fem(spec, c, results[chosen].f0_hz)
     if model is not None:
         if model not in results:
-            raise ValueError(f"model {model!r} invalid, must be one of {sorted(results)}")
+            raise ValueError(f"model {model!r} invalid, must be one of {sorted(results) + ['fem']}")
         chosen = model
-        band_model = (results[model].f0_hz,) * 2 if model != "soft_wall" else band_model
+        band_model = band_model if model in ("soft_wall", "fem") else (results[model].f0_hz,) * 2
 
     warnings = _model_warnings(chosen, results[chosen], xi)
     cal = spec_calibration(spec)
