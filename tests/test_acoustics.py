@@ -182,3 +182,37 @@ def test_vectorised_matches_scalar():
     vec = models.transmission_line_hz(C, A, 8.0, ln, 4.0)
     scalar = [float(models.transmission_line_hz(C, a, 8.0, x, 4.0)) for a, x in zip(A, ln)]
     np.testing.assert_allclose(vec, scalar, rtol=1e-12)
+
+
+def test_uncertainty_budget_lines_and_band():
+    from matcad.acoustics.uncertainty import model_errors, total
+    p = predict(spec_mod.load(PAPER))
+    sources = [b.source for b in p.budget]
+    assert sources == ["model", "neck diameter", "neck length (sheet)", "cavity diameter (core pin)",
+                       "core-pin draft", "air temperature", "silicone shear modulus"]
+    assert all(b.low_hz <= 0 <= b.high_hz for b in p.budget)
+    low, high = total(list(p.budget))
+    assert p.band_hz == pytest.approx((p.f0_hz + low, p.f0_hz + high))
+    model = next(b for b in p.budget if b.source == "model")
+    assert model.high_hz == pytest.approx(model_errors()["soft_wall"]["max_abs"] * p.f0_hz)
+    # a wider neck sings higher: the neck-diameter line is negative at d - tol, positive at d + tol
+    neck = next(b for b in p.budget if b.source == "neck diameter")
+    assert neck.low_hz < 0 < neck.high_hz
+    # ISO 7823-1 on 6.35 mm cast sheet: +-1.035 mm; a thicker neck sings lower (DIGEST: +-0.3 mm -> -+2 %)
+    sheet = next(b for b in p.budget if b.source == "neck length (sheet)")
+    assert "1.04 mm" in sheet.tolerance and sheet.low_hz < -0.04 * p.f0_hz
+
+
+def test_measuring_the_sheet_narrows_the_band():
+    loose = predict(_spec())
+    measured = predict(_spec(plate__thickness_measured=True, plate__neck_pilot=True))
+    width = lambda p: p.band_hz[1] - p.band_hz[0]  # noqa: E731
+    assert width(measured) < 0.5 * width(loose)
+
+
+def test_model_errors_come_from_the_benchmark():
+    from matcad.acoustics.uncertainty import model_errors
+    errors = model_errors()
+    assert set(errors) >= {"lumped", "end_corrected", "transmission_line", "soft_wall", "fem"}
+    assert all(e["measured_by"] == "benchmarks/error_vs_runtime.py" and e["cases"] >= 1 for e in errors.values())
+    assert errors["fem"]["max_abs"] <= 0.001 and errors["transmission_line"]["max_abs"] < 0.02

@@ -10,17 +10,17 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from matcad.acoustics import geometry, models
-from matcad.acoustics.air import speed_of_sound_m_s
+from matcad.acoustics import models
+from matcad.acoustics.resonator import evaluate, resonator, shear_moduli_pa
+from matcad.acoustics.uncertainty import BudgetLine, budget, total
 from matcad.acoustics.load import MAT_PAPER_2024, LoadCalibration, frequency_at_force_hz, invalid_reason
 
-MODEL_ERROR = 0.03
-"""Relative model-error allowance on the chosen f0 (±3 %): the DIGEST's viscous boundary-layer shift (~−2 %)
-plus the mount correction's roughness; to be replaced by the error measured against the FEM reference."""
 PLANE_WAVE_CUTOFF_KA = 1.8412
 """First non-planar (1,1) mode of a circular duct cuts on at k·a = 1.8412 (zero of J1')."""
 PANCAKE_L_OVER_D = 0.3
 LUMPED_NECK_AIR_RATIO = 0.1
+LUMPED_END_CORRECTION_RATIO = 0.1
+"""Uncorrected Eq. 1 needs the neck's end corrections ≪ its length (they are 24 % of it on the paper taxel)."""
 
 
 @dataclass(frozen=True)
@@ -59,6 +59,7 @@ class Prediction:
     model: str
     f0_hz: float
     band_hz: tuple[float, float]
+    budget: tuple[BudgetLine, ...]
     warnings: tuple[str, ...]
     calibration: str | None = None
     load_curve: tuple[LoadPoint, ...] = ()
@@ -93,6 +94,8 @@ def _model_warnings(name: str, result: ModelResult, diameter_ratio: float) -> li
     text = {
         "neck_air_ratio_small": f"{name}: neck holds much air relative to the cavity (A*l/V >= "
                                 f"{LUMPED_NECK_AIR_RATIO}); lumped neck assumption fails",
+        "end_corrections_small": f"{name}: the neck's end corrections are >= {LUMPED_END_CORRECTION_RATIO:g} x its "
+                                 "length; uncorrected Eq. 1 overestimates f",
         "ingard_xi_below_0.4": f"{name}: Ingard's inner correction used at xi = {diameter_ratio:.3g}, outside "
                                f"its stated xi < {models.INGARD_XI_LIMIT}",
         "plane_waves_in_cavity": f"{name}: cavity wider than the plane-wave limit at f0 (k*D/2 >= "
@@ -104,85 +107,61 @@ def _model_warnings(name: str, result: ModelResult, diameter_ratio: float) -> li
     return [text[check] for check, ok in result.checks.items() if not ok]
 
 
-def _fem(spec, c_m_s: float, f_guess_hz: float) -> tuple[ModelResult, tuple[float, float]]:
-    """The FEM reference for this spec (rigid, or at the shear-modulus range's ends and geometric mean)."""
+def _fem(spec, c_m_s: float, f_guess_hz: float) -> ModelResult:
+    """The FEM reference for this spec (rigid walls, or the silicone wall at the geometric-mean modulus)."""
     from matcad.acoustics import fem
 
     k_guess = 2 * np.pi * f_guess_hz / (c_m_s * models.MM_PER_M)
-    if spec.wall.model == "silicone":
-        g_lo, g_hi = (x * 1e6 for x in spec.wall.shear_modulus_mpa)
-        shears = [np.sqrt(g_lo * g_hi), g_lo, g_hi]
-    else:
-        shears = [None]
-    runs = [fem.solve(fem.geometry_from_spec(spec, g), k_guess, speed_of_sound_m_s=c_m_s) for g in shears]
-    mid = runs[0]
-    checks = {"mode_in_cavity": mid.cavity_energy_fraction > 0.3, "fundamental_found": mid.q > fem.MIN_Q}
-    source = (f"axisymmetric P2 FEM (scikit-fem), level {mid.level}, {mid.dofs} dofs, Q = {mid.q:.1f}, "
-              f"{sum(r.seconds for r in runs):.2f} s")
-    band = (runs[1].f0_hz, runs[2].f0_hz) if len(runs) == 3 else (mid.f0_hz, mid.f0_hz)
-    return ModelResult(mid.f0_hz, checks, source), band
+    shear = shear_moduli_pa(spec)[1] if spec.wall.model == "silicone" else None
+    run = fem.solve(fem.geometry_from_spec(spec, shear), k_guess, speed_of_sound_m_s=c_m_s)
+    checks = {"mode_in_cavity": run.cavity_energy_fraction > 0.3, "fundamental_found": run.q > fem.MIN_Q}
+    return ModelResult(run.f0_hz, checks, f"axisymmetric P2 FEM (scikit-fem), level {run.level}, {run.dofs} "
+                                          f"dofs, Q = {run.q:.1f}, {run.seconds:.2f} s")
 
 
 def predict(spec, forces_n=(), model: str | None = None) -> Prediction:
     """Predict the unloaded resonance of ``spec`` with every model; Eq. 5 at ``forces_n`` (N) if calibrated.
 
-    ``model`` overrides the automatic choice (one of the returned ``models`` keys).
+    ``model`` overrides the automatic choice: one of the returned ``models`` keys, or ``fem``.
     """
-    cav, neck = spec.cavity, spec.neck
-    c = float(spec.air.speed_of_sound or speed_of_sound_m_s(spec.air.temperature_c))
-    # as cast: core-pin draft narrows the cavity; the 1-D models see the equal-volume cylinder
-    volume = float(geometry.drafted_cavity_volume_mm3(cav.diameter, cav.length, spec.mold.draft_deg))
-    cav_diameter = float(geometry.equivalent_diameter_mm(volume, cav.length))
-    area = float(geometry.neck_area_mm2(neck.diameter))
-    cav_area = float(geometry.circle_area_mm2(cav_diameter))
-    xi = float(geometry.diameter_ratio(neck.diameter, cav_diameter))
-    air_ratio = area * neck.length / volume
-    gap_radius = min(spec.plate.width, spec.plate.depth) / 2.0
-    outer = float(models.mouth_end_correction_mm(neck.mouth, neck.diameter / 2, spec.spacer.height, gap_radius))
-    inner_ingard = float(models.ingard_end_correction_mm(neck.diameter, cav_diameter))
-    inner_step = float(models.step_end_correction_mm(neck.diameter, cav_diameter))
-    neck_eff = neck.length + outer + inner_step
-
+    neck = spec.neck
+    res = resonator(spec)
+    c, xi, air_ratio = res.c_m_s, res.diameter_ratio, res.neck_air_ratio
     lumped_ok = air_ratio < LUMPED_NECK_AIR_RATIO
+    corrections_small = (res.outer_correction + res.inner_step) / res.neck_length < LUMPED_END_CORRECTION_RATIO
     results: dict[str, ModelResult] = {
-        "lumped": ModelResult(float(models.lumped_hz(c, area, volume, neck.length)),
-                              {"neck_air_ratio_small": lumped_ok},
+        "lumped": ModelResult(float(evaluate(res, "lumped")),
+                              {"neck_air_ratio_small": lumped_ok, "end_corrections_small": corrections_small},
                               "paper Eq. 1 with c_f = 0 (Helmholtz/Rayleigh)"),
         "end_corrected": ModelResult(
-            float(models.end_corrected_hz(c, area, volume, neck.length + outer + inner_ingard)),
+            float(evaluate(res, "end_corrected")),
             {"neck_air_ratio_small": lumped_ok, "ingard_xi_below_0.4": xi < models.INGARD_XI_LIMIT},
             f"Eq. 1 with l + {neck.mouth} outer correction + Ingard 1953 inner correction"),
     }
-    f_tl = float(models.transmission_line_hz(c, area, cav_area, neck_eff, cav.length))
+    f_tl = float(evaluate(res, "transmission_line"))
     results["transmission_line"] = ModelResult(
-        f_tl, _checks_plane_wave(f_tl, c, cav_diameter, cav.length),
+        f_tl, _checks_plane_wave(f_tl, c, res.cavity_diameter, res.cavity_length),
         "Selamet et al. 1997 transmission line, Kergomard & Garcia 1987 step correction")
     chosen = "transmission_line"
-    band_model = (f_tl, f_tl)
-
     if spec.wall.model == "silicone":
-        g_lo, g_hi = (x * 1e6 for x in spec.wall.shear_modulus_mpa)
-        shear = np.array([g_lo, np.sqrt(g_lo * g_hi), g_hi])
-        n, extra = models.soft_wall_length_scale(shear, cav_diameter, spec.end_cap.outer_diameter)
-        f_lo, f_mid, f_hi = models.transmission_line_hz(c, area, cav_area, neck_eff, cav.length, n, extra)
+        shear = shear_moduli_pa(spec)[1]
+        f_mid = float(evaluate(res, "soft_wall", shear))
         density = spec.silicone.density_g_cm3 * 1000.0
-        breathing = float(models.wall_breathing_hz(shear[1], density, cav_diameter, spec.end_cap.outer_diameter))
-        checks = (_checks_plane_wave(f_mid, c, cav_diameter, cav.length)
+        breathing = float(models.wall_breathing_hz(shear, density, res.cavity_diameter, res.cap_outer_diameter))
+        checks = (_checks_plane_wave(f_mid, c, res.cavity_diameter, res.cavity_length)
                   | {"quasi_static_wall": bool(f_mid < breathing)})
         results["soft_wall"] = ModelResult(
-            float(f_mid), checks,
-            f"transmission line with quasi-static silicone wall (Lame cylinder + half-space end) at "
-            f"G = {shear[1] / 1e6:.3g} MPa, geometric mean of the spec's range")
+            f_mid, checks, f"transmission line with quasi-static silicone wall (Lame cylinder + half-space end) "
+                           f"at G = {shear / 1e6:.3g} MPa, geometric mean of the spec's range")
         chosen = "soft_wall"
-        band_model = (float(f_lo), float(f_hi))
-
     if model == "fem":
-        results["fem"], band_model = _fem(spec, c, results[chosen].f0_hz)
+        results["fem"] = _fem(spec, c, results[chosen].f0_hz)
     if model is not None:
         if model not in results:
             raise ValueError(f"model {model!r} invalid, must be one of {sorted(results) + ['fem']}")
         chosen = model
-        band_model = band_model if model in ("soft_wall", "fem") else (results[model].f0_hz,) * 2
+    lines = budget(spec, res, chosen, results[chosen].f0_hz)
+    low, high = total(lines)
 
     warnings = _model_warnings(chosen, results[chosen], xi)
     cal = spec_calibration(spec)
@@ -196,10 +175,10 @@ def predict(spec, forces_n=(), model: str | None = None) -> Prediction:
         if cal.area_convention == MAT_PAPER_2024.area_convention:
             warnings.append("load curve uses the paper's A = d^2/4 convention with its fitted V0 (see DIGEST); "
                             "its volumes are not physical cavity volumes")
+    f0 = results[chosen].f0_hz
     return Prediction(
-        cavity_volume_mm3=volume, neck_area_mm2=area, cavity_area_mm2=cav_area, neck_air_ratio=air_ratio,
-        diameter_ratio=xi, speed_of_sound_m_s=c, outer_end_correction_mm=outer,
-        inner_end_correction_mm=inner_step, models=results, model=chosen, f0_hz=results[chosen].f0_hz,
-        band_hz=(band_model[0] * (1 - MODEL_ERROR), band_model[1] * (1 + MODEL_ERROR)),
-        warnings=tuple(warnings), calibration=None if cal is None else f"{cal.name} ({cal.area_convention})",
-        load_curve=curve)
+        cavity_volume_mm3=res.volume, neck_area_mm2=res.neck_area, cavity_area_mm2=res.cavity_area,
+        neck_air_ratio=air_ratio, diameter_ratio=xi, speed_of_sound_m_s=c,
+        outer_end_correction_mm=res.outer_correction, inner_end_correction_mm=res.inner_step, models=results,
+        model=chosen, f0_hz=f0, band_hz=(f0 + low, f0 + high), budget=tuple(lines), warnings=tuple(warnings),
+        calibration=None if cal is None else f"{cal.name} ({cal.area_convention})", load_curve=curve)

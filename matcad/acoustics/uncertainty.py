@@ -1,0 +1,104 @@
+"""Uncertainty budget of a prediction: one line per source, combined root-sum-square into the band (Hz).
+
+Sources: the chosen model's own error (measured against the converged FEM by
+benchmarks/error_vs_runtime.py, stored in model_errors.json), fabrication (neck diameter as cut or drilled,
+sheet thickness per ISO 7823-1 unless measured, printed cavity diameter, core-pin draft), air temperature and
+the silicone's shear modulus. Each line re-evaluates the chosen model (or, for the FEM, the cheap model it
+refines) with that one input moved to the ends of its tolerance; lines are independent, so lows and highs
+add in quadrature separately.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from dataclasses import dataclass
+from importlib import resources
+
+from matcad.acoustics.resonator import evaluate, resonator, shear_moduli_pa
+
+NECK_DIAMETER_TOL_MM = {"laser": 0.1, "drilled": 0.02}
+"""Laser-cut acrylic holds ±0.1 mm (DIGEST); a pilot drilled to size ±0.02 mm."""
+MEASURED_SHEET_TOL_MM = 0.05
+"""A calipered sheet."""
+CAVITY_DIAMETER_TOL_MM = {"fdm": 0.1, "sla": 0.05}
+DRAFT_TOL_DEG = 0.25
+TEMPERATURE_TOL_C = 3.0
+"""A lab's day-to-day swing; an explicit speed of sound is taken as exact."""
+
+
+@dataclass(frozen=True)
+class BudgetLine:
+    """One source: what varies, by how much, and the f shift at each end (Hz, low ≤ 0 ≤ high)."""
+
+    source: str
+    tolerance: str
+    low_hz: float
+    high_hz: float
+
+
+def model_errors() -> dict:
+    """Relative model errors against the converged FEM, as measured by benchmarks/error_vs_runtime.py."""
+    return json.loads(resources.files("matcad.acoustics").joinpath("model_errors.json").read_text())
+
+
+def _replace(spec, section: str, **values):
+    return dataclasses.replace(spec, **{section: dataclasses.replace(getattr(spec, section), **values)})
+
+
+def budget(spec, res, model: str, f0_hz: float) -> list[BudgetLine]:
+    """Every source's contribution for ``model`` at ``f0_hz``; ``res`` is ``resonator(spec)``."""
+    cheap = model if model in ("lumped", "end_corrected", "transmission_line", "soft_wall") else (
+        "soft_wall" if spec.wall.model == "silicone" else "transmission_line")
+    shear = shear_moduli_pa(spec)[1] if cheap == "soft_wall" else None
+    base = float(evaluate(res, cheap, shear))
+    scale = f0_hz / base  # sensitivities of the cheap model, applied to the chosen f0
+
+    def shifts(variants):
+        fs = [float(evaluate(resonator(v), cheap, shear)) * scale - f0_hz for v in variants]
+        return min(fs + [0.0]), max(fs + [0.0])
+
+    lines = []
+    error = model_errors()[model]
+    lines.append(BudgetLine("model", f"{model}: max |error| {100 * error['max_abs']:.2f} % vs FEM over "
+                                     f"{error['cases']} geometries", -error["max_abs"] * f0_hz,
+                            error["max_abs"] * f0_hz))
+    drilled = spec.plate.neck_pilot
+    tol = NECK_DIAMETER_TOL_MM["drilled" if drilled else "laser"]
+    d = spec.neck.diameter
+    d_variants = [_replace(spec, "neck", diameter=x) for x in (d - tol, min(d + tol, spec.cavity.diameter))]
+    lines.append(BudgetLine("neck diameter", f"+-{tol:g} mm ({'drilled' if drilled else 'laser cut'})",
+                            *shifts(d_variants)))
+    t = spec.neck.length
+    tol = MEASURED_SHEET_TOL_MM if spec.plate.thickness_measured else 0.4 + 0.1 * t
+    what = "measured" if spec.plate.thickness_measured else "ISO 7823-1 cast sheet"
+    lines.append(BudgetLine("neck length (sheet)", f"+-{tol:.3g} mm ({what})",
+                            *shifts([_replace(spec, "neck", length=max(t - tol, 0.05 * t)),
+                                     _replace(spec, "neck", length=t + tol)])))
+    tol = CAVITY_DIAMETER_TOL_MM[spec.machine.printer]
+    D = spec.cavity.diameter
+    lines.append(BudgetLine("cavity diameter (core pin)", f"+-{tol:g} mm ({spec.machine.printer})",
+                            *shifts([_replace(spec, "cavity", diameter=max(D - tol, d)),
+                                     _replace(spec, "cavity", diameter=D + tol)])))
+    draft = spec.mold.draft_deg
+    max_draft = math.degrees(math.atan(D / (2 * spec.cavity.length))) * 0.99
+    lines.append(BudgetLine("core-pin draft", f"{draft:g} +-{DRAFT_TOL_DEG:g} deg",
+                            *shifts([_replace(spec, "mold", draft_deg=max(draft - DRAFT_TOL_DEG, 0.0)),
+                                     _replace(spec, "mold", draft_deg=min(draft + DRAFT_TOL_DEG, max_draft))])))
+    if spec.air.speed_of_sound is None:
+        temp = spec.air.temperature_c
+        lines.append(BudgetLine("air temperature", f"{temp:g} +-{TEMPERATURE_TOL_C:g} C",
+                                *shifts([_replace(spec, "air", temperature_c=max(temp - TEMPERATURE_TOL_C, -273.0)),
+                                         _replace(spec, "air", temperature_c=temp + TEMPERATURE_TOL_C)])))
+    if cheap == "soft_wall":
+        g_lo, _, g_hi = shear_moduli_pa(spec)
+        fs = [float(evaluate(res, cheap, g)) * scale - f0_hz for g in (g_lo, g_hi)]
+        lines.append(BudgetLine("silicone shear modulus", f"{g_lo / 1e6:g}-{g_hi / 1e6:g} MPa",
+                                min(fs + [0.0]), max(fs + [0.0])))
+    return lines
+
+
+def total(lines: list[BudgetLine]) -> tuple[float, float]:
+    """Root-sum-square of the lows and of the highs (Hz)."""
+    return (-math.sqrt(sum(x.low_hz ** 2 for x in lines)), math.sqrt(sum(x.high_hz ** 2 for x in lines)))
