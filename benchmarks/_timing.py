@@ -15,7 +15,7 @@ def wall_time_s(argv, cwd=ROOT) -> float:
     return time.perf_counter() - t0
 
 
-def median_ratio(argv, baseline, runs=15, warmup=2):
+def median_ratio(argv, baseline, runs=31, warmup=3):
     """Median wall time of ``argv`` and of ``baseline`` (alternating runs), and their ratio."""
     for _ in range(warmup):
         wall_time_s(argv), wall_time_s(baseline)

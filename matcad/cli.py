@@ -6,7 +6,6 @@ Exit codes: 0 ok; 1 design-rule failure (or, for loop commands, no usable result
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from pathlib import Path
@@ -17,6 +16,8 @@ EXIT_OK, EXIT_RULES, EXIT_INPUT = 0, 1, 2
 
 
 def _print_json(data) -> None:
+    import json
+
     print(json.dumps(data, indent=2, allow_nan=False))
 
 

@@ -14,7 +14,7 @@ import dataclasses
 import json
 import math
 from dataclasses import dataclass
-from importlib import resources
+from pathlib import Path
 
 from matcad.acoustics.resonator import evaluate, resonator, shear_moduli_pa
 
@@ -40,7 +40,7 @@ class BudgetLine:
 
 def model_errors() -> dict:
     """Relative model errors against the converged FEM, as measured by benchmarks/error_vs_runtime.py."""
-    return json.loads(resources.files("matcad.acoustics").joinpath("model_errors.json").read_text())
+    return json.loads((Path(__file__).parent / "model_errors.json").read_text(encoding="utf-8"))
 
 
 def _replace(spec, section: str, **values):
