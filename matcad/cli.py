@@ -55,7 +55,9 @@ def cmd_predict(args) -> int:
     from matcad.acoustics.predict import predict
 
     spec = spec_mod.load(args.spec)
-    result = predict(spec, forces_n=args.force or (), model=args.model)
+    if args.fem_level is not None and not 1 <= args.fem_level <= 64:
+        raise ValueError(f"--fem-level {args.fem_level} invalid, must be 1-64 elements across the neck radius")
+    result = predict(spec, forces_n=args.force or (), model=args.model, fem_level=args.fem_level)
     if args.json:
         _print_json(result.to_dict())
     else:
@@ -151,7 +153,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--force", type=float, nargs="+", metavar="F",
                    help="normal loads in N: add paper Eq. 5 f(F) using the spec's [calibration]")
-    p.add_argument("--model", help="use this model's f0 instead of the automatic choice")
+    p.add_argument("--model", help="use this model's f0 instead of the automatic choice ('fem' adds the FEM)")
+    p.add_argument("--fem-level", type=int, help="FEM mesh refinement: elements across the neck radius (default 8)")
     p.set_defaults(func=cmd_predict)
 
     c = sub.add_parser("check", help="run the design rules without building (exit 1 on errors)")

@@ -107,22 +107,23 @@ def _model_warnings(name: str, result: ModelResult, diameter_ratio: float) -> li
     return [text[check] for check, ok in result.checks.items() if not ok]
 
 
-def _fem(spec, c_m_s: float, f_guess_hz: float) -> ModelResult:
+def _fem(spec, c_m_s: float, f_guess_hz: float, level: int) -> ModelResult:
     """The FEM reference for this spec (rigid walls, or the silicone wall at the geometric-mean modulus)."""
     from matcad.acoustics import fem
 
     k_guess = 2 * np.pi * f_guess_hz / (c_m_s * models.MM_PER_M)
     shear = shear_moduli_pa(spec)[1] if spec.wall.model == "silicone" else None
-    run = fem.solve(fem.geometry_from_spec(spec, shear), k_guess, speed_of_sound_m_s=c_m_s)
+    run = fem.solve(fem.geometry_from_spec(spec, shear), k_guess, level, speed_of_sound_m_s=c_m_s)
     checks = {"mode_in_cavity": run.cavity_energy_fraction > 0.3, "fundamental_found": run.q > fem.MIN_Q}
     return ModelResult(run.f0_hz, checks, f"axisymmetric P2 FEM (scikit-fem), level {run.level}, {run.dofs} "
                                           f"dofs, Q = {run.q:.1f}, {run.seconds:.2f} s")
 
 
-def predict(spec, forces_n=(), model: str | None = None) -> Prediction:
+def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None = None) -> Prediction:
     """Predict the unloaded resonance of ``spec`` with every model; Eq. 5 at ``forces_n`` (N) if calibrated.
 
-    ``model`` overrides the automatic choice: one of the returned ``models`` keys, or ``fem``.
+    ``model`` overrides the automatic choice: one of the returned ``models`` keys, or ``fem`` (elements
+    across the neck radius ``fem_level``, default :data:`matcad.acoustics.fem.DEFAULT_LEVEL`).
     """
     neck = spec.neck
     res = resonator(spec)
@@ -155,7 +156,9 @@ def predict(spec, forces_n=(), model: str | None = None) -> Prediction:
                            f"at G = {shear / 1e6:.3g} MPa, geometric mean of the spec's range")
         chosen = "soft_wall"
     if model == "fem":
-        results["fem"] = _fem(spec, c, results[chosen].f0_hz)
+        from matcad.acoustics.fem import DEFAULT_LEVEL
+
+        results["fem"] = _fem(spec, c, results[chosen].f0_hz, fem_level or DEFAULT_LEVEL)
     if model is not None:
         if model not in results:
             raise ValueError(f"model {model!r} invalid, must be one of {sorted(results) + ['fem']}")

@@ -1,0 +1,69 @@
+"""Read a build folder back with the libraries fabricators' software uses; shared by the template tests and
+the fuzzer. Every check is an assertion on real file contents."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import ezdxf
+
+from matcad.export.dxf_svg import LAYERS
+from matcad.parts.catalogue import laser_parts
+
+SVG = "{http://www.w3.org/2000/svg}"
+
+
+def assert_manifest(out: Path) -> dict:
+    report = json.loads((out / "report.json").read_text())
+    listed = {f["file"]: f for f in report["files"]}
+    assert set(listed) == {p.name for p in out.iterdir()} - {"report.json", "report.md"}
+    for name, row in listed.items():
+        data = (out / name).read_bytes()
+        assert row["bytes"] == len(data) and row["sha256"] == hashlib.sha256(data).hexdigest()
+    return report
+
+
+def assert_laser_files(spec, out: Path) -> None:
+    kerf = spec.machine.laser_kerf
+    for flat in laser_parts(spec):
+        doc = ezdxf.readfile(out / f"{flat.name}.dxf")
+        assert doc.header["$INSUNITS"] == 4
+        assert not doc.audit().has_errors
+        assert len({doc.layers.get(name).color for name in LAYERS}) == len(LAYERS)
+        msp = doc.modelspace()
+        assert not msp.query("SPLINE ELLIPSE")
+        drawn = sorted(2 * c.dxf.radius for c in msp.query("CIRCLE[layer=='CUT_INNER']"))
+        want = sorted([h.diameter - kerf for h in flat.holes] * flat.quantity)
+        assert len(drawn) == len(want) and all(abs(a - b) <= 1e-6 for a, b in zip(drawn, want))
+        outlines = msp.query("LWPOLYLINE[layer=='CUT_OUTER']")
+        assert len(outlines) == flat.quantity and all(p.closed for p in outlines)
+        xs = [x for x, *_ in outlines[0].get_points("xyb")]
+        assert abs(max(xs) - min(xs) - (flat.width + kerf)) <= 1e-6
+        root = ET.parse(out / f"{flat.name}.svg").getroot()
+        w, h = (float(re.fullmatch(r"([\d.]+)mm", root.get(k)).group(1)) for k in ("width", "height"))
+        vb = [float(v) for v in root.get("viewBox").split()]
+        assert abs(vb[2] - w) < 1e-9 and abs(vb[3] - h) < 1e-9
+        groups = {g.get("id"): g for g in root.iter(f"{SVG}g")}
+        assert groups["CUT_INNER"].get("stroke") == LAYERS["CUT_INNER"][1]
+        assert groups["CUT_OUTER"].get("stroke") == LAYERS["CUT_OUTER"][1]
+
+
+def assert_meshes(report: dict, out: Path) -> None:
+    import trimesh
+
+    for name, checks in report["meshes"].items():
+        mesh = trimesh.load_mesh(out / name)
+        assert mesh.is_watertight and mesh.is_volume, name
+        assert len(mesh.split(only_watertight=False)) == 1, name
+        assert abs(mesh.volume / checks["brep_volume_mm3"] - 1) < 1e-3, name
+
+
+def assert_build_folder(spec, out: Path) -> None:
+    """Everything a build wrote reads back correctly."""
+    report = assert_manifest(out)
+    assert_laser_files(spec, out)
+    assert_meshes(report, out)
