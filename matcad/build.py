@@ -7,15 +7,11 @@ laser parts never imports the CAD kernel.
 
 from __future__ import annotations
 
-import os
-import shutil
-import tempfile
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 from matcad.acoustics.predict import Prediction, predict
-from matcad.errors import OutputError
+from matcad.output import staged_output
 from matcad.export.dxf_svg import write_dxf, write_svg
 from matcad.parts.catalogue import laser_parts, needs_cad_kernel, printed_parts
 from matcad.parts.flat import cut_plan
@@ -41,48 +37,6 @@ class BuildResult:
 
 def default_out_dir(spec, suffix: str = "", root: Path = Path("out")) -> Path:
     return root / f"{spec.name}{suffix}"
-
-
-def _check_target(target: Path) -> None:
-    """Refuse to replace anything that is not an earlier matcad build (or an empty folder)."""
-    if not target.exists() and not target.is_symlink():
-        return
-    if target.is_symlink() or not target.is_dir():
-        raise OutputError(f"--out {target}: exists and is not a folder; refusing to replace it")
-    if any(target.iterdir()) and not (target / "report.json").is_file():
-        raise OutputError(f"--out {target}: exists and is not a matcad build folder (no report.json); "
-                          "refusing to replace it")
-
-
-def _replace(tmp: Path, target: Path) -> None:
-    """Move the finished build into place; the previous build survives any failure."""
-    backup = None
-    if target.exists():
-        backup = target.with_name(f".{target.name}.old-{os.getpid()}")
-        os.rename(target, backup)
-    try:
-        os.rename(tmp, target)
-    except OSError:
-        if backup is not None:
-            os.rename(backup, target)
-        raise
-    if backup is not None:
-        shutil.rmtree(backup, ignore_errors=True)
-
-
-@contextmanager
-def staged_output(target: Path):
-    """Yield a hidden temporary sibling of ``target``; on success it replaces ``target`` in one move, on any
-    failure it is deleted and ``target`` is left as it was."""
-    _check_target(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
-    try:
-        yield tmp
-        _replace(tmp, target)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
 
 
 def write_laser_part(flat, spec, folder: Path) -> list[dict]:

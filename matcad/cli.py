@@ -1,6 +1,7 @@
 """Command line. Thin: parse, call one function, print text or --json, map errors to exit codes.
 
-Exit codes: 0 ok; 1 design-rule failure (or, for loop commands, no usable result); 2 bad input.
+Exit codes: 0 ok; 1 design-rule failure, or for analyze/calibrate/sense no trustworthy result (no tone, a
+tone at the band edge, degenerate data, a force outside the calibrated range); 2 bad input.
 """
 
 from __future__ import annotations
@@ -129,6 +130,107 @@ def cmd_coupon(args) -> int:
     return EXIT_OK
 
 
+def _band(args):
+    if args.band:
+        lo, hi = args.band
+        if not (0 <= lo < hi):
+            raise ValueError(f"--band {lo:g} {hi:g} invalid, must be 0 <= LO < HI (Hz)")
+        return lo, hi
+    if args.spec:
+        from matcad import spec as spec_mod
+        from matcad.acoustics.predict import predict
+        from matcad.loop.analyze import band_from_prediction
+
+        return band_from_prediction(predict(spec_mod.load(args.spec)).band_hz)
+    raise ValueError("analyze needs --spec SPEC (its predicted band) or --band LO HI (Hz)")
+
+
+def cmd_analyze(args) -> int:
+    from matcad.loop.analyze import analyze, plot, write_track_csv
+    from matcad.loop.wav import read_mono
+    from matcad.output import staged_output
+
+    band = _band(args)
+    x, fs = read_mono(args.recording)
+    result = analyze(x, fs, band)
+    target = args.out or Path("out") / f"analyze-{Path(args.recording).stem}"
+    with staged_output(target) as tmp:
+        write_track_csv(result, tmp / "track.csv")
+        plot(result, tmp / "spectrogram.png")
+        _write_json(tmp / "report.json", {"recording": str(args.recording), **result.to_dict()})
+    if args.json:
+        _print_json({**result.to_dict(), "out_dir": str(target)})
+    else:
+        print(f"{args.recording}: mean {result.mean_hz:.2f} Hz, median {result.median_hz:.2f} Hz, "
+              f"sd {result.std_hz:.2f} Hz over {len(result.track_hz)} frames; SNR {result.snr_db:.1f} dB, "
+              f"prominence {result.prominence_db:.1f} dB (band {result.band_hz[0]:.0f}-{result.band_hz[1]:.0f} Hz)")
+        for w in result.warnings:
+            print(f"  warning: {w}")
+        print(f"  track.csv, spectrogram.png, report.json in {target}/")
+    return EXIT_OK
+
+
+def cmd_calibrate(args) -> int:
+    from matcad import spec as spec_mod
+    from matcad.loop.calibrate import fit_from_spec, plot, read_csv
+    from matcad.output import staged_output
+
+    spec = spec_mod.load(args.spec)
+    forces, freqs = read_csv(args.data)
+    cal = fit_from_spec(forces, freqs, spec, k_free=args.k_free)
+    target = args.out or Path("out") / f"calibrate-{Path(args.data).stem}"
+    with staged_output(target) as tmp:
+        (tmp / "calibration.toml").write_text(cal.to_toml(), encoding="utf-8")
+        plot(cal, tmp / "residuals.png")
+        _write_json(tmp / "report.json", {"data": str(args.data), "spec": spec.name, **cal.to_dict()})
+    if args.json:
+        _print_json({**cal.to_dict(), "out_dir": str(target)})
+    else:
+        d = cal.to_dict()
+        print(f"Eq. 5 fit to {d['points']} points, {d['force_range_n'][0]:g}-{d['force_range_n'][1]:g} N "
+              f"({'K free, V0 = as-built cavity' if cal.k_free else 'K from the as-built geometry'}):")
+        for name in ("v0", "b", "a"):
+            value = d["v0_mm3"] if name == "v0" else d[name]
+            lo, hi = d[f"{name}_ci95"]
+            print(f"  {name:<3}= {value:.6g} +- {d[name + '_se']:.3g}  (95 %: {lo:.6g} .. {hi:.6g})")
+        print(f"  residual RMS {d['residual_rms_hz']:.2f} Hz; calibration.toml, residuals.png in {target}/")
+    return EXIT_OK
+
+
+def cmd_sense(args) -> int:
+    import numpy as np
+
+    from matcad.loop.analyze import analyze
+    from matcad.loop.sense import SensorCalibration, require_in_range, sense
+    from matcad.loop.wav import read_mono
+    from matcad.spec import load_calibration
+
+    cal = SensorCalibration.from_spec_calibration(load_calibration(args.calibration))
+    f_lo, f_hi = cal.frequency_range_hz()
+    x, fs = read_mono(args.recording)
+    result = analyze(x, fs, (0.8 * f_lo, 1.25 * f_hi))
+    reading = sense(result.track_hz, cal)
+    if args.json:
+        frames = [{"time_s": float(t), "frequency_hz": float(f), "force_n": None if np.isnan(force) else float(force),
+                   "force_interval_n": None if np.isnan(force) else [float(lo), float(hi)]}
+                  for t, f, force, (lo, hi) in zip(result.times_s, result.track_hz, reading.frames_n,
+                                                   reading.frames_interval_n)]
+        _print_json({**reading.to_dict(), "warnings": list(result.warnings), "frames": frames})
+    elif np.isfinite(reading.force_n):
+        lo, hi = reading.force_interval_n
+        print(f"{args.recording}: F = {reading.force_n:.3f} N (95 %: {lo:.3f} .. {hi:.3f} N) at "
+              f"{reading.frequency_hz:.2f} Hz; {int(np.sum(np.isfinite(reading.frames_n)))}/{len(reading.frames_n)} "
+              "frames inside the calibrated range")
+    require_in_range(reading)
+    return EXIT_OK
+
+
+def _write_json(path: Path, data) -> None:
+    import json
+
+    path.write_text(json.dumps(data, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+
+
 def cmd_schema(args) -> int:
     from matcad.spec import schema
 
@@ -144,7 +246,11 @@ def cmd_schema(args) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="matcad", description=__doc__.splitlines()[0])
+    import matcad
+
+    parser = argparse.ArgumentParser(prog="matcad", description=matcad.__doc__,
+                                     epilog="exit codes: 0 ok; 1 design-rule error or no trustworthy result; "
+                                            "2 bad input")
     parser.add_argument("--version", action="version", version=f"matcad {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
@@ -175,6 +281,29 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--json", action="store_true")
     k.set_defaults(func=cmd_coupon)
 
+    a = sub.add_parser("analyze", help="the taxel's frequency in a recording (spectrogram ridge)")
+    a.add_argument("recording", help="WAV file (mono/stereo; 8-32-bit integer or float; any sample rate)")
+    group = a.add_mutually_exclusive_group()
+    group.add_argument("--spec", help="spec TOML: analyse its predicted band (-10 %% / +25 %% for load)")
+    group.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="analysis band in Hz")
+    a.add_argument("--out", type=Path, help="output folder (default out/analyze-<recording>)")
+    a.add_argument("--json", action="store_true")
+    a.set_defaults(func=cmd_analyze)
+
+    c2 = sub.add_parser("calibrate", help="fit paper Eq. 5 to force/frequency pairs, with uncertainty")
+    c2.add_argument("data", help="CSV with force_n and frequency_hz columns")
+    c2.add_argument("--spec", required=True, help="spec TOML of the taxel (its as-built K or V0)")
+    c2.add_argument("--k-free", action="store_true", help="fix V0 to the as-built cavity and fit K instead")
+    c2.add_argument("--out", type=Path, help="output folder (default out/calibrate-<data>)")
+    c2.add_argument("--json", action="store_true")
+    c2.set_defaults(func=cmd_calibrate)
+
+    n = sub.add_parser("sense", help="force from a recording through a calibration, with 95 %% intervals")
+    n.add_argument("recording", help="WAV file")
+    n.add_argument("--calibration", required=True, help="calibration.toml from `matcad calibrate`, or a spec")
+    n.add_argument("--json", action="store_true")
+    n.set_defaults(func=cmd_sense)
+
     s = sub.add_parser("schema", help="print every spec field with unit, default and allowed range")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_schema)
@@ -184,6 +313,7 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     from matcad.errors import OutputError
+    from matcad.loop import LoopError
     from matcad.spec import SpecError
 
     try:
@@ -194,6 +324,9 @@ def main(argv: list[str] | None = None) -> int:
     except OutputError as exc:
         print(f"matcad: error: {exc}", file=sys.stderr)
         return EXIT_INPUT
+    except LoopError as exc:
+        print(f"matcad: {exc}", file=sys.stderr)
+        return EXIT_RULES
     except ValueError as exc:
         print(f"matcad: error: {exc}", file=sys.stderr)
         return EXIT_INPUT

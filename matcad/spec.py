@@ -257,6 +257,19 @@ class Calibration:
     area_convention: str = _param(
         "neck area used with v0: 'pi_d2/4' (physical, A = pi d^2/4) or 'd2/4' (the paper's fit, "
         "see DIGEST)", default="pi_d2/4", kind="choice", choices=("pi_d2/4", "d2/4"))
+    k_mm3_hz2: float | None = _param("K = c^2 A / (4 pi^2 l) the fit used; when given it replaces the one "
+                                     "computed from the neck and area_convention (written by `matcad calibrate`)",
+                                     "mm^3 Hz^2", None, lo=0.0, hi=1e30)
+    force_range_n: tuple[float, float] | None = _param(
+        "[low, high] forces the calibration was measured over; `sense` gives no force outside it", "N", None,
+        kind="range", lo=-1e6, hi=1e6, lo_open=False)
+    covariance: tuple[float, ...] | None = _param(
+        "covariance of (v0_mm3, b, a), 9 numbers row by row (written by `matcad calibrate`)", "", None,
+        kind="vector9", lo=-1e30, hi=1e30, lo_open=False)
+    residual_std_mm3: float | None = _param("standard deviation of the fit's residuals in K/f^2", "mm^3", None,
+                                            lo=0.0, hi=1e30, lo_open=False)
+    dof: int | None = _param("degrees of freedom of the fit (points - 3)", default=None, kind="integer",
+                             lo=1, hi=10**9)
 
 
 @dataclass(frozen=True)
@@ -318,6 +331,8 @@ def _allowed_text(meta: dict) -> str:
         return "true | false"
     if kind == "text":
         return "at most 40 printable ASCII characters"
+    if kind == "vector9":
+        return "9 finite numbers"
     return _range_text(meta)
 
 
@@ -339,6 +354,10 @@ def _convert(path: str, value: Any, meta: dict) -> Any:
         if isinstance(value, bool) or not isinstance(value, int) or not meta["lo"] <= value <= meta["hi"]:
             raise SpecError(path, value, f"must be a whole number, {meta['lo']:g} <= value <= {meta['hi']:g}")
         return value
+    if kind == "vector9":
+        if not isinstance(value, list) or len(value) != 9:
+            raise SpecError(path, value, "must be a list of 9 finite numbers (a 3 x 3 matrix, row by row)")
+        return tuple(_number(path, v, meta) for v in value)
     if kind == "bool":
         if not isinstance(value, bool):
             raise SpecError(path, value, "must be true or false")
@@ -447,6 +466,23 @@ def load(path: str | Path) -> Spec:
     except tomllib.TOMLDecodeError as exc:
         raise SpecError("spec file", str(p), f"must be valid TOML ({exc})")
     return from_dict(data)
+
+
+def load_calibration(path: str | Path) -> Calibration:
+    """The [calibration] table of a calibration file or of a whole spec, validated like a spec's."""
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_bytes().decode("utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise SpecError("calibration file", str(p), f"must be a readable TOML file ({exc.__class__.__name__})")
+    if "cavity" in data:
+        cal = from_dict(data).calibration
+        if cal is None:
+            raise SpecError("calibration", None, f"is required: {p} has no [calibration] table")
+        return cal
+    if "calibration" not in data:
+        raise SpecError("calibration", None, f"is required: {p} has no [calibration] table")
+    return _section(Calibration, "calibration", data["calibration"])
 
 
 def schema() -> list[dict]:

@@ -31,6 +31,7 @@ class LoadCalibration:
     b: float
     area_convention: str = "pi_d2/4"
     name: str = "spec"
+    k_mm3_hz2: float | None = None
 
     def __post_init__(self):
         if self.area_convention not in AREA_CONVENTIONS:
@@ -50,7 +51,9 @@ def convention_area_mm2(neck_diameter_mm, area_convention):
 
 
 def frequency_constant_mm3_hz2(cal, speed_of_sound_m_s, neck_diameter_mm, neck_length_mm):
-    """K = c²A/(4π² l) in mm³·Hz², so that f² = K / V_eff."""
+    """K = c²A/(4π² l) in mm³·Hz², so that f² = K / V_eff; a calibration's own fitted K when it has one."""
+    if cal.k_mm3_hz2 is not None:
+        return cal.k_mm3_hz2
     c = np.asarray(speed_of_sound_m_s, dtype=float) * MM_PER_M
     return c * c * convention_area_mm2(neck_diameter_mm, cal.area_convention) / (4 * np.pi**2 * neck_length_mm)
 

@@ -79,9 +79,9 @@ def spec_calibration(spec) -> LoadCalibration | None:
         return None
     values = (cal.v0_mm3, cal.a, cal.b, cal.area_convention)
     paper = MAT_PAPER_2024
-    if values == (paper.v0_mm3, paper.a, paper.b, paper.area_convention):
+    if values == (paper.v0_mm3, paper.a, paper.b, paper.area_convention) and cal.k_mm3_hz2 is None:
         return paper
-    return LoadCalibration(*values, name="spec")
+    return LoadCalibration(*values, name="spec", k_mm3_hz2=cal.k_mm3_hz2)
 
 
 def _checks_plane_wave(f_hz, c_m_s, cavity_diameter_mm, cavity_length_mm) -> dict[str, bool]:
