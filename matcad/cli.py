@@ -254,59 +254,49 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"matcad {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser("predict", help="predict the taxel's resonance frequency from a spec")
+    def command(name, func, help_text, out_default=None):
+        cmd = sub.add_parser(name, help=help_text)
+        cmd.set_defaults(func=func)
+        cmd.add_argument("--json", action="store_true", help="print JSON instead of text")
+        if out_default:
+            cmd.add_argument("--out", type=Path, help=f"output folder (default {out_default})")
+        return cmd
+
+    p = command("predict", cmd_predict, "predict the taxel's resonance frequency from a spec")
     p.add_argument("spec", help="spec TOML file")
-    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--force", type=float, nargs="+", metavar="F",
                    help="normal loads in N: add paper Eq. 5 f(F) using the spec's [calibration]")
     p.add_argument("--model", help="use this model's f0 instead of the automatic choice ('fem' adds the FEM)")
     p.add_argument("--fem-level", type=int, help="FEM mesh refinement: elements across the neck radius (default 8)")
-    p.set_defaults(func=cmd_predict)
 
-    c = sub.add_parser("check", help="run the design rules without building (exit 1 on errors)")
-    c.add_argument("spec", help="spec TOML file")
-    c.add_argument("--json", action="store_true")
-    c.set_defaults(func=cmd_check)
+    command("check", cmd_check, "run the design rules without building (exit 1 on errors)").add_argument(
+        "spec", help="spec TOML file")
 
-    b = sub.add_parser("build", help="write the fabrication kit and report to out/<name>/")
+    b = command("build", cmd_build, "write the fabrication kit and report to out/<name>/", "out/<name>")
     b.add_argument("spec", help="spec TOML file")
-    b.add_argument("--out", type=Path, help="output folder (default out/<name>)")
     b.add_argument("--force", action="store_true", help="build despite design-rule errors")
-    b.add_argument("--json", action="store_true")
-    b.set_defaults(func=cmd_build)
 
-    k = sub.add_parser("coupon", help="test coupons sweeping neck, dowel and needle-bore sizes")
-    k.add_argument("spec", help="spec TOML file")
-    k.add_argument("--out", type=Path, help="output folder (default out/<name>-coupon)")
-    k.add_argument("--json", action="store_true")
-    k.set_defaults(func=cmd_coupon)
+    command("coupon", cmd_coupon, "test coupons sweeping neck, dowel and needle-bore sizes",
+            "out/<name>-coupon").add_argument("spec", help="spec TOML file")
 
-    a = sub.add_parser("analyze", help="the taxel's frequency in a recording (spectrogram ridge)")
+    a = command("analyze", cmd_analyze, "the taxel's frequency in a recording (spectrogram ridge)",
+                "out/analyze-<recording>")
     a.add_argument("recording", help="WAV file (mono/stereo; 8-32-bit integer or float; any sample rate)")
     group = a.add_mutually_exclusive_group()
     group.add_argument("--spec", help="spec TOML: analyse its predicted band (-10 %% / +25 %% for load)")
     group.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="analysis band in Hz")
-    a.add_argument("--out", type=Path, help="output folder (default out/analyze-<recording>)")
-    a.add_argument("--json", action="store_true")
-    a.set_defaults(func=cmd_analyze)
 
-    c2 = sub.add_parser("calibrate", help="fit paper Eq. 5 to force/frequency pairs, with uncertainty")
-    c2.add_argument("data", help="CSV with force_n and frequency_hz columns")
-    c2.add_argument("--spec", required=True, help="spec TOML of the taxel (its as-built K or V0)")
-    c2.add_argument("--k-free", action="store_true", help="fix V0 to the as-built cavity and fit K instead")
-    c2.add_argument("--out", type=Path, help="output folder (default out/calibrate-<data>)")
-    c2.add_argument("--json", action="store_true")
-    c2.set_defaults(func=cmd_calibrate)
+    c = command("calibrate", cmd_calibrate, "fit paper Eq. 5 to force/frequency pairs, with uncertainty",
+                "out/calibrate-<data>")
+    c.add_argument("data", help="CSV with force_n and frequency_hz columns")
+    c.add_argument("--spec", required=True, help="spec TOML of the taxel (its as-built K or V0)")
+    c.add_argument("--k-free", action="store_true", help="fix V0 to the as-built cavity and fit K instead")
 
-    n = sub.add_parser("sense", help="force from a recording through a calibration, with 95 %% intervals")
+    n = command("sense", cmd_sense, "force from a recording through a calibration, with 95 %% intervals")
     n.add_argument("recording", help="WAV file")
     n.add_argument("--calibration", required=True, help="calibration.toml from `matcad calibrate`, or a spec")
-    n.add_argument("--json", action="store_true")
-    n.set_defaults(func=cmd_sense)
 
-    s = sub.add_parser("schema", help="print every spec field with unit, default and allowed range")
-    s.add_argument("--json", action="store_true")
-    s.set_defaults(func=cmd_schema)
+    command("schema", cmd_schema, "print every spec field with unit, default and allowed range")
     return parser
 
 
