@@ -21,11 +21,6 @@ def neck_area_mm2(neck_diameter_mm):
     return circle_area_mm2(neck_diameter_mm)
 
 
-def diameter_ratio(neck_diameter_mm, cavity_diameter_mm):
-    """ξ = d/D (dimensionless), paper nomenclature."""
-    return np.divide(neck_diameter_mm, cavity_diameter_mm)
-
-
 def neck_air_ratio(neck_diameter_mm, neck_length_mm, cavity_diameter_mm, cavity_length_mm):
     """Air volume in the neck over air volume in the cavity, A·l / V_c (dimensionless).
 

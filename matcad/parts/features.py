@@ -15,9 +15,6 @@ ISO_273_CLEARANCE_MM = {
 SELF_TAP_PILOT_MM = {"M2": 1.6, "M2.5": 2.05, "M3": 2.5}
 """Pilot hole for a machine screw cutting its own thread in a printed part (ISO tap-drill size, mm)."""
 
-NUT_ACROSS_FLATS_MM = {"M2": 4.0, "M2.5": 5.0, "M3": 5.5}
-"""ISO 4032 hex nut width across flats (mm)."""
-
 PIN_FIT_ALLOWANCE_MM = {
     "laser": {"clearance": 0.15, "slip": 0.05, "press": 0.0},
     "fdm": {"clearance": 0.4, "slip": 0.2, "press": 0.0},
