@@ -1,7 +1,7 @@
 """Every model's signed error against the converged FEM, and its run time, over a geometry set; the FEM itself
 at several mesh levels; STL tessellation tolerance against volume error and export time.
 
-Writes docs/error_vs_runtime.md (the table the README shows), docs/error_vs_runtime.png (log-log error vs time)
+Writes docs/error_vs_runtime.md and the README's copy of it, docs/error_vs_runtime.png (log-log error vs time)
 and matcad/acoustics/model_errors.json (each model's max |error| where its validity checks pass, which the
 uncertainty budget uses). Run: .venv/bin/python benchmarks/error_vs_runtime.py
 """
@@ -36,7 +36,10 @@ CASES = {
     "classic 10 x 10 mm cavity": (10.0, 10.0, 2.5, 3.0, "baffled", "rigid"),
     "sub-mm ultrasonic taxel (x0.1)": (0.318, 0.476, 0.21, 0.635, "baffled", "rigid"),
     "bottle (70 x 150 mm, 20 mm neck)": (70.0, 150.0, 20.0, 50.0, "baffled", "rigid"),
+    "classic 10 x 10 mm cavity, silicone": (10.0, 10.0, 2.5, 3.0, "baffled", "silicone"),
+    "1 mm neck, silicone": (3.18, 4.76, 2.10, 1.0, "baffled", "silicone"),
 }
+README_MARKERS = ("<!-- error-table -->", "<!-- /error-table -->")
 STL_TOLERANCES = ((0.1, 0.5), (0.05, 0.3), (0.01, 0.1), (0.005, 0.05), (0.001, 0.02))
 
 
@@ -133,7 +136,12 @@ def write_outputs(results, stls):
               "|---:|---:|---:|---:|---:|---:|"]
     lines += [f"| {s['tolerance_mm']:g} | {s['angular_rad']:g} | {s['triangles']} | {100 * s['volume_error']:+.3f} % | "
               f"{s['seconds'] * 1e3:.0f} ms | {s['bytes'] / 1024:.0f} KiB |" for s in stls]
-    (docs / "error_vs_runtime.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    table = "\n".join(lines) + "\n"
+    (docs / "error_vs_runtime.md").write_text(table, encoding="utf-8")
+    readme = ROOT / "README.md"
+    text = readme.read_text(encoding="utf-8")
+    start, end = text.index(README_MARKERS[0]), text.index(README_MARKERS[1])
+    readme.write_text(text[:start + len(README_MARKERS[0])] + "\n" + table + text[end:], encoding="utf-8")
 
     errors = {}
     for model in list(CHEAP_MODELS) + ["fem"]:

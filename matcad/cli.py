@@ -317,6 +317,10 @@ def main(argv: list[str] | None = None) -> int:
     except LoopError as exc:
         print(f"matcad: {exc}", file=sys.stderr)
         return EXIT_RULES
+    except OSError as exc:  # unwritable output folder, unreadable input: the user's file system, not a bug
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"matcad: error: {where}{exc.strerror or exc} (check the path and its permissions)", file=sys.stderr)
+        return EXIT_INPUT
     except ValueError as exc:
         print(f"matcad: error: {exc}", file=sys.stderr)
         return EXIT_INPUT

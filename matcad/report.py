@@ -61,6 +61,11 @@ def bill_of_materials(spec) -> dict:
                    "min_length_mm": stack + engage},
         "bolts": {"count": len(plate_bolt_positions_mm(spec)), "size": spec.fasteners.bolt,
                   "min_length_mm": stack + engage, "note": "self-tapping into the printed mount"},
+        "spacers": ({"count": len(plate_bolt_positions_mm(spec)), "style": "laser",
+                     "note": f"{spec.spacer.size:g} mm squares cut from {spec.spacer.height:g} mm sheet"}
+                    if spec.spacer.style == "laser" else
+                    {"count": len(plate_bolt_positions_mm(spec)), "style": "standoff",
+                     "note": f"printed on the needle mount, {spec.spacer.height:g} mm tall"}),
         "needle": {"count": 1, "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
                    "y_mm": spec.needle.y},
     }
@@ -124,6 +129,7 @@ def _markdown(r: dict) -> str:
               f"{s['batch_ml']:.2f} ml = {s['batch_mass_g']:.2f} g for {s['caps_per_pour']} cap(s)",
               f"- {bom['dowels']['count']} dowel pins Ø{bom['dowels']['diameter_mm']:g} mm, ≥ "
               f"{bom['dowels']['min_length_mm']:.1f} mm long",
+              f"- {bom['spacers']['count']} spacers: {bom['spacers']['note']}",
               f"- {bom['bolts']['count']} × {bom['bolts']['size']} bolts, ≥ {bom['bolts']['min_length_mm']:.1f} mm "
               f"({bom['bolts']['note']})",
               f"- needle Ø{bom['needle']['outer_diameter_mm']:g} mm at θ = {bom['needle']['theta_deg']:g}°, "

@@ -88,3 +88,11 @@ def test_check_exit_codes(write_spec):
     assert taper["level"] == "warning" and taper["value"] == pytest.approx(2.1 / 6.35, abs=1e-3)
     code, out, _ = run_cli("check", write_spec(BAD_RULE))
     assert code == 1 and "fit.dowel_laser" in out
+
+
+def test_unwritable_output_is_exit_2(tmp_path, write_spec):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")  # a folder cannot be made under a regular file, whoever runs this
+    code, _, err = run_cli("build", write_spec(LASER_ONLY), "--out", blocker / "o")
+    assert code == 2 and "Traceback" not in err and "matcad: error" in err
+    assert blocker.read_text() == "x"

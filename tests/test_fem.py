@@ -87,7 +87,11 @@ def test_soft_wall_tends_to_rigid_and_matches_1d_model():
 
 def test_predict_model_fem_in_json():
     p = predict(spec_mod.load(PAPER), model="fem")
-    assert p.model == "fem" and p.models["fem"].valid
+    assert p.model == "fem"
+    fem_checks = p.models["fem"].checks
+    assert fem_checks["mode_in_cavity"] and fem_checks["fundamental_found"]
+    # the soft-wall FEM is quasi-static too: it carries the soft-wall model's wall check
+    assert fem_checks["quasi_static_wall"] == p.models["soft_wall"].checks["quasi_static_wall"]
     assert p.band_hz[0] < p.f0_hz < p.band_hz[1]
     assert p.models["fem"].f0_hz == pytest.approx(p.models["soft_wall"].f0_hz, rel=0.03)
 

@@ -107,14 +107,16 @@ def _model_warnings(name: str, result: ModelResult, diameter_ratio: float) -> li
     return [text[check] for check, ok in result.checks.items() if not ok]
 
 
-def _fem(spec, c_m_s: float, f_guess_hz: float, level: int) -> ModelResult:
-    """The FEM reference for this spec (rigid walls, or the silicone wall at the geometric-mean modulus)."""
+def _fem(spec, c_m_s: float, f_guess_hz: float, level: int, wall_checks: dict) -> ModelResult:
+    """The FEM reference for this spec (rigid walls, or the silicone wall at the geometric-mean modulus, which
+    shares the soft-wall model's quasi-static assumption and so its ``wall_checks``)."""
     from matcad.acoustics import fem
 
     k_guess = 2 * np.pi * f_guess_hz / (c_m_s * models.MM_PER_M)
     shear = shear_moduli_pa(spec)[1] if spec.wall.model == "silicone" else None
     run = fem.solve(fem.geometry_from_spec(spec, shear), k_guess, level, speed_of_sound_m_s=c_m_s)
-    checks = {"mode_in_cavity": run.cavity_energy_fraction > 0.3, "fundamental_found": run.q > fem.MIN_Q}
+    checks = {"mode_in_cavity": run.cavity_energy_fraction > 0.3, "fundamental_found": run.q > fem.MIN_Q,
+              **wall_checks}
     return ModelResult(run.f0_hz, checks, f"axisymmetric P2 FEM (scikit-fem), level {run.level}, {run.dofs} "
                                           f"dofs, Q = {run.q:.1f}, {run.seconds:.2f} s")
 
@@ -158,7 +160,8 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
     if model == "fem":
         from matcad.acoustics.fem import DEFAULT_LEVEL
 
-        results["fem"] = _fem(spec, c, results[chosen].f0_hz, fem_level or DEFAULT_LEVEL)
+        wall_checks = {k: v for k, v in results[chosen].checks.items() if k == "quasi_static_wall"}
+        results["fem"] = _fem(spec, c, results[chosen].f0_hz, fem_level or DEFAULT_LEVEL, wall_checks)
     if model is not None:
         if model not in results:
             raise ValueError(f"model {model!r} invalid, must be one of {sorted(results) + ['fem']}")
