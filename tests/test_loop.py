@@ -54,7 +54,7 @@ def test_stronger_hum_and_harmonic_outside_band_do_not_fool_it():
         + 0.2 * np.sin(2 * np.pi * 9400 * t)
     r = analyze(x, FS, BAND)
     assert abs(r.mean_hz - 4700.0) < 0.5
-    assert r.warnings and "stronger tone" in r.warnings[0]
+    assert r.warnings and "stronger tone near 50 Hz" in r.warnings[0]  # the hum, located to the hertz
 
 
 def test_silence_and_noise_refused():

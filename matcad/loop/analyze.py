@@ -111,7 +111,9 @@ def _strongest_outside(f, mean_spectrum, lo, hi, in_band_peak) -> str:
     i = int(np.argmax(np.where(outside, mean_spectrum, 0.0)))
     if mean_spectrum[i] <= in_band_peak:
         return ""
-    return (f"a stronger tone near {f[i]:.0f} Hz outside the band "
+    log_power = 10 * np.log10(mean_spectrum[None, :] + np.finfo(float).tiny)
+    where = f[0] + float(_refine(log_power, np.array([i]))[0]) * df
+    return (f"a stronger tone near {where:.0f} Hz outside the band "
             f"({10 * np.log10(mean_spectrum[i] / in_band_peak):.1f} dB above the in-band peak)")
 
 
