@@ -120,3 +120,9 @@ def test_fem_and_tline_find_the_same_mode_at_extremes(ratio, neck_length):
     run = fem.solve(fem.geometry_from_spec(s), 2 * math.pi * tl / 343.2e3, 4, 343.2)
     assert run.f0_hz == pytest.approx(tl, rel=0.05)
     assert run.cavity_energy_fraction > 0.3
+
+
+@pytest.mark.parametrize("neck_diameter", [0.01, 0.05, 0.1])
+def test_neck_thinner_than_its_tolerance_keeps_a_finite_budget(neck_diameter):
+    p = predict(_spec(neck__diameter=neck_diameter))
+    assert _all_finite(p) and p.band_hz[0] > 0

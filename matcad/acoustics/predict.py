@@ -11,9 +11,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from matcad.acoustics import models
+from matcad.acoustics.load import MAT_PAPER_2024, LoadCalibration, frequency_at_force_hz, invalid_reason
 from matcad.acoustics.resonator import evaluate, resonator, shear_moduli_pa
 from matcad.acoustics.uncertainty import BudgetLine, budget, total
-from matcad.acoustics.load import MAT_PAPER_2024, LoadCalibration, frequency_at_force_hz, invalid_reason
 
 PLANE_WAVE_CUTOFF_KA = 1.8412
 """First non-planar (1,1) mode of a circular duct cuts on at k·a = 1.8412 (zero of J1')."""

@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from matcad.acoustics.resonator import evaluate, resonator, shear_moduli_pa
+from matcad.acoustics.resonator import CHEAP_MODELS, evaluate, resonator, shear_moduli_pa
 
 NECK_DIAMETER_TOL_MM = {"laser": 0.1, "drilled": 0.02}
 """Laser-cut acrylic holds ±0.1 mm (DIGEST); a pilot drilled to size ±0.02 mm."""
@@ -49,8 +49,8 @@ def _replace(spec, section: str, **values):
 
 def budget(spec, res, model: str, f0_hz: float) -> list[BudgetLine]:
     """Every source's contribution for ``model`` at ``f0_hz``; ``res`` is ``resonator(spec)``."""
-    cheap = model if model in ("lumped", "end_corrected", "transmission_line", "soft_wall") else (
-        "soft_wall" if spec.wall.model == "silicone" else "transmission_line")
+    cheap = model if model in CHEAP_MODELS else ("soft_wall" if spec.wall.model == "silicone" else
+                                                 "transmission_line")
     shear = shear_moduli_pa(spec)[1] if cheap == "soft_wall" else None
     base = float(evaluate(res, cheap, shear))
     scale = f0_hz / base  # sensitivities of the cheap model, applied to the chosen f0
@@ -67,7 +67,8 @@ def budget(spec, res, model: str, f0_hz: float) -> list[BudgetLine]:
     drilled = spec.plate.neck_pilot
     tol = NECK_DIAMETER_TOL_MM["drilled" if drilled else "laser"]
     d = spec.neck.diameter
-    d_variants = [_replace(spec, "neck", diameter=x) for x in (d - tol, min(d + tol, spec.cavity.diameter))]
+    # a neck smaller than the tolerance is a design-rule matter; here it may at most halve
+    d_variants = [_replace(spec, "neck", diameter=x) for x in (max(d - tol, d / 2), min(d + tol, spec.cavity.diameter))]
     lines.append(BudgetLine("neck diameter", f"+-{tol:g} mm ({'drilled' if drilled else 'laser cut'})",
                             *shifts(d_variants)))
     t = spec.neck.length
