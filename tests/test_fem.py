@@ -99,3 +99,10 @@ def test_predict_model_fem_in_json():
 def test_unflanged_mouth_is_a_clear_error():
     with pytest.raises(ValueError, match="mouth"):
         fem.mesh(_geom(mouth="unflanged"))
+
+
+def test_soft_wall_applies_when_neck_is_as_wide_as_cavity():
+    wide = _geom(neck_radius=1.59)
+    rigid = fem.solve(wide, _k(7000), 4, C).f0_hz
+    soft = fem.solve(dataclasses.replace(wide, wall_shear_modulus_pa=0.3e6, cap_outer_radius=4.0), _k(6000), 4, C)
+    assert soft.f0_hz < 0.97 * rigid  # the silicone side wall is compliant whatever the neck

@@ -217,7 +217,7 @@ def _boundary_facets(m, g: FemGeometry):
         radiation = boundary & (r > g.gap_radius - tol)
         kappa = 1.0 / (2.0 * g.gap_radius)
     top = boundary & (z > l + L - tol)
-    side = boundary & (z > l + tol) & (z < l + L - tol) & (r > a + tol)
+    side = boundary & (z > l + tol) & (z < l + L - tol) & (r > tol)  # off the axis: the cavity's wall
     return np.flatnonzero(radiation), kappa, np.flatnonzero(side), np.flatnonzero(top)
 
 
