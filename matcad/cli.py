@@ -39,7 +39,7 @@ def _format_prediction(spec, p) -> str:
         mark = "*" if name == p.model else " "
         lines.append(f"{mark} {name:<18} {r.f0_hz:9.1f}  {'yes' if r.valid else 'no':<5}  {failed}")
     lines += ["", f"  f0 = {p.f0_hz:.0f} Hz ({p.model}), band {p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz "
-                  "(root-sum-square of):"]
+                  "(root-sum-square in ln f of):"]
     lines += [f"    {b.source:<28} {b.tolerance:<52} {b.low_hz:+8.1f} {b.high_hz:+8.1f} Hz" for b in p.budget]
     if p.load_curve:
         lines += ["", f"  load curve, paper Eq. 5, calibration {p.calibration}:", f"  {'F [N]':>9} {'f [Hz]':>9}"]

@@ -116,7 +116,7 @@ def _markdown(r: dict) -> str:
         failed = ", ".join(k for k, ok in m["checks"].items() if not ok) or "–"
         lines.append(f"| {name}{' (chosen)' if name == p['model'] else ''} | {m['f0_hz']:.1f} | "
                      f"{'yes' if m['valid'] else 'no'} | {failed} |")
-    lines += ["", f"Band {p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz, root-sum-square of:", "",
+    lines += ["", f"Band {p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz, root-sum-square in ln f of:", "",
               "| source | tolerance | low [Hz] | high [Hz] |", "|---|---|---:|---:|"]
     lines += [f"| {b['source']} | {b['tolerance']} | {b['low_hz']:+.1f} | {b['high_hz']:+.1f} |" for b in p["budget"]]
     lines += ["", "## Design rules", "", "| level | rule | message | fix |", "|---|---|---|---|"]

@@ -1,5 +1,7 @@
 """The acoustic ladder against closed forms, limits, monotonicity and the paper's numbers."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -189,10 +191,13 @@ def test_uncertainty_budget_lines_and_band():
     p = predict(spec_mod.load(PAPER))
     sources = [b.source for b in p.budget]
     assert sources == ["model", "neck diameter", "neck length (sheet)", "cavity diameter (core pin)",
-                       "core-pin draft", "air temperature", "silicone shear modulus"]
+                       "core-pin draft", "air temperature", "boundary layers", "silicone shear modulus"]
     assert all(b.low_hz <= 0 <= b.high_hz for b in p.budget)
-    low, high = total(list(p.budget))
+    low, high = total(list(p.budget), p.f0_hz)
     assert p.band_hz == pytest.approx((p.f0_hz + low, p.f0_hz + high))
+    # small shifts: the same as a plain root-sum-square, to within a few percent of the band
+    plain = math.sqrt(sum(b.high_hz ** 2 for b in p.budget))
+    assert high == pytest.approx(plain, rel=0.05)
     model = next(b for b in p.budget if b.source == "model")
     assert model.high_hz == pytest.approx(model_errors()["soft_wall"]["max_abs"] * p.f0_hz)
     # a wider neck sings higher: the neck-diameter line is negative at d - tol, positive at d + tol
@@ -216,3 +221,17 @@ def test_model_errors_come_from_the_benchmark():
     assert set(errors) >= {"lumped", "end_corrected", "transmission_line", "soft_wall", "fem"}
     assert all(e["measured_by"] == "benchmarks/error_vs_runtime.py" and e["cases"] >= 1 for e in errors.values())
     assert errors["fem"]["max_abs"] <= 0.001 and errors["transmission_line"]["max_abs"] < 0.02
+
+
+def test_boundary_layer_estimate_matches_digest_and_grows_small():
+    # DIGEST: about −2 % in f for the paper's neck; Kirchhoff's ε scales as 1/(a·sqrt(f))
+    assert air.boundary_layer_shift(5000.0, 1.05) == pytest.approx(0.021, abs=0.002)
+    assert air.boundary_layer_shift(50000.0, 0.105) == pytest.approx(
+        air.boundary_layer_shift(5000.0, 1.05) * 10 / np.sqrt(10), rel=1e-12)
+    line = next(b for b in predict(spec_mod.load(PAPER)).budget if b.source == "boundary layers")
+    assert line.high_hz == 0.0 and line.low_hz < 0
+    tiny = predict(_spec(cavity__diameter=0.318, cavity__length=0.476, neck__diameter=0.21, neck__length=0.635))
+    assert any("boundary layers in this" in w for w in tiny.warnings)
+    capillary = predict(_spec(neck__diameter=0.02))
+    assert any("may not sing" in w for w in capillary.warnings) and capillary.band_hz[0] > 0
+    assert not any("boundary layers" in w for w in predict(spec_mod.load(PAPER)).warnings)

@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from matcad.acoustics import models
+from matcad.acoustics.air import VISCOUS_REGIME_EPS, boundary_layer_drop, boundary_layer_shift
 from matcad.acoustics.load import MAT_PAPER_2024, LoadCalibration, frequency_at_force_hz, invalid_reason
 from matcad.acoustics.resonator import evaluate, resonator, shear_moduli_pa
 from matcad.acoustics.uncertainty import BudgetLine, budget, total
@@ -19,6 +20,7 @@ PLANE_WAVE_CUTOFF_KA = 1.8412
 """First non-planar (1,1) mode of a circular duct cuts on at k·a = 1.8412 (zero of J1')."""
 PANCAKE_L_OVER_D = 0.3
 LUMPED_NECK_AIR_RATIO = 0.1
+BOUNDARY_LAYER_WARN = 0.05
 LUMPED_END_CORRECTION_RATIO = 0.1
 """Uncorrected Eq. 1 needs the neck's end corrections ≪ its length (they are 24 % of it on the paper taxel)."""
 
@@ -167,9 +169,17 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
             raise ValueError(f"model {model!r} invalid, must be one of {sorted(results) + ['fem']}")
         chosen = model
     lines = budget(spec, res, chosen, results[chosen].f0_hz)
-    low, high = total(lines)
+    low, high = total(lines, results[chosen].f0_hz)
 
     warnings = _model_warnings(chosen, results[chosen], xi)
+    eps = float(boundary_layer_shift(results[chosen].f0_hz, neck.diameter / 2))
+    if eps > VISCOUS_REGIME_EPS:
+        warnings.append(f"{chosen}: the {neck.diameter:g} mm neck is so narrow that boundary layers fill it "
+                        f"(Kirchhoff eps = {eps:.2f}): viscous flow, heavy damping, it may not sing at all")
+    elif eps > BOUNDARY_LAYER_WARN:
+        warnings.append(f"{chosen}: viscous/thermal boundary layers in this {neck.diameter:g} mm neck lower f by "
+                        f"~{100 * boundary_layer_drop(results[chosen].f0_hz, neck.diameter / 2):.1f} %, which the "
+                        "lossless models leave out (the band includes it)")
     cal = spec_calibration(spec)
     curve: tuple[LoadPoint, ...] = ()
     if len(forces_n):

@@ -2,10 +2,10 @@
 
 Sources: the chosen model's own error (measured against the converged FEM by
 benchmarks/error_vs_runtime.py, stored in model_errors.json), fabrication (neck diameter as cut or drilled,
-sheet thickness per ISO 7823-1 unless measured, printed cavity diameter, core-pin draft), air temperature and
-the silicone's shear modulus. Each line re-evaluates the chosen model (or, for the FEM, the cheap model it
+sheet thickness per ISO 7823-1 unless measured, printed cavity diameter, core-pin draft), air temperature,
+viscous/thermal boundary layers (one-sided: every model here is lossless) and the silicone's shear modulus. Each line re-evaluates the chosen model (or, for the FEM, the cheap model it
 refines) with that one input moved to the ends of its tolerance; lines are independent, so lows and highs
-add in quadrature separately.
+add in quadrature separately, in ln f (relative shifts), which keeps a wide band above zero.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from matcad.acoustics.air import boundary_layer_drop
 from matcad.acoustics.resonator import CHEAP_MODELS, evaluate, resonator, shear_moduli_pa
 
 NECK_DIAMETER_TOL_MM = {"laser": 0.1, "drilled": 0.02}
@@ -92,6 +93,9 @@ def budget(spec, res, model: str, f0_hz: float) -> list[BudgetLine]:
         lines.append(BudgetLine("air temperature", f"{temp:g} +-{TEMPERATURE_TOL_C:g} C",
                                 *shifts([_replace(spec, "air", temperature_c=max(temp - TEMPERATURE_TOL_C, -273.0)),
                                          _replace(spec, "air", temperature_c=temp + TEMPERATURE_TOL_C)])))
+    drop = boundary_layer_drop(f0_hz, spec.neck.diameter / 2)
+    lines.append(BudgetLine("boundary layers", f"viscous + thermal, not in the lossless models: -{100 * drop:.1f} %",
+                            -drop * f0_hz, 0.0))
     if cheap == "soft_wall":
         g_lo, _, g_hi = shear_moduli_pa(spec)
         fs = [float(evaluate(res, cheap, g)) * scale - f0_hz for g in (g_lo, g_hi)]
@@ -100,6 +104,11 @@ def budget(spec, res, model: str, f0_hz: float) -> list[BudgetLine]:
     return lines
 
 
-def total(lines: list[BudgetLine]) -> tuple[float, float]:
-    """Root-sum-square of the lows and of the highs (Hz)."""
-    return (-math.sqrt(sum(x.low_hz ** 2 for x in lines)), math.sqrt(sum(x.high_hz ** 2 for x in lines)))
+def total(lines: list[BudgetLine], f0_hz: float) -> tuple[float, float]:
+    """Lows and highs combined root-sum-square in ln f, as offsets from ``f0_hz`` (Hz): the same as a plain
+    root-sum-square of small shifts, and never below zero frequency when shifts are large."""
+    def rss(shifts):
+        return math.sqrt(sum(math.log1p(x / f0_hz) ** 2 for x in shifts))
+
+    return (f0_hz * (math.exp(-rss(x.low_hz for x in lines)) - 1.0),
+            f0_hz * (math.exp(rss(x.high_hz for x in lines)) - 1.0))
