@@ -17,7 +17,7 @@ def test_coupon_sizes_read_back(tmp_path):
     assert code == 0, err
     folder = tmp_path / "c"
     doc = ezdxf.readfile(folder / "coupon_laser.dxf")
-    assert doc.header["$INSUNITS"] == 4
+    assert doc.header["$INSUNITS"] == 4 and not doc.audit().has_errors
     drawn = sorted(round(2 * c.dxf.radius, 6) for c in doc.modelspace().query("CIRCLE"))
     finished = [spec.neck.diameter + d for d in NECK_SWEEP_MM] + [spec.fasteners.dowel_diameter + d
                                                                  for d in DOWEL_SWEEP_MM]

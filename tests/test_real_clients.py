@@ -18,6 +18,7 @@ import pytest
 from matcad import spec as spec_mod
 from matcad.build import build, build_coupon
 from matcad.parts.catalogue import laser_parts
+from matcad.parts.coupon import laser_coupon
 from matcad.parts.flat import cut_plan
 from tests.conftest import TEMPLATES
 
@@ -88,10 +89,11 @@ def test_librecad_renders_every_dxf_at_one_to_one(builds, tmp_path):
     need("pdftoppm")
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
     checked = 0
+    coupon_spec = spec_mod.load(TEMPLATES[0])
     for spec, folder in builds:
-        if spec is None:
-            continue
-        for flat in laser_parts(spec):
+        flats = laser_parts(spec) if spec is not None else [laser_coupon(coupon_spec)]
+        spec = spec or coupon_spec
+        for flat in flats:
             plan = cut_plan(flat, spec.machine.laser_kerf, spec.outputs.reference_square)
             x0, y0, x1, y1 = plan.extents
             target = tmp_path / f"{spec.name}-{flat.name}"
@@ -104,4 +106,4 @@ def test_librecad_renders_every_dxf_at_one_to_one(builds, tmp_path):
             assert width == pytest.approx(x1 - x0, abs=0.3), flat.name
             assert height == pytest.approx(y1 - y0, abs=0.3), flat.name
             checked += 1
-    assert checked >= 9
+    assert checked >= 10  # every laser part of every template, and the coupon
