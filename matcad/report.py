@@ -97,6 +97,11 @@ def make_report(spec, prediction, findings, holes, meshes, folder: Path) -> dict
     }
 
 
+def _cell(text) -> str:
+    """Free text made safe for a Markdown table cell."""
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
 def _markdown(r: dict) -> str:
     p, ab, bom = r["prediction"], r["as_built"], r["bom"]
     lines = [f"# {r['name']} — matcad {r['matcad_version']} build report", "",
@@ -118,9 +123,10 @@ def _markdown(r: dict) -> str:
                      f"{'yes' if m['valid'] else 'no'} | {failed} |")
     lines += ["", f"Band {p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz, root-sum-square in ln f of:", "",
               "| source | tolerance | low [Hz] | high [Hz] |", "|---|---|---:|---:|"]
-    lines += [f"| {b['source']} | {b['tolerance']} | {b['low_hz']:+.1f} | {b['high_hz']:+.1f} |" for b in p["budget"]]
+    lines += [f"| {b['source']} | {_cell(b['tolerance'])} | {b['low_hz']:+.1f} | {b['high_hz']:+.1f} |"
+              for b in p["budget"]]
     lines += ["", "## Design rules", "", "| level | rule | message | fix |", "|---|---|---|---|"]
-    lines += [f"| {f['level']} | {f['id']} | {f['message']} | {f['fix']} |" for f in r["findings"]]
+    lines += [f"| {f['level']} | {f['id']} | {_cell(f['message'])} | {_cell(f['fix'])} |" for f in r["findings"]]
     s = bom["silicone"]
     lines += ["", "## Bill of materials", ""]
     lines += [f"- acrylic {sh['thickness_mm']:g} mm{' (measured)' if sh['measured'] else ''}: "

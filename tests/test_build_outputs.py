@@ -126,3 +126,19 @@ def test_only_asked_outputs_written(built):
     assert ("needle_mount.stl" in names) == o.needle_mount
     assert ("assembly.step" in names) == o.assembly
     assert ("spacer.dxf" in names) == (o.spacers and spec.spacer.style == "laser")
+
+
+def test_report_markdown_tables_are_well_formed(built):
+    _, out, _ = built
+    lines = (out / "report.md").read_text().splitlines()
+    tables, current = [], []
+    for line in lines + [""]:
+        if line.startswith("|"):
+            current.append(line)
+        elif current:
+            tables.append(current)
+            current = []
+    assert len(tables) >= 4  # prediction, budget, rules, files
+    for table in tables:
+        widths = {len(re.findall(r"(?<!\\)\|", row)) for row in table}
+        assert len(widths) == 1, table[0]
