@@ -72,7 +72,6 @@ def reference(levels_f):
 def run_case(name, dims):
     spec = case_spec(dims)
     p = predict(spec)
-    res = resonator(spec)
     shear = shear_moduli_pa(spec)[1] if spec.wall.model == "silicone" else None
     geom = fem.geometry_from_spec(spec, shear)
     k0 = 2 * math.pi * p.f0_hz / (p.speed_of_sound_m_s * 1e3)
