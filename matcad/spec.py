@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from matcad.materials import DEFAULT_GRADE, GRADES
+
 LENGTH_MIN_MM = 1e-3
 LENGTH_MAX_MM = 1e5
 CAP_OUTER_PER_D = 2.5
@@ -204,9 +206,12 @@ class Microphone:
 
 @dataclass(frozen=True)
 class Silicone:
-    """Cast silicone (Dragon Skin 30: specific gravity 1.08)."""
+    """Cast silicone: a grade from :mod:`matcad.materials` supplies the defaults of every material value."""
 
-    density_g_cm3: float = _param("density of the cured silicone", "g/cm^3", 1.08, lo=0.0, hi=30.0)
+    grade: str = _param("cast silicone grade (see docs/materials.md for the sourced values)",
+                        default=DEFAULT_GRADE, kind="choice", choices=tuple(GRADES))
+    density_g_cm3: float | None = _param("density of the cured silicone; default from the grade", "g/cm^3",
+                                         None, lo=0.0, hi=30.0)
     waste_factor: float = _param("batch volume / cast volume (cups, sprues, vents)", "", 1.3, lo=1.0,
                                  hi=100.0, lo_open=False)
 
@@ -240,9 +245,9 @@ class Wall:
 
     model: str = _param("'rigid' (ideal walls) or 'silicone' (quasi-static wall compliance band)",
                         default="rigid", kind="choice", choices=("rigid", "silicone"))
-    shear_modulus_mpa: tuple[float, float] = _param(
-        "[low, high] shear modulus of the cured silicone; Dragon Skin 30 ~0.31 MPa, uncertain ~2x",
-        "MPa", (0.2, 0.6), kind="range", lo=0.0, hi=1e6)
+    shear_modulus_mpa: tuple[float, float] | None = _param(
+        "[low, high] static shear modulus of the cured silicone; default from silicone.grade "
+        "(Dragon Skin 30: 0.2-0.6 MPa)", "MPa", None, kind="range", lo=0.0, hi=1e6)
 
 
 @dataclass(frozen=True)
@@ -442,7 +447,8 @@ KEY_CLEARANCE_MM = {"fdm": 0.2, "sla": 0.1}
 
 
 def _resolve_defaults(spec: Spec) -> Spec:
-    """Fill defaults that depend on other fields (cap body proportional to the cavity; key clearance)."""
+    """Fill defaults that depend on other fields (cap body proportional to the cavity; key clearance; silicone
+    values from its grade)."""
     cap = spec.end_cap
     d = spec.cavity.diameter
     cap = dataclasses.replace(
@@ -451,7 +457,14 @@ def _resolve_defaults(spec: Spec) -> Spec:
     machine = spec.machine
     if machine.key_clearance is None:
         machine = dataclasses.replace(machine, key_clearance=KEY_CLEARANCE_MM[machine.printer])
-    return dataclasses.replace(spec, end_cap=cap, machine=machine)
+    grade = GRADES[spec.silicone.grade]
+    silicone = spec.silicone
+    if silicone.density_g_cm3 is None:
+        silicone = dataclasses.replace(silicone, density_g_cm3=grade.density_kg_m3 / 1000.0)
+    wall = spec.wall
+    if wall.shear_modulus_mpa is None:
+        wall = dataclasses.replace(wall, shear_modulus_mpa=grade.shear_modulus_mpa)
+    return dataclasses.replace(spec, end_cap=cap, machine=machine, silicone=silicone, wall=wall)
 
 
 def load(path: str | Path) -> Spec:
