@@ -18,6 +18,10 @@ from matcad.parts.flat import cut_plan
 from matcad.rules import Finding, check, errors
 
 
+UNFORCEABLE = ("laser.drawn_size",)
+"""Rule ids that --force cannot override: the file itself could not be written correctly."""
+
+
 class DesignRuleFailure(Exception):
     """The spec breaks at least one design rule at level error."""
 
@@ -84,7 +88,8 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
 
     prediction = predict(spec)
     findings = check(spec, prediction)
-    if errors(findings) and not force:
+    blocking = [f for f in errors(findings) if not force or f.id in UNFORCEABLE]
+    if blocking:
         raise DesignRuleFailure(findings)
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
     with staged_output(target) as tmp:

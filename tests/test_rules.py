@@ -28,7 +28,7 @@ def _levels(spec, rule_id):
     ({"mold__fill_port": 1.5}, "mold.fill_port", "warning"),
     ({"mold__vent": 2.5}, "mold.vents", "error"),                       # wider than the 2 mm flange ring
     ({"plate__width": 13.0}, "laser.web", "error"),                     # bolt holes run into the flange hole
-    ({"machine__laser_min_feature": 1.6}, "laser.feature", "warning"),  # 1.55 mm dowel holes
+    ({"machine__laser_min_feature": 1.4}, "laser.feature", "error"),    # dowel holes drawn 1.55 - 0.25 mm
     ({"neck__length": 6.0}, "laser.stock", "info"),                     # 6 mm is stock
     ({"neck__length": 6.1}, "laser.stock", "warning"),                  # 6.1 mm is not
     ({"fasteners__dowel_fit_laser": "press"}, "fit.dowel_laser", "error"),

@@ -75,15 +75,39 @@ class CutPlan:
     extents: tuple[float, float, float, float] = field(default=(0, 0, 0, 0))
 
 
+class DrawnSizeError(ValueError):
+    """A feature whose drawn (kerf-compensated) size is not a real size: nothing can be drawn or cut."""
+
+
+def drawn_diameter_mm(finished_mm: float, kerf_mm: float) -> float:
+    """Diameter the laser must follow for a hole of ``finished_mm``: the finished size minus the full kerf
+    (the beam removes kerf/2 on each side of the line), mm."""
+    return finished_mm - kerf_mm
+
+
+def drawn_holes(flat: Flat, kerf: float) -> list[tuple[Hole, float]]:
+    """Every hole of ``flat`` with the diameter it is drawn at (mm), smallest first."""
+    return sorted(((h, drawn_diameter_mm(h.diameter, kerf)) for h in flat.holes), key=lambda hd: hd[1])
+
+
 def cut_plan(flat: Flat, kerf: float, reference_square: bool, spacing: float = 3.0) -> CutPlan:
-    """Apply kerf compensation (outline +kerf/2, holes −kerf/2) and lay out ``quantity`` copies in a row."""
+    """Apply kerf compensation (outline +kerf/2, holes −kerf/2) and lay out ``quantity`` copies in a row.
+
+    Raises :class:`DrawnSizeError` when a hole would be drawn at a diameter ≤ 0 (a hole smaller than the kerf):
+    the design rule ``laser.drawn_size`` reports the same thing, naming the spec field, before any build.
+    """
+    for hole, drawn in drawn_holes(flat, kerf):
+        if drawn <= 0:
+            raise DrawnSizeError(f"{flat.name}: {hole.purpose} hole of {hole.diameter:g} mm would be drawn at "
+                                 f"{drawn:g} mm after the {kerf:g} mm kerf; it must be drawn > 0 mm")
     half = kerf / 2
     outlines, circles = [], []
     for i in range(flat.quantity):
         dx = i * (flat.width + kerf + spacing)
         outlines.append((dx - flat.width / 2 - half, -flat.depth / 2 - half,
                          dx + flat.width / 2 + half, flat.depth / 2 + half, flat.corner_radius + half))
-        circles += [CutCircle(dx + h.x, h.y, h.diameter - kerf, h.diameter, -kerf, h.purpose) for h in flat.holes]
+        circles += [CutCircle(dx + h.x, h.y, drawn_diameter_mm(h.diameter, kerf), h.diameter, -kerf, h.purpose)
+                    for h in flat.holes]
     x_max = outlines[-1][2]
     square = None
     if reference_square:

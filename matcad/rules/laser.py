@@ -6,7 +6,7 @@ import math
 
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.features import is_stock_sheet
-from matcad.parts.flat import Flat
+from matcad.parts.flat import Flat, drawn_holes
 from matcad.rules import Finding
 
 TAPER_RATIO = 0.7
@@ -35,11 +35,37 @@ def feature_and_web(spec) -> list[Finding]:
             out.append(Finding("laser.web", level, round(web, 4), limit,
                                f"{flat.name}: {what} leaves {web:.2f} mm of acrylic (< {limit:g} mm)",
                                "enlarge plate.width/depth or plate.bolt_inset, or use smaller fasteners"))
-        small = min(flat.holes, key=lambda h: h.diameter)
-        if small.diameter < limit:
-            out.append(Finding("laser.feature", "warning", small.diameter, limit,
-                               f"{flat.name}: {small.purpose} hole {small.diameter:g} mm is below the laser's "
-                               f"smallest reliable feature", "drill it instead, or raise the size"))
+    return out
+
+
+HOLE_FIELDS = {"neck": "neck.diameter", "neck_pilot": "plate.pilot_undersize", "dowel": "fasteners.dowel_diameter",
+               "bolt": "fasteners.bolt", "cap": "end_cap.outer_diameter"}
+"""The spec field that sets each hole purpose's size (what the user changes to fix a drawn size)."""
+
+
+def drawn_size(spec) -> list[Finding]:
+    """Holes as drawn, after kerf (the numbers written into the DXF/SVG, from the same function the exporter
+    uses): ≤ 0 cannot be drawn at all (``laser.drawn_size``, not overridable by --force); below
+    machine.laser_min_feature the beam cannot cut it cleanly (``laser.feature``)."""
+    out = []
+    limit = spec.machine.laser_min_feature
+    for flat in laser_parts(spec):
+        kerf = spec.machine.laser_kerf
+        seen = set()
+        for hole, drawn in drawn_holes(flat, kerf):
+            if hole.purpose in seen or drawn >= limit:
+                continue
+            seen.add(hole.purpose)
+            field = HOLE_FIELDS.get(hole.purpose, "machine.laser_kerf")
+            where = (f"{flat.name}: {hole.purpose} hole ({field}) finished {hole.diameter:g} mm is drawn at "
+                     f"{drawn:.3g} mm after the {kerf:g} mm kerf")
+            if drawn <= 0:
+                out.append(Finding("laser.drawn_size", "error", round(drawn, 4), "> 0",
+                                   f"{where}: nothing to cut", f"enlarge {field} or lower machine.laser_kerf"))
+            else:
+                out.append(Finding("laser.feature", "error", round(drawn, 4), limit,
+                                   f"{where}, below the laser's smallest feature {limit:g} mm "
+                                   "(machine.laser_min_feature)", f"enlarge {field}, or drill it instead"))
     return out
 
 
@@ -95,4 +121,4 @@ def dowel_fit(spec) -> list[Finding]:
     return []
 
 
-RULES = (feature_and_web, hole_taper, stock_thickness, dowel_fit)
+RULES = (feature_and_web, drawn_size, hole_taper, stock_thickness, dowel_fit)
