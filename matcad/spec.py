@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from matcad.inputs import CALIBRATION_MAX_BYTES, SPEC_MAX_BYTES
 from matcad.materials import DEFAULT_GRADE, GRADES
 
 LENGTH_MIN_MM = 1e-3
@@ -33,7 +34,9 @@ class SpecError(ValueError):
         self.field = field_name
         self.value = value
         self.allowed = allowed
-        super().__init__(f"{field_name} = {value!r}: {allowed}")
+        from matcad.errors import shorten
+
+        super().__init__(f"{field_name} = {shorten(value)}: {allowed}")
 
 
 def _param(doc: str, unit: str = "", default: Any = dataclasses.MISSING, *, kind: str = "number",
@@ -49,8 +52,24 @@ def _length(doc: str, default: Any = dataclasses.MISSING) -> Any:
     return _param(doc, "mm", default, lo=LENGTH_MIN_MM, hi=LENGTH_MAX_MM, lo_open=False)
 
 
+class Section:
+    """Base of every spec section: each field is validated on construction by the same per-field converter that
+    reads TOML, so ``dataclasses.replace`` (or a direct call) cannot make an invalid section. ``None`` is
+    accepted where the field's default is ``None`` (resolved later or optional)."""
+
+    def __post_init__(self) -> None:
+        path = SECTION_NAMES.get(type(self), type(self).__name__.lower())
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if value is None and f.default is None:
+                continue
+            if value is None and f.default is dataclasses.MISSING:
+                raise SpecError(f"{path}.{f.name}", None, f"is required ({f.metadata['doc']})")
+            object.__setattr__(self, f.name, _convert(f"{path}.{f.name}", value, dict(f.metadata)))
+
+
 @dataclass(frozen=True)
-class Cavity:
+class Cavity(Section):
     """The silicone end cap's cylindrical channel (paper: D, L)."""
 
     diameter: float = _length("cavity diameter D, cast in the silicone end cap")
@@ -58,7 +77,7 @@ class Cavity:
 
 
 @dataclass(frozen=True)
-class Neck:
+class Neck(Section):
     """The through-hole in the acrylic neck plate (paper: d, l)."""
 
     diameter: float = _length("neck diameter d (the through-hole as designed)")
@@ -70,7 +89,7 @@ class Neck:
 
 
 @dataclass(frozen=True)
-class Plate:
+class Plate(Section):
     """The laser-cut neck plate outline; the mount gap under it vents at its edges."""
 
     width: float = _length("neck plate width (x), neck at its centre", 24.0)
@@ -87,7 +106,7 @@ class Plate:
 
 
 @dataclass(frozen=True)
-class Guide:
+class Guide(Section):
     """Laser-cut guides over the plate: a locator around the cap's flange and a clamp over it (paper Sec. II)."""
 
     thickness: float = _length("guide sheet thickness (paper: 1.5 mm acrylic)", 1.5)
@@ -96,7 +115,7 @@ class Guide:
 
 
 @dataclass(frozen=True)
-class Spacer:
+class Spacer(Section):
     """Spacers between the neck plate and the air-supply mount (paper: 1.59 mm, for ventilation)."""
 
     height: float = _length("gap between neck plate and mount; the 'mount' mouth's gap height", 1.59)
@@ -109,7 +128,7 @@ class Spacer:
 
 
 @dataclass(frozen=True)
-class Fasteners:
+class Fasteners(Section):
     """Bolts clamping guide, plate, spacers and mount; dowel pins aligning them."""
 
     bolt: str = _param("metric bolt size", default="M2", kind="choice", choices=("M2", "M2.5", "M3"))
@@ -124,7 +143,7 @@ class Fasteners:
 
 
 @dataclass(frozen=True)
-class Needle:
+class Needle(Section):
     """The air-supply needle (paper: 1.52 mm, theta = 75 deg)."""
 
     outer_diameter: float = _length("needle outer diameter", 1.52)
@@ -140,14 +159,14 @@ class Needle:
 
 
 @dataclass(frozen=True)
-class Mount:
+class Mount(Section):
     """The printed air-supply (needle) mount under the plate."""
 
     thickness: float = _length("mount block thickness", 8.0)
 
 
 @dataclass(frozen=True)
-class Mold:
+class Mold(Section):
     """Two-part printed mold for the silicone end cap (base + lid carrying the core pin)."""
 
     draft_deg: float = _param("core-pin draft; narrows the cavity toward its closed end (reported)", "deg",
@@ -164,7 +183,7 @@ class Mold:
 
 
 @dataclass(frozen=True)
-class Machine:
+class Machine(Section):
     """The user's laser cutter and printer; fits and compensation come from here."""
 
     laser_kerf: float = _param("full kerf width of the laser (measure with `matcad coupon`)", "mm", 0.2,
@@ -181,7 +200,7 @@ class Machine:
 
 
 @dataclass(frozen=True)
-class Outputs:
+class Outputs(Section):
     """What `matcad build` writes; only what is asked for is built."""
 
     end_cap_mold: bool = _param("STL + STEP mold base and lid", default=True, kind="bool")
@@ -195,7 +214,7 @@ class Outputs:
 
 
 @dataclass(frozen=True)
-class Microphone:
+class Microphone(Section):
     """The recording chain."""
 
     sample_rate_hz: float = _param("microphone sample rate (band must stay < 0.45 x this)", "Hz", 44100.0,
@@ -205,7 +224,7 @@ class Microphone:
 
 
 @dataclass(frozen=True)
-class Silicone:
+class Silicone(Section):
     """Cast silicone: a grade from :mod:`matcad.materials` supplies the defaults of every material value."""
 
     grade: str = _param("cast silicone grade (see docs/materials.md for the sourced values)",
@@ -217,7 +236,7 @@ class Silicone:
 
 
 @dataclass(frozen=True)
-class EndCap:
+class EndCap(Section):
     """Outer body of the cast silicone end cap (the paper does not give it; defaults are matcad's)."""
 
     outer_diameter: float | None = _length(
@@ -230,7 +249,7 @@ class EndCap:
 
 
 @dataclass(frozen=True)
-class Air:
+class Air(Section):
     """The air in and around the taxel."""
 
     temperature_c: float = _param("air temperature; sets the speed of sound", "degC", 20.0,
@@ -240,7 +259,7 @@ class Air:
 
 
 @dataclass(frozen=True)
-class Wall:
+class Wall(Section):
     """Cavity wall mechanics."""
 
     model: str = _param("'rigid' (ideal walls) or 'silicone' (quasi-static wall compliance band)",
@@ -251,7 +270,7 @@ class Wall:
 
 
 @dataclass(frozen=True)
-class Calibration:
+class Calibration(Section):
     """Paper Eq. 5 constants: V_eff = v0_mm3 - a F^2 - b F (F in N)."""
 
     v0_mm3: float = _param("effective unloaded cavity volume V_ci", "mm^3", lo=0.0, hi=1e18)
@@ -275,6 +294,10 @@ class Calibration:
                                             lo=0.0, hi=1e30, lo_open=False)
     dof: int | None = _param("degrees of freedom of the fit (points - 3)", default=None, kind="integer",
                              lo=1, hi=10**9)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _check_calibration(self)
 
 
 @dataclass(frozen=True)
@@ -300,14 +323,29 @@ class Spec:
     silicone: Silicone = field(default_factory=Silicone)
     calibration: Calibration | None = None
 
+    def __post_init__(self) -> None:
+        name_meta = dict(dataclasses.fields(Spec)[0].metadata)
+        object.__setattr__(self, "name", _convert("name", self.name, name_meta))
+        for section, cls in SECTIONS.items():
+            value = getattr(self, section)
+            if value is None and section in REQUIRED_SECTIONS:
+                raise SpecError(section, None, f"is required: add a [{section}] table")
+            if value is not None and not isinstance(value, cls):
+                raise SpecError(section, value, f"must be a {cls.__name__} section")
+        _cross_checks(self)
+
 
 SECTIONS: dict[str, type] = {
     "cavity": Cavity, "neck": Neck, "plate": Plate, "guide": Guide, "spacer": Spacer, "end_cap": EndCap,
     "fasteners": Fasteners, "needle": Needle, "mount": Mount, "mold": Mold, "machine": Machine,
     "outputs": Outputs, "air": Air, "wall": Wall, "microphone": Microphone, "silicone": Silicone,
     "calibration": Calibration}
+SECTION_NAMES: dict[type, str] = {cls: name for name, cls in SECTIONS.items()}
 REQUIRED_SECTIONS = ("cavity", "neck")
-_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+_NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
+"""Matched with fullmatch: ``$`` would accept a final newline."""
+MAX_NESTING = 32
+"""Deepest TOML nesting a spec document may have (a spec needs 2); deeper is refused before Python recursion."""
 
 
 def _did_you_mean(key: str, known: list[str]) -> str:
@@ -344,7 +382,10 @@ def _allowed_text(meta: dict) -> str:
 def _number(path: str, value: Any, meta: dict) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise SpecError(path, value, f"must be {_range_text(meta)}")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:  # an integer of >= 309 digits
+        raise SpecError(path, value, f"must be {_range_text(meta)}") from None
     lo_ok = x > meta["lo"] if meta["lo_open"] else x >= meta["lo"]
     if not (math.isfinite(x) and lo_ok and x <= meta["hi"]):
         raise SpecError(path, value, f"must be {_range_text(meta)}")
@@ -360,7 +401,7 @@ def _convert(path: str, value: Any, meta: dict) -> Any:
             raise SpecError(path, value, f"must be a whole number, {meta['lo']:g} <= value <= {meta['hi']:g}")
         return value
     if kind == "vector9":
-        if not isinstance(value, list) or len(value) != 9:
+        if not isinstance(value, (list, tuple)) or len(value) != 9:
             raise SpecError(path, value, "must be a list of 9 finite numbers (a 3 x 3 matrix, row by row)")
         return tuple(_number(path, v, meta) for v in value)
     if kind == "bool":
@@ -376,14 +417,14 @@ def _convert(path: str, value: Any, meta: dict) -> Any:
             raise SpecError(path, value, f"must be one of {', '.join(map(repr, meta['choices']))}")
         return value
     if kind == "range":
-        if not isinstance(value, list) or len(value) != 2:
+        if not isinstance(value, (list, tuple)) or len(value) != 2:
             raise SpecError(path, value, f"must be [low, high], each {_range_text(meta)}")
         lo, hi = (_number(path, v, meta) for v in value)
         if lo > hi:
             raise SpecError(path, value, "must be [low, high] with low <= high")
         return (lo, hi)
     if kind == "name":
-        if not isinstance(value, str) or not _NAME_RE.match(value) or value in (".", ".."):
+        if not isinstance(value, str) or not _NAME_RE.fullmatch(value) or value in (".", ".."):
             raise SpecError(path, value, "must be 1-64 characters of A-Z a-z 0-9 . _ - "
                                          "starting with a letter or digit (it names a folder)")
         return value
@@ -399,6 +440,8 @@ def _section(cls: type, path: str, data: Any) -> Any:
             raise SpecError(f"{path}.{key}", data[key], _did_you_mean(key, list(fields)))
     values = {}
     for name, f in fields.items():
+        if name in data and data[name] is None and f.default is None:  # to_dict's unset optional field
+            continue
         if name in data:
             values[name] = _convert(f"{path}.{name}", data[name], dict(f.metadata))
         elif f.default is dataclasses.MISSING:
@@ -416,7 +459,7 @@ def _cross_checks(spec: Spec) -> None:
         raise SpecError("mold.draft_deg", spec.mold.draft_deg,
                         f"must leave the cavity open: draft closes a {spec.cavity.diameter:g} mm cavity within "
                         f"its {spec.cavity.length:g} mm length")
-    if spec.end_cap.outer_diameter <= spec.cavity.diameter:
+    if spec.end_cap.outer_diameter is not None and spec.end_cap.outer_diameter <= spec.cavity.diameter:
         raise SpecError("end_cap.outer_diameter", spec.end_cap.outer_diameter,
                         f"must be > cavity.diameter = {spec.cavity.diameter:g} mm")
 
@@ -432,14 +475,13 @@ def from_dict(data: dict) -> Spec:
         raise SpecError("name", None, f"is required ({name_meta['doc']})")
     values: dict[str, Any] = {"name": _convert("name", data["name"], name_meta)}
     for section, cls in SECTIONS.items():
+        if section in data and data[section] is None and section not in REQUIRED_SECTIONS:
+            continue
         if section in data:
             values[section] = _section(cls, section, data[section])
         elif section in REQUIRED_SECTIONS:
             raise SpecError(section, None, f"is required: add a [{section}] table")
-    spec = Spec(**values)
-    spec = _resolve_defaults(spec)
-    _cross_checks(spec)
-    return spec
+    return _resolve_defaults(Spec(**values))  # Spec.__post_init__ runs the cross-field checks
 
 
 KEY_CLEARANCE_MM = {"fdm": 0.2, "sla": 0.1}
@@ -469,25 +511,43 @@ def _resolve_defaults(spec: Spec) -> Spec:
 
 def load(path: str | Path) -> Spec:
     """Read and validate a spec TOML file. Raises SpecError naming the field on bad input."""
+    return from_dict(_read_toml(path, "spec file", SPEC_MAX_BYTES))
+
+
+def _depth(value: Any, limit: int) -> int:
+    """Nesting depth of parsed TOML data, stopping once it passes ``limit``."""
+    if limit < 0 or not isinstance(value, (dict, list)):
+        return 0
+    items = value.values() if isinstance(value, dict) else value
+    return 1 + max((_depth(v, limit - 1) for v in items), default=0)
+
+
+def _read_toml(path: str | Path, what: str, limit: int) -> dict:
+    """A size-limited regular file parsed as TOML; any failure is a SpecError naming the file."""
+    from matcad.errors import InputError
+    from matcad.inputs import read_text
+
     p = Path(path)
     try:
-        text = p.read_bytes().decode("utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SpecError("spec file", str(p), f"must be a readable UTF-8 TOML file ({exc.__class__.__name__})")
+        text = read_text(p, what, limit)
+    except InputError as exc:
+        raise SpecError(what, str(p), str(exc).split(": ", 1)[-1]) from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise SpecError("spec file", str(p), f"must be valid TOML ({exc})")
-    return from_dict(data)
+        raise SpecError(what, str(p), f"must be valid TOML ({exc})") from None
+    except (RecursionError, ValueError, MemoryError) as exc:  # nesting or integer digits beyond the parser's limits
+        raise SpecError(what, str(p), f"must be valid TOML within the parser's limits ({exc.__class__.__name__})") \
+            from None
+    if _depth(data, MAX_NESTING) > MAX_NESTING:
+        raise SpecError(what, str(p), f"nests tables or arrays deeper than {MAX_NESTING} levels")
+    return data
 
 
 def load_calibration(path: str | Path) -> Calibration:
     """The [calibration] table of a calibration file or of a whole spec, validated like a spec's."""
     p = Path(path)
-    try:
-        data = tomllib.loads(p.read_bytes().decode("utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise SpecError("calibration file", str(p), f"must be a readable TOML file ({exc.__class__.__name__})")
+    data = _read_toml(p, "calibration file", CALIBRATION_MAX_BYTES)
     if "cavity" in data:
         cal = from_dict(data).calibration
         if cal is None:
@@ -496,6 +556,26 @@ def load_calibration(path: str | Path) -> Calibration:
     if "calibration" not in data:
         raise SpecError("calibration", None, f"is required: {p} has no [calibration] table")
     return _section(Calibration, "calibration", data["calibration"])
+
+
+def _check_calibration(cal: Calibration) -> None:
+    """What sensing needs of a calibration beyond each field's range: a covariance that is one (symmetric,
+    variances >= 0, no negative eigenvalue beyond rounding), and V_eff = v0 - bF - aF^2 > 0 over its force range
+    (else f = sqrt(K/V_eff) is not real there)."""
+    if cal.covariance is not None:
+        import numpy as np
+
+        cov = np.array(cal.covariance, dtype=float).reshape(3, 3)
+        scale = float(np.max(np.abs(cov))) or 1.0
+        if np.any(np.diag(cov) < 0) or not np.allclose(cov, cov.T, rtol=1e-9, atol=1e-12 * scale) \
+                or float(np.min(np.linalg.eigvalsh((cov + cov.T) / 2))) < -1e-9 * scale:
+            raise SpecError("calibration.covariance", list(cal.covariance),
+                            "must be a covariance matrix: symmetric, variances >= 0, positive semi-definite")
+    if cal.force_range_n is not None:
+        for force in cal.force_range_n:
+            if not cal.v0_mm3 - cal.b * force - cal.a * force * force > 0:
+                raise SpecError("calibration.force_range_n", list(cal.force_range_n),
+                                f"must keep V_eff = v0 - bF - aF^2 > 0 mm^3 (at F = {force:g} N it is not)")
 
 
 def schema() -> list[dict]:

@@ -93,12 +93,23 @@ def t_quantile(p: float, dof: int) -> float:
     return float(stdtrit(dof, p))
 
 
+FORCE_LIMIT_N = 1e6
+"""|F| above this is not a taxel load (and F² would overflow the fit): the spec's calibration.force_range_n bound."""
+FREQUENCY_LIMIT_HZ = 1e7
+"""The spec's microphone.sample_rate_hz bound: no recorded tone lies above it."""
+
+
 def read_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
-    """Force (N) and frequency (Hz) columns: a header naming force_n and frequency_hz, or the first two columns."""
+    """Force (N) and frequency (Hz) columns: a header naming force_n and frequency_hz, or the first two columns.
+    The file is size-limited before parsing (:data:`matcad.inputs.CSV_MAX_BYTES`); raises ValueError."""
+    from matcad.errors import shorten
+    from matcad.inputs import CSV_MAX_BYTES, read_text
+
+    text = read_text(path, "calibration data", CSV_MAX_BYTES)
     try:
-        rows = list(csv.reader(Path(path).read_text(encoding="utf-8").splitlines()))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"calibration data {path}: not a readable CSV file ({exc.__class__.__name__})") from None
+        rows = list(csv.reader(text.splitlines()))
+    except csv.Error as exc:  # a field over csv.field_size_limit() (131 072 characters), a NUL byte
+        raise ValueError(f"calibration data {path}: not a readable CSV file ({exc})") from None
     rows = [r for r in rows if r and not r[0].lstrip().startswith("#")]
     if not rows:
         raise ValueError(f"calibration data {path}: no rows")
@@ -111,11 +122,11 @@ def read_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
         try:
             force, freq = float(row[i_f]), float(row[i_hz])
         except (ValueError, IndexError):
-            raise ValueError(f"calibration data {path}, row {line}: {row!r} must hold a force (N) and a frequency "
-                             "(Hz)") from None
-        if not (math.isfinite(force) and math.isfinite(freq) and freq > 0):
-            raise ValueError(f"calibration data {path}, row {line}: force {force!r} must be finite and frequency "
-                             f"{freq!r} finite and > 0 Hz")
+            raise ValueError(f"calibration data {path}, row {line}: {shorten(row)} must hold a force (N) and a "
+                             "frequency (Hz)") from None
+        if not (abs(force) <= FORCE_LIMIT_N and 0 < freq <= FREQUENCY_LIMIT_HZ):
+            raise ValueError(f"calibration data {path}, row {line}: force {force!r} must be finite with |F| <= "
+                             f"{FORCE_LIMIT_N:g} N and frequency {freq!r} finite, 0 < f <= {FREQUENCY_LIMIT_HZ:g} Hz")
         forces.append(force)
         freqs.append(freq)
     return np.array(forces), np.array(freqs)
@@ -157,6 +168,13 @@ def fit(forces_n, frequencies_hz, k_mm3_hz2: float, v0_fixed_mm3: float | None =
         theta, cov, sigma2, k_mm3_hz2 = k * theta, k * k * cov, sigma2 * k * k, k
     v0, b, a = (float(v) for v in theta)
     lo, hi = float(force.min()), float(force.max())
+    # the README promises exit 1 when the data show no load: the change of y = K/f² across the range,
+    # Δy = b·(hi − lo) + a·(hi² − lo²), must stand out of its own 95 % interval
+    g = np.array([0.0, hi - lo, hi * hi - lo * lo])
+    change = b * g[1] + a * g[2]
+    if not abs(change) > max(t_quantile(0.975, dof) * math.sqrt(max(float(g @ cov @ g), 0.0)), 1e-12 * abs(v0)):
+        raise LoopError(f"the frequencies do not change with force over {lo:g}-{hi:g} N beyond their scatter: "
+                        "no load response to calibrate (check that the cap is loaded and the tone tracked)")
     if a != 0:
         turn = -b / (2 * a)
         if lo <= turn <= hi:
