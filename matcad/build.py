@@ -84,6 +84,7 @@ def _write_solids(spec, folder: Path) -> dict[str, dict]:
 
 def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:
     """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
+    from matcad.render.kit import render_figures
     from matcad.report import make_report, write_report
 
     prediction = predict(spec)
@@ -95,7 +96,8 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
     with staged_output(target) as tmp:
         holes = _write_laser(spec, tmp)
         meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
-        report = make_report(spec, prediction, findings, holes, meshes, tmp)
+        figures = render_figures(spec, prediction, tmp, meshes)
+        report = make_report(spec, prediction, findings, holes, meshes, tmp) | {"figures": figures}
         write_report(report, tmp)
     files = tuple(sorted(p.name for p in target.iterdir()))
     return BuildResult(target, files, tuple(findings), prediction, report)

@@ -14,7 +14,7 @@ from matcad.parts.features import (bolt_nominal_mm, cap_flange_thickness_mm, cap
                                    plate_bolt_positions_mm, plate_dowel_positions_mm)
 from matcad.spec import to_dict
 
-REPORT_FILES = ("report.json", "report.md")
+REPORT_FILES = ("report.json", "report.md", "report.html")
 THREAD_ENGAGEMENT_PER_D = 2.0
 """Self-tapping screws into printed plastic want ~2 x diameter of engagement."""
 
@@ -102,6 +102,14 @@ def _cell(text) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
+def _part_link(finding: dict, r: dict) -> str:
+    """The part a finding concerns, linked to its preview in the report ('–' when it names none)."""
+    from matcad.report_page import finding_part, part_anchor
+
+    part = finding_part(finding, r)
+    return f"[{part}](#{part_anchor(part)})" if part else "–"
+
+
 def _markdown(r: dict) -> str:
     p, ab, bom = r["prediction"], r["as_built"], r["bom"]
     lines = [f"# {r['name']} — matcad {r['matcad_version']} build report", "",
@@ -125,8 +133,9 @@ def _markdown(r: dict) -> str:
               "| source | tolerance | low [Hz] | high [Hz] |", "|---|---|---:|---:|"]
     lines += [f"| {b['source']} | {_cell(b['tolerance'])} | {b['low_hz']:+.1f} | {b['high_hz']:+.1f} |"
               for b in p["budget"]]
-    lines += ["", "## Design rules", "", "| level | rule | message | fix |", "|---|---|---|---|"]
-    lines += [f"| {f['level']} | {f['id']} | {_cell(f['message'])} | {_cell(f['fix'])} |" for f in r["findings"]]
+    lines += ["", "## Design rules", "", "| level | rule | part | message | fix |", "|---|---|---|---|---|"]
+    lines += [f"| {f['level']} | {f['id']} | {_part_link(f, r)} | {_cell(f['message'])} | {_cell(f['fix'])} |"
+              for f in r["findings"]]
     s = bom["silicone"]
     lines += ["", "## Bill of materials", ""]
     lines += [f"- acrylic {sh['thickness_mm']:g} mm{' (measured)' if sh['measured'] else ''}: "
@@ -151,5 +160,10 @@ def _markdown(r: dict) -> str:
 
 
 def write_report(report: dict, folder: Path) -> None:
+    """report.json, and report.md and report.html from one Markdown rendering of the same data."""
+    from matcad.report_page import render_html, render_markdown
+
     (folder / "report.json").write_text(json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    (folder / "report.md").write_text(_markdown(report), encoding="utf-8")
+    text = render_markdown(report, _markdown(report))
+    (folder / "report.md").write_text(text, encoding="utf-8")
+    (folder / "report.html").write_text(render_html(text, f"{report['name']} — matcad report"), encoding="utf-8")

@@ -13,6 +13,7 @@ import ezdxf
 
 from matcad.export.dxf_svg import LAYERS
 from matcad.parts.catalogue import laser_parts
+from matcad.report import REPORT_FILES
 
 SVG = "{http://www.w3.org/2000/svg}"
 
@@ -20,7 +21,7 @@ SVG = "{http://www.w3.org/2000/svg}"
 def assert_manifest(out: Path) -> dict:
     report = json.loads((out / "report.json").read_text())
     listed = {f["file"]: f for f in report["files"]}
-    assert set(listed) == {p.name for p in out.iterdir()} - {"report.json", "report.md"}
+    assert set(listed) == {p.name for p in out.iterdir()} - set(REPORT_FILES)
     for name, row in listed.items():
         data = (out / name).read_bytes()
         assert row["bytes"] == len(data) and row["sha256"] == hashlib.sha256(data).hexdigest()

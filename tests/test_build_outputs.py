@@ -33,7 +33,7 @@ def test_report_manifest_matches_files(built):
     spec, out, result = built
     report = json.loads((out / "report.json").read_text())
     listed = {f["file"]: f for f in report["files"]}
-    on_disk = {p.name for p in out.iterdir()} - {"report.json", "report.md"}
+    on_disk = {p.name for p in out.iterdir()} - {"report.json", "report.md", "report.html"}
     assert set(listed) == on_disk
     for name, row in listed.items():
         data = (out / name).read_bytes()

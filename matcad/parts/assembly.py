@@ -14,6 +14,7 @@ from matcad.parts.neck_plate import neck_plate
 from matcad.parts.needle_mount import needle, needle_mount
 from matcad.parts.solid import flat_solid
 from matcad.parts.spacer import spacer
+from matcad.render.section import annotate_section
 
 SECTION_COLOURS = {
     "neck_plate": "#9cc8f0", "guide_locator": "#c4e0fa", "guide_clamp": "#c4e0fa", "end_cap": "#f0a050",
@@ -49,7 +50,8 @@ def assembly(spec, parts=None) -> Compound:
 
 
 def write_section_svg(spec, path, parts=None) -> None:
-    """Section of the assembly through the neck axis in the XZ plane (needle plane), to scale in mm."""
+    """Section of the assembly through the neck axis in the XZ plane (needle plane), to scale in mm, with part
+    labels and the design's dimensions (:func:`matcad.render.section.annotate_section`)."""
     parts = parts or assembled_parts(spec)
     svg = ExportSVG(margin=2.0, line_weight=0.05)
     layers = set()
@@ -63,3 +65,4 @@ def write_section_svg(spec, path, parts=None) -> None:
             layers.add(layer)
         svg.add_shape(Rot(-90, 0, 0) * cut, layer=layer)  # XZ plane → drawing plane, z up
     svg.write(str(path))
+    annotate_section(spec, path)

@@ -1,0 +1,144 @@
+"""report.html: the same content as report.md, self-contained, every picture loads in a real headless Chromium;
+the section is labelled and dimensioned to scale; previews are real pictures of the parts."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import xml.etree.ElementTree as ET
+from html.parser import HTMLParser
+
+import numpy as np
+import pytest
+
+from matcad import spec as spec_mod
+from matcad.build import build
+from tests.browser import broken_images, chromium, console_errors
+from tests.conftest import ROOT
+
+SVG = "{http://www.w3.org/2000/svg}"
+SPECS = [ROOT / "templates" / "mat-paper.toml", ROOT / "templates" / "mat-laser-only.toml"]
+
+
+@pytest.fixture(scope="module", params=SPECS, ids=lambda p: p.stem)
+def kit(request, tmp_path_factory):
+    spec = spec_mod.load(request.param)
+    out = tmp_path_factory.mktemp("html") / spec.name
+    build(spec, out)
+    return spec, out, json.loads((out / "report.json").read_text())
+
+
+class _Page(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.images, self.links, self.ids, self.headings, self.urls = [], [], set(), [], []
+        self._heading = None
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "img":
+            self.images.append(a["src"])
+        if tag == "a" and "href" in a:
+            self.links.append(a["href"])
+        if "id" in a:
+            self.ids.add(a["id"])
+        self.urls += [v for k, v in attrs if k in ("src", "href") and v and re.match(r"[a-z]+:", v)]
+        if re.fullmatch(r"h[1-6]", tag):
+            self._heading = ""
+
+    def handle_data(self, data):
+        if self._heading is not None:
+            self._heading += data
+
+    def handle_endtag(self, tag):
+        if re.fullmatch(r"h[1-6]", tag) and self._heading is not None:
+            self.headings.append(self._heading.strip())
+            self._heading = None
+
+
+def test_html_is_the_markdown_rendered(kit):
+    spec, out, report = kit
+    md = (out / "report.md").read_text()
+    page = _Page()
+    page.feed((out / "report.html").read_text())
+    md_images = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md)
+    assert page.images == md_images and len(md_images) == len(report["figures"])
+    assert page.headings == [re.sub(r"\*\*|`", "", h) for h in re.findall(r"^#+ (.*)$", md, flags=re.M)]
+    assert page.urls == [], "the page must not reach the network"
+    for src in page.images:
+        assert (out / src).is_file()
+    for link in page.links:
+        assert link.startswith("#") and link[1:] in page.ids, link
+    # every part built has its picture, and the rules that name a part link to it
+    parts = {f["part"] for f in report["figures"]}
+    laser = {p.stem for p in out.glob("*.dxf")}
+    printed = {p.stem for p in out.glob("*.stl")}
+    assert laser | printed <= parts
+    for f in report["findings"]:
+        head = f["message"].split(":", 1)[0]
+        if head in laser | printed:
+            assert f"[{head}](#part-{head})" in md
+
+
+def test_every_picture_loads_in_chromium_without_console_errors(kit):
+    _, out, report = kit
+    with chromium() as driver:
+        driver.get((out / "report.html").as_uri())
+        assert driver.execute_script("return document.readyState") == "complete"
+        n = driver.execute_script("return document.images.length")
+        assert n == len(report["figures"]) > 0
+        assert broken_images(driver) == []
+        widths = driver.execute_script("return [...document.images].map(i => i.naturalWidth)")
+        assert min(widths) > 100
+        assert console_errors(driver) == []
+
+
+def test_previews_are_pictures_not_blank(kit):
+    import matplotlib.image as mpimg
+
+    _, out, report = kit
+    for fig in report["figures"]:
+        if not fig["file"].endswith(".png"):
+            continue
+        img = mpimg.imread(out / fig["file"])
+        assert img.shape[0] > 150 and img.shape[1] > 300
+        ink = np.mean(np.any(np.abs(img[..., :3] - 1.0) > 0.1, axis=-1))
+        assert 0.01 < ink < 0.9, (fig["file"], ink)  # drawn on, but not a solid block
+
+
+def _dimension_lengths(root) -> dict[str, float]:
+    """Label text → length of the dimension line drawn just before its arrows (mm, drawing units)."""
+    group = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "dimensions")
+    found, last_line = {}, None
+    for el in group:
+        if el.tag == f"{SVG}line" and el.get("class") == "dimension":
+            last_line = el
+        elif el.tag == f"{SVG}text" and last_line is not None:
+            x1, y1, x2, y2 = (float(last_line.get(k)) for k in ("x1", "y1", "x2", "y2"))
+            found[el.text] = math.hypot(x2 - x1, y2 - y1)
+    return found
+
+
+def test_section_is_labelled_and_dimensioned_to_scale(kit):
+    spec, out, _ = kit
+    if not spec.outputs.assembly:
+        assert not (out / "section.svg").exists()
+        return
+    root = ET.parse(out / "section.svg").getroot()
+    texts = [t.text for t in root.iter(f"{SVG}text")]
+    for name in ("neck plate", "end cap", "needle mount", "needle", "guide"):
+        assert any(name in t for t in texts), name
+    want = {f"D = {spec.cavity.diameter:g}": spec.cavity.diameter, f"L = {spec.cavity.length:g}": spec.cavity.length,
+            f"d = {spec.neck.diameter:g}": spec.neck.diameter, f"l = {spec.neck.length:g}": spec.neck.length,
+            f"cap Ø {spec.end_cap.outer_diameter:g}": spec.end_cap.outer_diameter,
+            f"top {spec.end_cap.top_thickness:g}": spec.end_cap.top_thickness,
+            f"gap {spec.spacer.height:g}": spec.spacer.height, f"y = {spec.needle.y:g}": spec.needle.y}
+    drawn = _dimension_lengths(root)
+    for label, length in want.items():
+        assert drawn[label] == pytest.approx(length, abs=1e-3), label
+    assert f"θ = {spec.needle.theta_deg:g}°" in texts
+    # the dimensions sit on the geometry: the neck plate's section spans z = 0..l, i.e. y = -l..0 in the drawing
+    plate = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "neck_plate")
+    ys = [float(v) for p in plate for v in re.findall(r"[-\d.]+,([-\d.]+)", p.get("d"))]
+    assert max(ys) - min(ys) == pytest.approx(spec.neck.length, abs=1e-6)
