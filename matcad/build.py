@@ -53,13 +53,19 @@ def write_laser_part(flat, spec, folder: Path) -> list[dict]:
 
 
 def write_printed_part(name: str, solid, spec, folder: Path) -> dict:
-    """STL + STEP of one solid; returns the STL's read-back checks and the B-rep volume."""
+    """STL + STEP of one solid in its print pose (:data:`PRINT_POSES`); returns the STL's read-back checks,
+    the B-rep volume and the pose (bed face, design → print frame matrix)."""
     from matcad.export.mesh import mesh_checks, write_step, write_stl
+    from matcad.parts.catalogue import PRINT_POSES, in_print_pose
 
+    solid, matrix = in_print_pose(name, solid)
     stl = folder / f"{name}.stl"
     write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance)
     write_step(solid, folder / f"{name}.step")
-    return mesh_checks(stl) | {"brep_volume_mm3": float(solid.volume)}
+    pose = PRINT_POSES[name]
+    return mesh_checks(stl) | {"brep_volume_mm3": float(solid.volume), "printed": pose.printed,
+                               "bed_face": pose.bed_face, "rotation_x_deg": pose.rx_deg,
+                               "design_to_print": matrix}
 
 
 def _write_laser(spec, folder: Path) -> list[dict]:

@@ -152,10 +152,13 @@ def _markdown(r: dict) -> str:
     lines += [f"| {f['file']} | {f['bytes']} | `{f['sha256'][:16]}…` |" for f in r["files"]]
     if r["meshes"]:
         lines += ["", "## Mesh checks (STL read back)", "",
-                  "| file | watertight | is_volume | bodies | STL vs B-rep volume |", "|---|---|---|---:|---:|"]
+                  "| file | watertight | is_volume | bodies | STL vs B-rep volume | print orientation (on the bed) |",
+                  "|---|---|---|---:|---:|---|"]
         for name, m in r["meshes"].items():
             dev = m["volume_mm3"] / m["brep_volume_mm3"] - 1
-            lines.append(f"| {name} | {m['watertight']} | {m['is_volume']} | {m['bodies']} | {dev:+.4%} |")
+            turn = f"turned {m['rotation_x_deg']:g}° about x; " if m["rotation_x_deg"] else "as modelled; "
+            lines.append(f"| {name} | {m['watertight']} | {m['is_volume']} | {m['bodies']} | {dev:+.4%} | "
+                         f"{_cell(turn + m['bed_face'])} |")
     return "\n".join(lines) + "\n"
 
 

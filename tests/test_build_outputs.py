@@ -6,6 +6,7 @@ import re
 import xml.etree.ElementTree as ET
 
 import ezdxf
+import numpy as np
 import pytest
 import trimesh
 
@@ -141,3 +142,47 @@ def test_report_markdown_tables_are_well_formed(built):
     for table in tables:
         widths = {len(re.findall(r"(?<!\\)\|", row)) for row in table}
         assert len(widths) == 1, table[0]
+
+
+def _horizontal_groups(mesh):
+    """Coplanar horizontal faces grouped by (normal sign, z rounded to 1 µm): {(sign, z): area} (mm²)."""
+    groups = {}
+    nz = mesh.face_normals[:, 2]
+    for i in np.flatnonzero(np.abs(nz) > 1 - 1e-9):
+        key = (int(np.sign(nz[i])), round(float(mesh.triangles[i, :, 2].mean()), 3))
+        groups[key] = groups.get(key, 0.0) + float(mesh.area_faces[i])
+    return groups
+
+
+def test_every_printed_stl_lies_on_its_largest_flat_face(built):
+    spec, out, result = built
+    report = json.loads((out / "report.json").read_text())
+    for name, m in report["meshes"].items():
+        mesh = trimesh.load_mesh(out / name)
+        groups = _horizontal_groups(mesh)
+        z_min = round(float(mesh.bounds[0, 2]), 3)
+        assert z_min == 0.0, name  # exported standing on the bed
+        if not m["printed"]:
+            continue
+        bed = groups[(-1, z_min)]
+        assert bed == max(groups.values()), (name, bed, max(groups.values()))
+        extent = mesh.extents[0] * mesh.extents[1]
+        assert bed > 0.75 * extent, (name, bed, extent)
+        assert m["bed_face"] in (out / "report.md").read_text()
+
+
+def test_mold_lid_exported_pins_up_with_its_outer_face_on_the_bed(built):
+    spec, out, _ = built
+    if not spec.outputs.end_cap_mold:
+        return
+    from matcad.parts import end_cap_mold
+    from matcad.parts.features import bolt_clearance_mm
+
+    lay = end_cap_mold.layout(spec)
+    mesh = trimesh.load_mesh(out / "end_cap_mold_lid.stl")
+    # the lid plate (lid_thickness) is at the bottom, the core pins (cavity length) stand above it
+    assert mesh.bounds[1, 2] == pytest.approx(spec.mold.lid_thickness + spec.cavity.length, abs=1e-6)
+    holes = (len(lay.fill_ports) * spec.mold.fill_port ** 2 + len(lay.vents) * spec.mold.vent ** 2
+             + len(lay.bolts) * bolt_clearance_mm(spec.mold.bolt, "normal") ** 2) * np.pi / 4
+    bed = _horizontal_groups(mesh)[(-1, 0.0)]
+    assert bed == pytest.approx(lay.block_x * lay.block_y - holes, rel=2e-3)

@@ -1,9 +1,10 @@
 """3-D parts measured as solids: needle bore angle and y, collisions, mold fit, cap volume."""
 
+import json
 import math
 
 import pytest
-from build123d import GeomType, import_step
+from build123d import GeomType, Pos, import_step
 
 from matcad import spec as spec_mod
 from matcad.acoustics.geometry import drafted_cavity_volume_mm3
@@ -44,7 +45,10 @@ def test_needle_bore_angle_and_y_measured_on_step(tmp_path, spec, theta, y):
     s = dataclasses.replace(s, outputs=dataclasses.replace(s.outputs, end_cap_mold=False, assembly=False,
                                                            neck_plate=False, guides=False, spacers=False))
     build(s, out)
-    solid = import_step(out / "needle_mount.step")
+    solid = import_step(out / "needle_mount.step")  # in its print pose: back to the assembly frame
+    matrix = json.loads((out / "report.json").read_text())["meshes"]["needle_mount.stl"]["design_to_print"]
+    assert matrix[:3] == [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, matrix[2][3]]]  # a pure lift
+    solid = Pos(0, 0, -matrix[2][3]) * solid
     axis = _bore_axis(solid, needle_bore_diameter_mm(s))
     d, p = axis.direction, axis.position
     if d.Z < 0:

@@ -74,6 +74,64 @@ def test_prusa_slicer_slices_every_stl(builds, tmp_path):
         assert gcode.stat().st_size > 1000 and b"G1" in gcode.read_bytes()[:200000]
 
 
+def support_volume_mm3(gcode_text: str) -> float:
+    """Filament volume (mm³) PrusaSlicer extrudes in ';TYPE:Support material*' sections of a G-code file."""
+    diameter = float(re.search(r"^; filament_diameter = ([\d.]+)", gcode_text, re.M).group(1))
+    relative = re.search(r"^M83\b", gcode_text, re.M) is not None
+    e_last, kind, support_mm = 0.0, "", 0.0
+    for line in gcode_text.splitlines():
+        if line.startswith(";TYPE:"):
+            kind = line[6:]
+        elif line.startswith("G92"):
+            e_last = float(m.group(1)) if (m := re.search(r"E(-?[\d.]+)", line)) else e_last
+        elif line.startswith(("G1 ", "G0 ")) and (m := re.search(r"E(-?[\d.]+)", line)):
+            e = float(m.group(1))
+            step = e if relative else e - e_last
+            e_last = e_last + e if relative else e
+            if kind.startswith("Support material") and step > 0:
+                support_mm += step
+    return support_mm * np.pi * diameter ** 2 / 4
+
+
+def test_prusa_slicer_with_supports_on_generates_none(builds, tmp_path):
+    """Each printed STL as exported (its print pose), sliced with automatic supports enabled: no support."""
+    need("prusa-slicer")
+    import json
+
+    volumes = {}
+    for _, folder in builds:
+        report = json.loads((folder / "report.json").read_text())
+        for name, mesh in (report["meshes"] if "meshes" in report else {"coupon_printed.stl": report["mesh"]}).items():
+            if not mesh["printed"]:
+                continue
+            gcode = tmp_path / f"{folder.name}-{name}.gcode"
+            proc = subprocess.run(["prusa-slicer", "--export-gcode", "--support-material", "--support-material-auto",
+                                   "--output", str(gcode), str(folder / name)], capture_output=True, text=True,
+                                  timeout=600)
+            assert proc.returncode == 0, (name, proc.stderr[-500:])
+            text = gcode.read_text()
+            assert "; support_material = 1" in text  # supports really were on
+            volumes[f"{folder.name}/{name}"] = support_volume_mm3(text)
+            assert ";TYPE:Support material" not in text, (folder.name, name, volumes[f"{folder.name}/{name}"])
+    print("support volume per STL (mm^3):", volumes)
+    assert len(volumes) >= 6
+    # the check can fail: the paper's lid turned back into its design (pour) pose, pins down, needs support
+    import trimesh
+
+    folder = next(f for _, f in builds if (f / "end_cap_mold_lid.stl").exists())
+    matrix = json.loads((folder / "report.json").read_text())["meshes"]["end_cap_mold_lid.stl"]["design_to_print"]
+    lid = trimesh.load_mesh(folder / "end_cap_mold_lid.stl")
+    lid.apply_transform(np.linalg.inv(np.array(matrix)))
+    pins_down = tmp_path / "lid_pins_down.stl"
+    lid.export(pins_down)
+    gcode = tmp_path / "pins_down.gcode"
+    subprocess.run(["prusa-slicer", "--export-gcode", "--support-material", "--support-material-auto", "--output",
+                    str(gcode), str(pins_down)], capture_output=True, check=True, timeout=600)
+    pins_down_support = support_volume_mm3(gcode.read_text())
+    print(f"lid pins down (as before): {pins_down_support:.1f} mm^3 of support")
+    assert pins_down_support > 1.0
+
+
 def _ink_extent_mm(ppm_path):
     data = ppm_path.read_bytes()
     magic, size, depth, pixels = data.split(b"\n", 3)

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 from matcad.parts.flat import Flat
 from matcad.parts.guide import ROLES, guide
 from matcad.parts.neck_plate import neck_plate
@@ -20,8 +23,45 @@ def laser_parts(spec) -> list[Flat]:
     return parts
 
 
+@dataclass(frozen=True)
+class PrintPose:
+    """How a 3-D part is exported: rotated ``rx_deg`` about x from its design frame, then lifted so its lowest
+    point is z = 0 (the bed). ``bed_face`` names the face that lies on the bed, ``printed`` is False for the
+    cast silicone cap (a reference shape, not a print)."""
+
+    rx_deg: float
+    bed_face: str
+    printed: bool = True
+
+    def matrix(self, z_min_rotated: float) -> list[list[float]]:
+        """4 x 4 transform from the design frame to the exported (print) frame (mm)."""
+        c, s = math.cos(math.radians(self.rx_deg)), math.sin(math.radians(self.rx_deg))
+        return [[1.0, 0.0, 0.0, 0.0], [0.0, c, -s, 0.0], [0.0, s, c, -z_min_rotated], [0.0, 0.0, 0.0, 1.0]]
+
+
+PRINT_POSES = {
+    "end_cap": PrintPose(0.0, "base (the sealing face), cavity opening down: cast, not printed", printed=False),
+    "end_cap_mold_base": PrintPose(0.0, "flat underside; cap cavities and keys face up"),
+    "end_cap_mold_lid": PrintPose(180.0, "outer (top) face; core pins point up, the parting face prints last"),
+    "needle_mount": PrintPose(0.0, "flat underside; standoffs and the needle bore's mouth face up"),
+    "coupon_printed": PrintPose(0.0, "flat underside"),
+}
+"""Print orientation of every exported 3-D part: flat face down, no overhang that needs support."""
+
+
+def in_print_pose(name: str, solid):
+    """``solid`` (design frame) turned into its print pose: (solid, 4 x 4 matrix design → print frame)."""
+    from build123d import Pos, Rot
+
+    pose = PRINT_POSES[name]
+    turned = Rot(pose.rx_deg, 0, 0) * solid if pose.rx_deg else solid
+    z_min = turned.bounding_box().min.Z
+    return Pos(0, 0, -z_min) * turned, pose.matrix(z_min)
+
+
 def printed_parts(spec) -> dict[str, object]:
-    """Name → build123d solid for every printed part ``[outputs]`` asks for (imports the CAD kernel)."""
+    """Name → build123d solid, in its design frame, for every 3-D part ``[outputs]`` asks for (imports the CAD
+    kernel). The exporter turns each into :data:`PRINT_POSES`."""
     parts = {}
     if spec.outputs.end_cap_mold:
         from matcad.parts.end_cap import end_cap
