@@ -58,12 +58,12 @@ def write_printed_part(name: str, solid, spec, folder: Path) -> dict:
     from matcad.export.mesh import mesh_checks, write_step, write_stl
     from matcad.parts.catalogue import PRINT_POSES, in_print_pose
 
-    solid, matrix = in_print_pose(name, solid)
+    posed, matrix = in_print_pose(name, solid)
     stl = folder / f"{name}.stl"
-    write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance)
-    write_step(solid, folder / f"{name}.step")
+    write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance, matrix)
+    write_step(posed, folder / f"{name}.step")
     pose = PRINT_POSES[name]
-    return mesh_checks(stl) | {"brep_volume_mm3": float(solid.volume), "printed": pose.printed,
+    return mesh_checks(stl) | {"brep_volume_mm3": float(posed.volume), "printed": pose.printed,
                                "bed_face": pose.bed_face, "rotation_x_deg": pose.rx_deg,
                                "design_to_print": matrix}
 

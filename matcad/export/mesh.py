@@ -5,12 +5,20 @@ from __future__ import annotations
 from pathlib import Path
 
 
-def write_stl(shape, path: Path, tolerance_mm: float, angular_tolerance_rad: float) -> None:
-    """Binary STL in mm with an explicit chordal (mm) and angular (rad) tessellation tolerance."""
+def write_stl(shape, path: Path, tolerance_mm: float, angular_tolerance_rad: float, matrix=None) -> None:
+    """Binary STL in mm with an explicit chordal (mm) and angular (rad) tessellation tolerance; ``matrix`` (4 x 4)
+    moves the tessellated mesh (not the B-rep: shared vertices stay bit-identical, so the STL stays closed)."""
     from build123d import export_stl
 
     if not export_stl(shape, str(path), tolerance=tolerance_mm, angular_tolerance=angular_tolerance_rad):
         raise RuntimeError(f"STL export failed for {path.name}")
+    if matrix is not None:
+        import numpy as np
+        import trimesh
+
+        mesh = trimesh.load_mesh(str(path), file_type="stl", process=False)
+        mesh.apply_transform(np.array(matrix))
+        mesh.export(str(path), file_type="stl")
 
 
 def write_step(shape, path: Path) -> None:

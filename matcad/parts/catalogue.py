@@ -35,7 +35,7 @@ class PrintPose:
 
     def matrix(self, z_min_rotated: float) -> list[list[float]]:
         """4 x 4 transform from the design frame to the exported (print) frame (mm)."""
-        c, s = math.cos(math.radians(self.rx_deg)), math.sin(math.radians(self.rx_deg))
+        c, s = (round(f(math.radians(self.rx_deg)), 12) + 0.0 for f in (math.cos, math.sin))  # exact for 180°
         return [[1.0, 0.0, 0.0, 0.0], [0.0, c, -s, 0.0], [0.0, s, c, -z_min_rotated], [0.0, 0.0, 0.0, 1.0]]
 
 
@@ -55,7 +55,7 @@ def in_print_pose(name: str, solid):
 
     pose = PRINT_POSES[name]
     turned = Rot(pose.rx_deg, 0, 0) * solid if pose.rx_deg else solid
-    z_min = turned.bounding_box().min.Z
+    z_min = turned.bounding_box(optimal=True).min.Z
     return Pos(0, 0, -z_min) * turned, pose.matrix(z_min)
 
 
