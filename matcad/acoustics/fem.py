@@ -141,44 +141,83 @@ def _quarter_disc(radii: np.ndarray):
     return _grid_cells(np.stack([x * scale, -y * scale], axis=-1), split_cross=True)
 
 
-def mesh(g: FemGeometry, level: int = DEFAULT_LEVEL):
-    """The taxel's (r, z) mesh at ``level`` elements across the neck radius; returns a skfem MeshTri."""
-    from skfem import MeshTri
+@dataclass(frozen=True)
+class Layout:
+    """The node lines the air mesh is built on (mm); the coupled cap mesh reuses them so both meshes share
+    nodes on the cavity wall."""
 
+    h: float
+    h_max: float
+    r_neck: np.ndarray
+    z_neck: np.ndarray
+    z_cavity: np.ndarray
+    s_annulus: np.ndarray
+
+
+def cavity_wall_radius(g: FemGeometry, z):
+    """Radius of the drafted cavity wall at height z (mm; z from the plate underside, cavity from l to l + L)."""
+    return g.cavity_radius + (z - g.neck_length) / g.cavity_length * (g.cavity_tip_radius - g.cavity_radius)
+
+
+def layout(g: FemGeometry, level: int = DEFAULT_LEVEL, cavity_breaks: tuple[float, ...] = ()) -> Layout:
+    """Node lines at ``level`` elements across the neck radius; ``cavity_breaks`` are heights (mm) that must be
+    node heights in the cavity (e.g. the top of the clamped flange); the nearest node line moves onto each."""
     a, l, L = g.neck_radius, g.neck_length, g.cavity_length
     h = a / level
     # away from the two re-entrant corners (mouth edge, neck-to-cavity step) cells grow to a size set by the
     # geometry's own scale, with P2 that keeps the smooth regions as accurate as the corners
     h_max = max(h, min(l, L, 2 * g.cavity_radius) / 6)
-    r_neck = np.linspace(0.0, a, level + 1)
-    z_neck = _graded_span(0.0, l, h, h_max)
     z_cav = _graded_span(l, l + L, h, h_max, fine_end=False)
-    blocks = [_block(lambda s, z: s, z_neck, r_neck), _block(lambda s, z: s, z_cav, r_neck)]
-    if g.cavity_radius - a > 1e-9 * a or g.cavity_tip_radius - a > 1e-9 * a:
-        def wall(z):
-            return g.cavity_radius + (z - l) / L * (g.cavity_tip_radius - g.cavity_radius)
-        width = g.cavity_radius - a
-        s = _graded_span(0.0, width, min(h, width), max(min(h, width), h_max), fine_end=False) / width
-        blocks.append(_block(lambda s_, z: a + s_ * (wall(z) - a), z_cav, s))
+    for z in cavity_breaks:
+        z_cav[1 + int(np.argmin(np.abs(z_cav[1:-1] - z)))] = z
+    width = g.cavity_radius - a
+    s = (_graded_span(0.0, width, min(h, width), max(min(h, width), h_max), fine_end=False) / width
+         if width > 1e-9 * a or g.cavity_tip_radius - a > 1e-9 * a else np.zeros(0))
+    return Layout(h, h_max, np.linspace(0.0, a, level + 1), _graded_span(0.0, l, h, h_max), z_cav, s)
+
+
+def air_blocks(g: FemGeometry, lay: Layout) -> list:
+    """The air's structured blocks (neck, cavity core, cavity annulus, exterior) as (points, triangles)."""
+    a = g.neck_radius
+    r_neck, z_cav = lay.r_neck, lay.z_cavity
+    blocks = [_block(lambda s, z: s, lay.z_neck, r_neck), _block(lambda s, z: s, z_cav, r_neck)]
+    if len(lay.s_annulus):
+        blocks.append(_block(lambda s_, z: a + s_ * (cavity_wall_radius(g, z) - a), z_cav, lay.s_annulus))
     if g.mouth == "mount":
-        radii = np.concatenate([r_neck, _graded(a, g.gap_radius, h)[1:]])
-        z_gap = _uniform(-g.gap, 0.0, max(h, g.gap / 16))
+        radii = np.concatenate([r_neck, _graded(a, g.gap_radius, lay.h)[1:]])
+        z_gap = _uniform(-g.gap, 0.0, max(lay.h, g.gap / 16))
         blocks.append(_block(lambda s, z: s, z_gap, radii))
     elif g.mouth == "baffled":
-        radii = np.concatenate([r_neck, _graded(a, EXTERIOR_RADIUS_PER_A * a, h)[1:]])
+        radii = np.concatenate([r_neck, _graded(a, EXTERIOR_RADIUS_PER_A * a, lay.h)[1:]])
         blocks.append(_quarter_disc(radii))
     else:
         raise ValueError(f"mouth {g.mouth!r} invalid for the FEM, must be one of 'baffled', 'mount'")
-    points, tris, offset = [], [], 0
+    return blocks
+
+
+def merge_blocks(blocks: list, h: float):
+    """One skfem MeshTri from (points, triangles) blocks, coincident nodes merged; also the first triangle index
+    of each block (so callers can tell subdomains apart)."""
+    from skfem import MeshTri
+
+    points, tris, offset, starts, count = [], [], 0, [], 0
     for p, t in blocks:
         points.append(p)
         tris.append(t + offset)
         offset += len(p)
+        starts.append(count)
+        count += len(t)
     p = np.vstack(points)
     key = np.round(p / (h * 1e-6)).astype(np.int64)
     _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
     t = inverse.ravel()[np.vstack(tris)]
-    return MeshTri(p[first].T.copy(), t.T.copy())
+    return MeshTri(p[first].T.copy(), t.T.copy()), starts
+
+
+def mesh(g: FemGeometry, level: int = DEFAULT_LEVEL):
+    """The taxel's (r, z) mesh at ``level`` elements across the neck radius; returns a skfem MeshTri."""
+    lay = layout(g, level)
+    return merge_blocks(air_blocks(g, lay), lay.h)[0]
 
 
 # ---------------------------------------------------------------- solve
