@@ -16,7 +16,10 @@ class SiliconeGrade:
 
     ``shear_modulus_mpa`` is the static (quasi-static test-rate) small-strain shear modulus range the band
     carries; ``modulus_100_mpa`` the data sheet's nominal stress at 100 % elongation (uniaxial), from which
-    ``neo_hookean_mu_mpa`` = σ₁₀₀ / (λ − λ⁻²) at λ = 2 is derived.
+    ``neo_hookean_mu_mpa`` = σ₁₀₀ / (λ − λ⁻²) at λ = 2 is derived. ``yeoh_c_mpa`` (C10, C20, C30) and
+    ``ogden_mu_alpha`` (μ in MPa, α; one term, W = 2μ/α² (λ₁^α + λ₂^α + λ₃^α − 3)) are the large-strain presets
+    of the cap mechanics, ``None`` when no sourced fit exists (the mechanics then says it falls back to
+    neo-Hookean); ``hyperelastic_source`` says where they come from.
     """
 
     key: str
@@ -32,6 +35,9 @@ class SiliconeGrade:
     tensile_mpa: float
     elongation_pct: float
     source: str
+    yeoh_c_mpa: tuple[float, float, float] | None = None
+    ogden_mu_alpha: tuple[float, float] | None = None
+    hyperelastic_source: str = ""
 
     @property
     def neo_hookean_mu_mpa(self) -> float:
@@ -49,7 +55,12 @@ GRADES: dict[str, SiliconeGrade] = {g.key: g for g in (
         shear_modulus_mpa=(0.2, 0.6), modulus_100_mpa=86 * PSI_MPA, shore="30A", mix_ratio="1A:1B by weight",
         pot_life_min=45.0, cure_h_room=16.0, viscosity_cps=20000.0, tensile_mpa=500 * PSI_MPA,
         elongation_pct=364.0,
-        source="Smooth-On Dragon Skin Series technical bulletin (specific gravity 1.08, 100 % modulus 86 psi)"),
+        source="Smooth-On Dragon Skin Series technical bulletin (specific gravity 1.08, 100 % modulus 86 psi)",
+        yeoh_c_mpa=(0.1536, 0.0016, 0.0), ogden_mu_alpha=(0.3098, 2.072),
+        hyperelastic_source="Yeoh C10 = 0.1536, C20 = 0.0016 MPa: a published uniaxial fit for Dragon Skin 30 "
+                            "(quoted in the project's physics notes, original not re-checked); Ogden: "
+                            "least-squares fit of one term to that Yeoh curve in uniaxial stress, "
+                            "stretch 0.6-2.0 (docs/materials.md)"),
     SiliconeGrade(
         key="ecoflex_00_30", label="Smooth-On Ecoflex 00-30", density_kg_m3=1070.0,
         shear_modulus_mpa=(0.02, 0.06), modulus_100_mpa=10 * PSI_MPA, shore="00-30",

@@ -270,6 +270,23 @@ class Wall(Section):
 
 
 @dataclass(frozen=True)
+class Mechanics(Section):
+    """Cap mechanics for f(F) before casting: the cap pressed by a rigid flat plate (matcad.mechanics)."""
+
+    material: str = _param("hyperelastic law with the grade's sourced constants (docs/materials.md)",
+                           default="ogden", kind="choice", choices=("neo_hookean", "yeoh", "ogden"))
+    contact: str = _param("plate on the cap's top: 'sticking' (no slip) or 'frictionless'", default="sticking",
+                          kind="choice", choices=("sticking", "frictionless"))
+    shear_modulus_mpa: float | None = _param("initial shear modulus the law is scaled to; default the grade's "
+                                             "preset (Dragon Skin 30 Ogden: 0.31 MPa)", "MPa", None, lo=0.0,
+                                             hi=1e3)
+    displacement_mm: float = _param("plate travel of the predicted curve", "mm", 2.0, lo=0.0, hi=LENGTH_MAX_MM)
+    steps: int = _param("load steps over that travel", default=10, kind="integer", lo=1, hi=200)
+    element_size_mm: float | None = _param("mesh element size; default from the cap's thinnest part", "mm", None,
+                                           lo=LENGTH_MIN_MM, hi=LENGTH_MAX_MM)
+
+
+@dataclass(frozen=True)
 class Calibration(Section):
     """Paper Eq. 5 constants: V_eff = v0_mm3 - a F^2 - b F (F in N)."""
 
@@ -322,6 +339,7 @@ class Spec:
     microphone: Microphone = field(default_factory=Microphone)
     silicone: Silicone = field(default_factory=Silicone)
     calibration: Calibration | None = None
+    mechanics: Mechanics = field(default_factory=Mechanics)
 
     def __post_init__(self) -> None:
         name_meta = dict(dataclasses.fields(Spec)[0].metadata)
@@ -339,7 +357,7 @@ SECTIONS: dict[str, type] = {
     "cavity": Cavity, "neck": Neck, "plate": Plate, "guide": Guide, "spacer": Spacer, "end_cap": EndCap,
     "fasteners": Fasteners, "needle": Needle, "mount": Mount, "mold": Mold, "machine": Machine,
     "outputs": Outputs, "air": Air, "wall": Wall, "microphone": Microphone, "silicone": Silicone,
-    "calibration": Calibration}
+    "calibration": Calibration, "mechanics": Mechanics}
 SECTION_NAMES: dict[type, str] = {cls: name for name, cls in SECTIONS.items()}
 REQUIRED_SECTIONS = ("cavity", "neck")
 _NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")

@@ -220,6 +220,51 @@ def mesh(g: FemGeometry, level: int = DEFAULT_LEVEL):
     return merge_blocks(air_blocks(g, lay), lay.h)[0]
 
 
+def _arc_param(curve: np.ndarray) -> np.ndarray:
+    seg = np.hypot(*np.diff(curve, axis=0).T)
+    t = np.concatenate([[0.0], np.cumsum(seg)])
+    return t / t[-1]
+
+
+def deform_cavity(m, g: FemGeometry, wall_rz, end_rz):
+    """The mesh ``m`` of :func:`mesh` with its cavity (z > neck length) mapped onto a deformed cavity outline.
+
+    ``wall_rz`` (k, 2): the wall from its foot on the plate to the closed end's corner; ``end_rz`` (j, 2): the
+    closed end from that corner to the axis; both (r, z) in mm in the cap's frame (plate face z = 0), e.g. from
+    :mod:`matcad.mechanics`. Each cavity node at (s = r / wall radius, t = height / L) goes to the transfinite
+    (Coons) interpolation of the four sides (plate, axis, wall and end, each by normalised arc length).
+    Raises ValueError when the map folds a triangle (an outline too distorted for it).
+    """
+    from skfem import MeshTri
+
+    wall, end = np.asarray(wall_rz, dtype=float), np.asarray(end_rz, dtype=float)[::-1]
+    l, L = g.neck_length, g.cavity_length
+    r, z = m.p
+    inside = z > l + 1e-9 * L
+    t = (z[inside] - l) / L
+    s = r[inside] / (g.cavity_radius + t * (g.cavity_tip_radius - g.cavity_radius))
+
+    def on(curve, u):
+        param = _arc_param(curve)
+        return np.stack([np.interp(u, param, curve[:, 0]), np.interp(u, param, curve[:, 1])], axis=-1)
+
+    foot, corner, top_axis = wall[0], wall[-1], end[0]
+    bottom = np.stack([s * foot[0], np.zeros_like(s)], axis=-1)
+    axis = np.stack([np.zeros_like(t), t * top_axis[1]], axis=-1)
+    ss, tt = s[:, None], t[:, None]
+    mapped = ((1 - tt) * bottom + tt * on(end, s) + (1 - ss) * axis + ss * on(wall, t)
+              - (ss * (1 - tt) * foot + (1 - ss) * tt * top_axis + ss * tt * corner))
+    p = m.p.copy()
+    p[0, inside], p[1, inside] = mapped[:, 0], l + mapped[:, 1]
+    def signed_areas(q):
+        a, b, c = (q[:, m.t[i]] for i in range(3))
+        return (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+
+    if np.any(signed_areas(p) * np.sign(signed_areas(m.p)) <= 0):
+        raise ValueError("the deformed cavity outline folds the acoustic mesh (outline too distorted)")
+    return MeshTri(p, m.t)
+
+
 # ---------------------------------------------------------------- solve
 def _forms():
     from skfem import BilinearForm
@@ -279,12 +324,17 @@ def _eigs_near(a_mat, m_mat, sigma, count):
 
 
 def solve(g: FemGeometry, k_guess_per_mm: float, level: int = DEFAULT_LEVEL, speed_of_sound_m_s: float = 343.0,
-          modes: int = 6) -> FemResult:
-    """The Helmholtz mode nearest ``k_guess_per_mm`` (e.g. the transmission-line estimate)."""
+          modes: int = 6, cavity_outline=None) -> FemResult:
+    """The Helmholtz mode nearest ``k_guess_per_mm`` (e.g. the transmission-line estimate); with
+    ``cavity_outline`` = (wall_rz, end_rz), on that deformed cavity (:func:`deform_cavity`, rigid walls)."""
     from skfem import Basis, ElementTriP2, FacetBasis, asm
 
     t0 = time.perf_counter()
     m = mesh(g, level)
+    if cavity_outline is not None:
+        if g.wall_shear_modulus_pa is not None:
+            raise ValueError("a deformed cavity outline takes rigid walls (wall_shear_modulus_pa = None)")
+        m = deform_cavity(m, g, *cavity_outline)
     element = ElementTriP2()
     basis = Basis(m, element)
     stiffness, mass, weighted_mass = _forms()
