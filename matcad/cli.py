@@ -145,28 +145,62 @@ def _band(args):
     raise ValueError("analyze needs --spec SPEC (its predicted band) or --band LO HI (Hz)")
 
 
+def _recording_blocks(args):
+    """(sample blocks, rate Hz, name) of the recording argument: a WAV file read in blocks, or '-' for standard
+    input (WAV, or raw PCM with --format/--rate)."""
+    from matcad.loop import wav
+
+    if str(args.recording) == "-":
+        stream = sys.stdin.buffer
+        info = wav.stream_info(stream, getattr(args, "rate", None), getattr(args, "format", None),
+                               getattr(args, "channels", 1))
+        return wav.iter_stream(stream, info), info.sample_rate_hz, "standard input"
+    if getattr(args, "format", None):
+        raise ValueError("--format/--rate describe raw PCM on standard input: give the recording as '-'")
+    info = wav.read_info(args.recording)
+    return wav.iter_blocks(args.recording, info), info.sample_rate_hz, str(args.recording)
+
+
+def _loop_output(args, kind: str, source: str) -> Path:
+    from matcad.loop.outputs import output_folder
+
+    return output_folder(args.out, kind, source)
+
+
+def _print_segments(analysis, forces=None) -> None:
+    for i, seg in enumerate(analysis.segments):
+        line = (f"  {seg.start_s:8.2f}-{seg.end_s:8.2f} s  {seg.mean_hz:9.2f} Hz (sd {seg.std_hz:5.2f})")
+        if forces is not None and seg.flag == "":
+            f, lo, hi = forces[i]
+            line += f"  F = {f:.3f} N (95 %: {lo:.3f} .. {hi:.3f})" if f == f else "  outside the calibrated range"
+        print(line + (f"  [{seg.flag}]" if seg.flag else ""))
+
+
 def cmd_analyze(args) -> int:
-    from matcad.loop.analyze import analyze, plot, write_track_csv
-    from matcad.loop.wav import read_mono
+    from matcad.loop.analyze import analyze_stream, plot, write_segments_csv, write_track_csv
     from matcad.output import staged_output
 
     band = _band(args)
-    x, fs = read_mono(args.recording)
-    result = analyze(x, fs, band)
-    target = args.out or Path("out") / f"analyze-{Path(args.recording).stem}"
+    blocks, fs, name = _recording_blocks(args)
+    result = analyze_stream(blocks, fs, [band])[0]
+    target = _loop_output(args, "analyze", name)
     with staged_output(target) as tmp:
         write_track_csv(result, tmp / "track.csv")
+        write_segments_csv(result, tmp / "segments.csv")
         plot(result, tmp / "spectrogram.png")
-        _write_json(tmp / "report.json", {"recording": str(args.recording), **result.to_dict()})
+        _write_json(tmp / "report.json", {"recording": name, **result.to_dict()})
     if args.json:
         _print_json({**result.to_dict(), "out_dir": str(target)})
     else:
-        print(f"{args.recording}: mean {result.mean_hz:.2f} Hz, median {result.median_hz:.2f} Hz, "
-              f"sd {result.std_hz:.2f} Hz over {len(result.track_hz)} frames; SNR {result.snr_db:.1f} dB, "
-              f"prominence {result.prominence_db:.1f} dB (band {result.band_hz[0]:.0f}-{result.band_hz[1]:.0f} Hz)")
+        print(f"{name}: mean {result.mean_hz:.2f} Hz, median {result.median_hz:.2f} Hz, sd {result.std_hz:.2f} Hz "
+              f"over {int(result.voiced.sum())} voiced of {len(result.track_hz)} frames (tone "
+              f"{100 * result.tone_fraction:.0f} %); line {result.snr_db:.1f} dB over the floor, prominence "
+              f"{result.prominence_db:.1f} dB (band {result.band_hz[0]:.0f}-{result.band_hz[1]:.0f} Hz)")
+        print(f"  {len(result.segments)} steady segments:")
+        _print_segments(result)
         for w in result.warnings:
             print(f"  warning: {w}")
-        print(f"  track.csv, spectrogram.png, report.json in {target}/")
+        print(f"  track.csv, segments.csv, spectrogram.png, report.json in {target}/")
     return EXIT_OK
 
 
@@ -176,9 +210,14 @@ def cmd_calibrate(args) -> int:
     from matcad.output import staged_output
 
     spec = spec_mod.load(args.spec)
-    forces, freqs = read_csv(args.data)
-    cal = fit_from_spec(forces, freqs, spec, k_free=args.k_free)
-    target = args.out or Path("out") / f"calibrate-{Path(args.data).stem}"
+    if args.temperature_c is not None and not -60.0 <= args.temperature_c <= 100.0:
+        raise ValueError(f"--temperature-c {args.temperature_c:g} invalid, must be -60 to 100 degC")
+    if args.cycle_std_n is not None and not 0.0 <= args.cycle_std_n <= 100.0:
+        raise ValueError(f"--cycle-std-n {args.cycle_std_n:g} invalid, must be 0-100 N")
+    forces, freqs, cycles = read_csv(args.data)
+    cal = fit_from_spec(forces, freqs, spec, k_free=args.k_free, cycles=cycles, temperature_c=args.temperature_c,
+                        cycle_std_n=args.cycle_std_n)
+    target = _loop_output(args, "calibrate", str(args.data))
     with staged_output(target) as tmp:
         (tmp / "calibration.toml").write_text(cal.to_toml(), encoding="utf-8")
         plot(cal, tmp / "residuals.png")
@@ -193,34 +232,79 @@ def cmd_calibrate(args) -> int:
             value = d["v0_mm3"] if name == "v0" else d[name]
             lo, hi = d[f"{name}_ci95"]
             print(f"  {name:<3}= {value:.6g} +- {d[name + '_se']:.3g}  (95 %: {lo:.6g} .. {hi:.6g})")
-        print(f"  residual RMS {d['residual_rms_hz']:.2f} Hz; calibration.toml, residuals.png in {target}/")
+        print(f"  residual RMS {d['residual_rms_hz']:.2f} Hz; between cycles {cal.cycle_std_n:.3g} N "
+              f"({cal.cycles} cycle(s)); at {cal.temperature_c:g} degC")
+        for note in cal.notes:
+            print(f"  note: {note}")
+        print(f"  calibration.toml, residuals.png in {target}/")
     return EXIT_OK
 
 
 def cmd_sense(args) -> int:
     import numpy as np
 
-    from matcad.loop.analyze import analyze
-    from matcad.loop.sense import SensorCalibration, require_in_range, sense
-    from matcad.loop.wav import read_mono
+    from matcad.loop.analyze import analyze_stream, plot, write_segments_csv
+    from matcad.loop.sense import SensorCalibration, force_with_interval, require_in_range, sense
+    from matcad.output import staged_output
     from matcad.spec import load_calibration
 
     cal = SensorCalibration.from_spec_calibration(load_calibration(args.calibration))
+    cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
     f_lo, f_hi = cal.frequency_range_hz()
-    x, fs = read_mono(args.recording)
-    result = analyze(x, fs, (0.8 * f_lo, 1.25 * f_hi))
-    reading = sense(result.track_hz, cal)
+    blocks, fs, name = _recording_blocks(args)
+    on_frame = None
+    if args.live:
+        def on_frame(_, time_s, freq, _excess):
+            if freq == freq:
+                force, half = force_with_interval(cal, [freq], temperature_c=args.temperature_c)
+                text = (f"F = {force[0]:.3f} +- {half[0]:.3f} N" if np.isfinite(force[0])
+                        else "outside the calibrated range")
+                print(f"{time_s:9.3f} s  {freq:9.2f} Hz  {text}", flush=True)
+            else:
+                print(f"{time_s:9.3f} s  no tone", flush=True)
+    result = analyze_stream(blocks, fs, [(0.8 * f_lo, 1.25 * f_hi)], on_frame)[0]
+    reading = sense(result, cal, args.temperature_c)
+    target = _loop_output(args, "sense", name) if not (args.live and args.out is None) else None
+    if target is not None:
+        with staged_output(target) as tmp:
+            write_segments_csv(result, tmp / "segments.csv", reading.segments_n)
+            rows = ["time_s,frequency_hz,force_n,force_low_n,force_high_n"]
+            for t, f, force, (lo, hi), v in zip(result.times_s, result.track_hz, reading.frames_n,
+                                                reading.frames_interval_n, result.voiced):
+                cells = [f"{t:.6f}", f"{f:.4f}" if v else ""] + ["" if not np.isfinite(c) else f"{c:.4f}"
+                                                                 for c in (force, lo, hi)]
+                rows.append(",".join(cells))
+            (tmp / "forces.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+            plot(result, tmp / "force.png", (reading.frames_n, *reading.frames_interval_n.T))
+            _write_json(tmp / "report.json", {"recording": name, "calibration": str(args.calibration),
+                                              **reading.to_dict(), "analysis": result.to_dict(),
+                                              "segment_forces_n": [[None if not np.isfinite(v) else float(v)
+                                                                    for v in row] for row in reading.segments_n]})
+    warnings = list(result.warnings) + list(reading.warnings)
     if args.json:
-        frames = [{"time_s": float(t), "frequency_hz": float(f), "force_n": None if np.isnan(force) else float(force),
+        frames = [{"time_s": float(t), "frequency_hz": float(f) if v else None,
+                   "force_n": None if np.isnan(force) else float(force),
                    "force_interval_n": None if np.isnan(force) else [float(lo), float(hi)]}
-                  for t, f, force, (lo, hi) in zip(result.times_s, result.track_hz, reading.frames_n,
-                                                   reading.frames_interval_n)]
-        _print_json({**reading.to_dict(), "warnings": list(result.warnings), "frames": frames})
-    elif np.isfinite(reading.force_n):
-        lo, hi = reading.force_interval_n
-        print(f"{args.recording}: F = {reading.force_n:.3f} N (95 %: {lo:.3f} .. {hi:.3f} N) at "
-              f"{reading.frequency_hz:.2f} Hz; {int(np.sum(np.isfinite(reading.frames_n)))}/{len(reading.frames_n)} "
-              "frames inside the calibrated range")
+                  for t, f, v, force, (lo, hi) in zip(result.times_s, result.track_hz, result.voiced,
+                                                      reading.frames_n, reading.frames_interval_n)]
+        segments = [{**seg.to_dict(), "force_n": None if not np.isfinite(f) else float(f),
+                     "force_interval_n": None if not np.isfinite(f) else [float(lo), float(hi)]}
+                    for seg, (f, lo, hi) in zip(result.segments, reading.segments_n)]
+        _print_json({**reading.to_dict(), "tone_fraction": result.tone_fraction, "warnings": warnings,
+                     "segments": segments, "frames": frames,
+                     "out_dir": None if target is None else str(target)})
+    else:
+        if np.isfinite(reading.force_n):
+            lo, hi = reading.force_interval_n
+            print(f"{name}: F = {reading.force_n:.3f} N (95 %: {lo:.3f} .. {hi:.3f} N) at "
+                  f"{reading.frequency_hz:.2f} Hz; {int(np.sum(np.isfinite(reading.frames_n)))} of "
+                  f"{len(reading.frames_n)} frames with a force (tone in {100 * result.tone_fraction:.0f} %)")
+        print(f"  {len(result.segments)} steady segments:")
+        _print_segments(result, reading.segments_n)
+        for w in warnings:
+            print(f"  warning: {w}")
+        if target is not None:
+            print(f"  forces.csv, segments.csv, force.png, report.json in {target}/")
     require_in_range(reading)
     return EXIT_OK
 
@@ -280,21 +364,37 @@ def _parser() -> argparse.ArgumentParser:
             "out/<name>-coupon").add_argument("spec", help="spec TOML file")
 
     a = command("analyze", cmd_analyze, "the taxel's frequency in a recording (spectrogram ridge)",
-                "out/analyze-<recording>")
-    a.add_argument("recording", help="WAV file (mono/stereo; 8-32-bit integer or float; any sample rate)")
+                "out/analyze-<recording>-<hash>")
+    a.add_argument("recording", help="WAV file (mono/stereo; 8-32-bit integer or float; any sample rate), or "
+                                     "'-' for standard input")
     group = a.add_mutually_exclusive_group()
     group.add_argument("--spec", help="spec TOML: analyse its predicted band (-10 %% / +25 %% for load)")
     group.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="analysis band in Hz")
 
     c = command("calibrate", cmd_calibrate, "fit paper Eq. 5 to force/frequency pairs, with uncertainty",
-                "out/calibrate-<data>")
-    c.add_argument("data", help="CSV with force_n and frequency_hz columns")
+                "out/calibrate-<data>-<hash>")
+    c.add_argument("data", help="CSV with force_n and frequency_hz columns (and optionally cycle: several load "
+                                "cycles give the between-cycle variance)")
     c.add_argument("--spec", required=True, help="spec TOML of the taxel (its as-built K or V0)")
     c.add_argument("--k-free", action="store_true", help="fix V0 to the as-built cavity and fit K instead")
+    c.add_argument("--temperature-c", type=float, help="air temperature during calibration (degC; default the "
+                                                       "spec's [air] temperature_c), recorded for `sense`")
+    c.add_argument("--cycle-std-n", type=float, help="between-cycle (hysteresis) sd in N assumed when DATA holds "
+                                                     "one load cycle (default 0.7, from the paper's ~1 N)")
 
-    n = command("sense", cmd_sense, "force from a recording through a calibration, with 95 %% intervals")
-    n.add_argument("recording", help="WAV file")
+    n = command("sense", cmd_sense, "force from a recording through a calibration, with 95 %% intervals",
+                "out/sense-<recording>-<hash>")
+    n.add_argument("recording", help="WAV file, or '-' for standard input (WAV, or raw PCM with --format --rate)")
     n.add_argument("--calibration", required=True, help="calibration.toml from `matcad calibrate`, or a spec")
+    n.add_argument("--temperature-c", type=float, help="air temperature now (degC): frequencies are scaled by "
+                                                       "sqrt(T_cal/T) to the calibration's temperature")
+    n.add_argument("--live", action="store_true", help="print each frame's force as it is decided (~1 s lag); "
+                                                       "no output folder unless --out")
+    for cmd in (a, n):
+        cmd.add_argument("--format", choices=("s16le", "s24le", "s32le", "u8", "f32le", "f64le"),
+                         help="raw PCM sample format on standard input (default: a WAV header is expected)")
+        cmd.add_argument("--rate", type=float, help="raw PCM sample rate (Hz)")
+        cmd.add_argument("--channels", type=int, default=1, help="raw PCM channels (default 1), averaged")
 
     command("schema", cmd_schema, "print every spec field with unit, default and allowed range")
     return parser

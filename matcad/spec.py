@@ -311,6 +311,13 @@ class Calibration(Section):
                                             lo=0.0, hi=1e30, lo_open=False)
     dof: int | None = _param("degrees of freedom of the fit (points - 3)", default=None, kind="integer",
                              lo=1, hi=10**9)
+    cycle_std_mm3: float | None = _param(
+        "between-cycle (hysteresis) standard deviation in K/f^2, estimated from several load cycles or assumed "
+        "from the paper (written by `matcad calibrate`); added to every force interval", "mm^3", None,
+        lo=0.0, hi=1e30, lo_open=False)
+    temperature_c: float | None = _param("air temperature during calibration; `sense --temperature-c` scales "
+                                         "frequencies by sqrt(T/T_cal) (f follows c)", "degC", None,
+                                         lo=-273.15, hi=1000.0)
 
     def __post_init__(self) -> None:
         super().__post_init__()

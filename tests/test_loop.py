@@ -113,7 +113,8 @@ def test_analyze_cli_json_and_files(tmp_path):
     data = json.loads(out)
     assert data["mean_hz"] == pytest.approx(4700.0, abs=0.5) and data["median_hz"] and data["snr_db"] > 8
     rows = (tmp_path / "a" / "track.csv").read_text().splitlines()
-    assert rows[0] == "time_s,frequency_hz,snr_db" and len(rows) - 1 == data["frames"]
+    assert rows[0] == "time_s,frequency_hz,snr_db,voiced" and len(rows) - 1 == data["frames"]
+    assert data["tone_fraction"] == 1.0 and len(data["segments"]) == 1
     assert (tmp_path / "a" / "spectrogram.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     code, _, err = run_cli("analyze", path, "--band", "6000", "7000", "--out", tmp_path / "b")
     assert code == 1 and "no tone" in err and not (tmp_path / "b").exists()
@@ -152,7 +153,7 @@ def test_force_interval_coverage():
 @pytest.mark.parametrize("forces,freqs,message", [
     ([0, 5, 10], [4000, 4100, 4200], "too few points"),
     ([0, 0, 10, 10, 10], [4000, 4001, 4200, 4201, 4199], "degenerate"),
-    (np.linspace(0, 60, 13), f_of(np.minimum(np.linspace(0, 60, 13), 26.0)), "turns"),
+    ([0, 5, 10, 15, 20, 25], [4500, 4400, 4300, 4400, 4500, 4600], "no lower range"),
 ])
 def test_calibration_refuses(forces, freqs, message):
     with pytest.raises(LoopError, match=message):
@@ -179,7 +180,7 @@ def test_calibrate_and_sense_cli(tmp_path):
     true_force = 12.0
     rec = tmp_path / "press.wav"
     wavfile.write(rec, FS, (wobbling_tone(float(f_of(true_force)), wobble=3.0, snr_db=20.0) * 30000).astype(np.int16))
-    code, out, err = run_cli("sense", rec, "--calibration", cal_toml, "--json")
+    code, out, err = run_cli("sense", rec, "--calibration", cal_toml, "--json", "--out", tmp_path / "s1")
     assert code == 0, err
     reading = json.loads(out)
     lo, hi = reading["force_interval_n"]
@@ -188,5 +189,23 @@ def test_calibrate_and_sense_cli(tmp_path):
     # outside the calibrated range: no number, a reason, exit 1
     far = tmp_path / "far.wav"
     wavfile.write(far, FS, (wobbling_tone(float(f_of(0.0)) - 60.0, wobble=0.0, snr_db=20.0) * 30000).astype(np.int16))
-    code, out, err = run_cli("sense", far, "--calibration", cal_toml, "--json")
+    code, out, err = run_cli("sense", far, "--calibration", cal_toml, "--json", "--out", tmp_path / "s2")
     assert code == 1 and json.loads(out)["force_n"] is None and "outside the calibrated" in err
+
+
+def test_paper_seven_load_protocol_to_28_n():
+    """The paper's protocol: 0.05, 0.17 mm, then 0.87-2.87 mm in 0.5 mm steps (F linear in d, 28 N at 2.87 mm);
+    f rises to ~25 N and then falls back. The fit keeps the range where Eq. 5 holds and says where it stops."""
+    forces = 28.0 / 2.87 * np.array([0.05, 0.17, 0.87, 1.37, 1.87, 2.37, 2.87])
+    freqs = f_of(np.where(forces > 25.0, 22.0, forces)) + np.random.default_rng(1).normal(0, 1.0, 7)
+    cal = fit(forces, freqs, K)
+    assert cal.force_range_n == (forces[0], forces[-2]) and cal.excluded_n == (forces[-1],)
+    assert any(f"holds up to {forces[-2]:g} N" in note for note in cal.notes)
+    assert np.allclose([cal.v0_mm3, cal.b, cal.a], TRUE, rtol=0.2, atol=0.01)
+
+
+def test_outlier_named():
+    forces, freqs = _synthetic_calibration(3)
+    freqs[4] += 25.0
+    cal = fit(forces, freqs, K)
+    assert [i for i, _ in cal.outliers] == [4] and any("point 5 " in n for n in cal.notes)

@@ -145,3 +145,87 @@ def read_mono(path: str | Path) -> tuple[np.ndarray, float]:
     """Samples as float64 in [-1, 1] (channels averaged) and the sample rate (Hz). Raises ValueError."""
     info = read_info(path)
     return read_frames(path, info), info.sample_rate_hz
+
+
+BLOCK_FRAMES = 1 << 18
+"""Frames per block when streaming (~6 s at 44.1 kHz: a few MB whatever the recording's length)."""
+RAW_FORMATS = {"s16le": ("int", 16), "s24le": ("int", 24), "s32le": ("int", 32), "u8": ("int", 8),
+               "f32le": ("float", 32), "f64le": ("float", 64)}
+"""Raw PCM sample formats for a live stream (names as in ffmpeg/arecord), little-endian."""
+
+
+def iter_blocks(path: str | Path, info: WavInfo | None = None, block_frames: int = BLOCK_FRAMES):
+    """Mono float64 blocks of ``path`` in order, ``block_frames`` frames each: memory bounded by one block."""
+    info = info or read_info(path)
+    for start in range(0, info.frames, block_frames):
+        yield read_frames(path, info, start, block_frames)
+
+
+def _read_exact(stream, n: int) -> bytes:
+    out = b""
+    while len(out) < n:
+        chunk = stream.read(n - len(out))
+        if not chunk:
+            break
+        out += chunk
+    return out
+
+
+def stream_info(stream, rate_hz: float | None = None, sample_format: str | None = None,
+                channels: int = 1, name: str = "standard input") -> WavInfo:
+    """Header of a live byte stream: parsed from a WAV header when ``sample_format`` is None (a streaming WAV may
+    give 0 or 0xFFFFFFFF as its data size: it is read to its end), else raw PCM at ``rate_hz`` (Hz)."""
+    if sample_format is not None:
+        if sample_format not in RAW_FORMATS:
+            raise ValueError(f"--format {sample_format!r} invalid, must be one of {', '.join(RAW_FORMATS)}")
+        if rate_hz is None or not 1 <= rate_hz <= 1e7:
+            raise ValueError(f"--rate {rate_hz} invalid: raw PCM needs a sample rate of 1-1e7 Hz")
+        if not 1 <= channels <= MAX_CHANNELS:
+            raise ValueError(f"--channels {channels} invalid, must be 1-{MAX_CHANNELS}")
+        kind, bits = RAW_FORMATS[sample_format]
+        return WavInfo(float(rate_hz), channels, kind, bits, 0, -1)
+    head = _read_exact(stream, 12)
+    if len(head) < 12 or head[:4] not in (b"RIFF", b"RIFX") or head[8:12] != b"WAVE":
+        raise _bad(name, "no RIFF/WAVE header (raw PCM needs --format and --rate)")
+    end = ">" if head[:4] == b"RIFX" else "<"
+    fmt = None
+    for _ in range(MAX_CHUNKS):
+        chunk = _read_exact(stream, 8)
+        if len(chunk) < 8:
+            raise _bad(name, "no 'data' chunk" if fmt else "no 'fmt ' chunk")
+        cid, csize = chunk[:4], struct.unpack(end + "I", chunk[4:])[0]
+        if cid == b"fmt ":
+            if csize > MAX_FMT_BYTES:
+                raise _bad(name, f"'fmt ' chunk of {csize} bytes")
+            fmt = _parse_fmt(name, _read_exact(stream, csize + (csize & 1))[:csize], end)
+        elif cid == b"data":
+            if fmt is None:
+                raise _bad(name, "'data' chunk before the 'fmt ' chunk")
+            kind, bits, channels, rate = fmt
+            frames = -1 if csize in (0, 0xFFFFFFFF) else csize // (channels * bits // 8)
+            return WavInfo(rate, channels, kind, bits, 0, frames, end == ">")
+        else:
+            if csize > MAX_FMT_BYTES * 64:
+                raise _bad(name, f"a '{cid.decode('latin-1')}' chunk of {csize} bytes before the data")
+            _read_exact(stream, csize + (csize & 1))
+    raise _bad(name, f"no 'data' chunk among the first {MAX_CHUNKS} chunks")
+
+
+def iter_stream(stream, info: WavInfo, block_frames: int = 4096, name: str = "standard input"):
+    """Mono float64 blocks from a byte stream as they arrive (``block_frames`` frames, ~93 ms at 44.1 kHz, so that
+    live output keeps up), until its end or ``info.frames`` frames."""
+    left = info.frames
+    while left != 0:
+        want = block_frames if left < 0 else min(block_frames, left)
+        raw = _read_exact(stream, want * info.block_align)
+        whole = len(raw) // info.block_align * info.block_align
+        if whole == 0:
+            return
+        x = _decode(raw[:whole], info)
+        x = x[:, 0] if info.channels == 1 else x.mean(axis=1)
+        if not np.all(np.isfinite(x)):
+            raise ValueError(f"recording {name}: contains NaN or infinite samples")
+        left = left - len(x) if left > 0 else left
+        yield x
+        if whole < want * info.block_align:
+            return
