@@ -65,7 +65,7 @@ def test_gaps_voicing_and_mean_over_voiced_frames_only():
         tail[max(0, i - 1):i + 1] = True
     assert not np.any(a.voiced & ~sounding & ~tail)
     assert abs(a.mean_hz - np.nanmean(truth)) < 1.0 and 0.4 < a.tone_fraction < 0.8
-    assert all(any(s.start_s < k + 1.5 < s.end_s for s in a.segments) for k in range(1, 10, 2))  # one per burst
+    assert all(any(s.start_s < k + 0.5 < s.end_s for s in a.segments) for k in range(1, 10, 2))  # one per burst
 
 
 def test_one_second_of_tone_in_ten_is_found():
