@@ -329,6 +329,24 @@ def cmd_schema(args) -> int:
     return EXIT_OK
 
 
+def cmd_serve(args) -> int:
+    from matcad.serve import DEFAULT_PORT, HOST, make_server
+
+    port = DEFAULT_PORT if args.port is None else args.port
+    if not 0 <= port <= 65535:
+        raise ValueError(f"--port {port} invalid, must be 0-65535 (0 picks a free port)")
+    server = make_server(port)
+    print(f"matcad design page on http://{HOST}:{server.server_address[1]}/ (local only; Ctrl-C stops it)",
+          flush=True)
+    try:
+        server.serve_forever()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.server_close()
+    return EXIT_OK
+
+
 def _parser() -> argparse.ArgumentParser:
     import matcad
 
@@ -397,6 +415,10 @@ def _parser() -> argparse.ArgumentParser:
         cmd.add_argument("--channels", type=int, default=1, help="raw PCM channels (default 1), averaged")
 
     command("schema", cmd_schema, "print every spec field with unit, default and allowed range")
+
+    sv = sub.add_parser("serve", help="a local design page: the spec as a form, live prediction, build to a zip")
+    sv.set_defaults(func=cmd_serve)
+    sv.add_argument("--port", type=int, help="port on 127.0.0.1 (default 8765; 0 picks a free one)")
     return parser
 
 

@@ -604,11 +604,12 @@ def _check_calibration(cal: Calibration) -> None:
 
 
 def schema() -> list[dict]:
-    """Every spec field: key, unit, default, allowed values and meaning."""
+    """Every spec field: key, unit, default, allowed values (as text, and as kind, choices, lo, hi) and meaning."""
     rows = []
     name_meta = dataclasses.fields(Spec)[0].metadata
     rows.append({"key": "name", "unit": "", "default": None, "allowed": "A-Z a-z 0-9 . _ - (1-64)",
-                 "required": True, "doc": name_meta["doc"]})
+                 "required": True, "doc": name_meta["doc"], "kind": "name", "choices": [], "lo": None,
+                 "hi": None, "required_in_table": True})
     for section, cls in SECTIONS.items():
         for f in dataclasses.fields(cls):
             meta = f.metadata
@@ -617,7 +618,9 @@ def schema() -> list[dict]:
             required = f.default is dataclasses.MISSING and section in REQUIRED_SECTIONS
             rows.append({"key": f"{section}.{f.name}", "unit": meta["unit"],
                          "default": list(default) if isinstance(default, tuple) else default,
-                         "allowed": allowed, "required": required, "doc": meta["doc"]})
+                         "allowed": allowed, "required": required, "doc": meta["doc"], "kind": meta["kind"],
+                         "choices": list(meta["choices"]), "lo": meta["lo"], "hi": meta["hi"],
+                         "required_in_table": f.default is dataclasses.MISSING})
     return rows
 
 
