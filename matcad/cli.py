@@ -42,13 +42,36 @@ def _format_prediction(spec, p) -> str:
                   "(root-sum-square in ln f of):"]
     lines += [f"    {b.source:<28} {b.tolerance:<52} {b.low_hz:+8.1f} {b.high_hz:+8.1f} Hz" for b in p.budget]
     if p.load_curve:
-        lines += ["", f"  load curve, paper Eq. 5, calibration {p.calibration}:", f"  {'F [N]':>9} {'f [Hz]':>9}"]
-        for pt in p.load_curve:
-            value = f"{pt.f_hz:9.1f}" if pt.f_hz is not None else f"{'n/a':>9}  {pt.reason}"
-            lines.append(f"  {pt.force_n:9.3f} {value}")
+        lines += _format_load_curve(p)
     if p.warnings:
         lines += ["", "  warnings:"] + [f"  - {w}" for w in p.warnings]
     return "\n".join(lines)
+
+
+def _format_load_curve(p) -> list[str]:
+    """The load curve by source (Eq. 5 calibration, cap mechanics) and the mechanics summary."""
+    lines = []
+    for source in dict.fromkeys(pt.source for pt in p.load_curve):
+        lines += ["", f"  load curve from {source}:", f"  {'F [N]':>9} {'f [Hz]':>9} {'x [mm]':>8} {'V [mm^3]':>9}"]
+        for pt in (q for q in p.load_curve if q.source == source):
+            if pt.f_hz is None:
+                lines.append(f"  {pt.force_n:9.3f} {'n/a':>9}  {pt.reason}")
+                continue
+            x, v = (f"{q:8.3f}" if q is not None else f"{'-':>8}" for q in (pt.displacement_mm, pt.cavity_volume_mm3))
+            lines.append(f"  {pt.force_n:9.3f} {pt.f_hz:9.1f} {x} {v:>9}")
+    m = p.load_model
+    if m:
+        turn = f"stops rising at {m['turn_force_n']:.3g} N" if m["turn_force_n"] is not None else \
+            f"still rising at the curve's end, {m['max_force_n']:.3g} N"
+        lines += [f"  cap mechanics: df/dF = {m['sensitivity_hz_per_n_at_0']:.1f} Hz/N at 0 N; f {turn}; "
+                  f"f shift by {m['route']}; {m['nodes']} nodes, {m['seconds']:.1f} s"]
+        for key in ("eq5", "eq5_paper_convention"):
+            if m[key]:
+                e = m[key]
+                lines.append(f"  Eq. 5 fit to it ({e['area_convention']}): V0 = {e['v0_mm3']:.4g} mm^3, "
+                             f"a = {e['a']:.4g} mm^3/N^2, b = {e['b']:.4g} mm^3/N")
+        lines += [f"  {m[k]}" for k in ("fit_note", "fem_note") if m[k]]
+    return lines
 
 
 def cmd_predict(args) -> int:
@@ -367,7 +390,8 @@ def _parser() -> argparse.ArgumentParser:
     p = command("predict", cmd_predict, "predict the taxel's resonance frequency from a spec")
     p.add_argument("spec", help="spec TOML file")
     p.add_argument("--force", type=float, nargs="+", metavar="F",
-                   help="normal loads in N: add paper Eq. 5 f(F) using the spec's [calibration]")
+                   help="normal loads in N: f(F) from the cap mechanics ([mechanics]; FElupe) and, with a "
+                        "[calibration], from paper Eq. 5 as well")
     p.add_argument("--model", help="use this model's f0 instead of the automatic choice ('fem' adds the FEM)")
     p.add_argument("--fem-level", type=int, help="FEM mesh refinement: elements across the neck radius (default 8)")
 

@@ -40,11 +40,15 @@ class ModelResult:
 
 @dataclass(frozen=True)
 class LoadPoint:
-    """Eq. 5 at one force: f_hz is None and reason says why when the model has no meaning there."""
+    """f at one force (N, Hz) from ``source`` (Eq. 5 with a calibration, or the cap mechanics, which also gives the
+    plate travel (mm) and the cavity volume (mm³)): f_hz is None and reason says why when it has no answer there."""
 
     force_n: float
     f_hz: float | None
     reason: str = ""
+    displacement_mm: float | None = None
+    cavity_volume_mm3: float | None = None
+    source: str = ""
 
 
 @dataclass(frozen=True)
@@ -65,6 +69,7 @@ class Prediction:
     warnings: tuple[str, ...]
     calibration: str | None = None
     load_curve: tuple[LoadPoint, ...] = ()
+    load_model: dict | None = None
 
     def to_dict(self) -> dict:
         d = asdict(self)
@@ -124,7 +129,8 @@ def _fem(spec, c_m_s: float, f_guess_hz: float, level: int, wall_checks: dict) -
 
 
 def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None = None) -> Prediction:
-    """Predict the unloaded resonance of ``spec`` with every model; Eq. 5 at ``forces_n`` (N) if calibrated.
+    """Predict the unloaded resonance of ``spec`` with every model; f at ``forces_n`` (N) from the cap mechanics
+    (:mod:`matcad.mechanics`, imported only then) and, if calibrated, from Eq. 5 too.
 
     ``model`` overrides the automatic choice: one of the returned ``models`` keys, or ``fem`` (elements
     across the neck radius ``fem_level``, default :data:`matcad.acoustics.fem.DEFAULT_LEVEL`).
@@ -182,19 +188,28 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
                         "lossless models leave out (the band includes it)")
     cal = spec_calibration(spec)
     curve: tuple[LoadPoint, ...] = ()
+    load_model = None
     if len(forces_n):
-        if cal is None:
-            raise ValueError("--force needs a [calibration] table in the spec (paper Eq. 5 constants)")
-        f_at = frequency_at_force_hz(cal, np.asarray(forces_n, dtype=float), c, neck.diameter, neck.length)
-        curve = tuple(LoadPoint(float(force), None if np.isnan(f) else float(f), invalid_reason(cal, force))
-                      for force, f in zip(forces_n, f_at))
-        if cal.area_convention == MAT_PAPER_2024.area_convention:
-            warnings.append("load curve uses the paper's A = d^2/4 convention with its fitted V0 (see DIGEST); "
-                            "its volumes are not physical cavity volumes")
+        from matcad.mechanics.frequency import load_points
+
+        if cal is not None:
+            f_at = frequency_at_force_hz(cal, np.asarray(forces_n, dtype=float), c, neck.diameter, neck.length)
+            curve = tuple(LoadPoint(float(force), None if np.isnan(f) else float(f), invalid_reason(cal, force),
+                                    source=f"calibration {cal.name} (Eq. 5)") for force, f in zip(forces_n, f_at))
+            if cal.area_convention == MAT_PAPER_2024.area_convention:
+                warnings.append("load curve uses the paper's A = d^2/4 convention with its fitted V0 (see DIGEST); "
+                                "its volumes are not physical cavity volumes")
+        # the FEM route on the deformed outlines when the FEM is the chosen model (DEFAULT_LEVEL imported above)
+        rows, load_model = load_points(spec, forces_n, results[chosen].f0_hz,
+                                       (fem_level or DEFAULT_LEVEL) if chosen == "fem" else None)
+        curve += tuple(LoadPoint(**row) for row in rows)
+        if load_model["message"]:
+            warnings.append(f"cap mechanics: {load_model['message']}")
     f0 = results[chosen].f0_hz
     return Prediction(
         cavity_volume_mm3=res.volume, neck_area_mm2=res.neck_area, cavity_area_mm2=res.cavity_area,
         neck_air_ratio=air_ratio, diameter_ratio=xi, speed_of_sound_m_s=c,
         outer_end_correction_mm=res.outer_correction, inner_end_correction_mm=res.inner_step, models=results,
         model=chosen, f0_hz=f0, band_hz=(f0 + low, f0 + high), budget=tuple(lines), warnings=tuple(warnings),
-        calibration=None if cal is None else f"{cal.name} ({cal.area_convention})", load_curve=curve)
+        calibration=None if cal is None else f"{cal.name} ({cal.area_convention})", load_curve=curve,
+        load_model=load_model)

@@ -136,3 +136,33 @@ def at_forces(fc: ForceCurve, forces_n) -> list[tuple[float, float | None, float
             out.append((float(F), *(float(np.interp(F, force, cols[c])) for c in
                                     ("f_hz", "displacement_mm", "cavity_volume_mm3")), ""))
     return out
+
+
+def load_points(spec, forces_n, f0_hz: float, fem_level: int | None = None) -> tuple[list[dict], dict]:
+    """The cap model's answer to ``matcad predict --force``: one row per force (force_n, f_hz, displacement_mm,
+    cavity_volume_mm3, reason, source) and a summary (material, contact, run, df/dF, turn force, Eq. 5 fit, the
+    whole computed curve). ``f0_hz`` is the unloaded ladder's chosen f0 (Hz); see :func:`force_curve`."""
+    from matcad.mechanics.solver import cap_curve
+
+    curve = cap_curve(spec)
+    fc = force_curve(spec, curve, f0_hz, fem_level)
+    source = f"cap mechanics ({curve.material.model}, {curve.contact}, G = {curve.material.shear_modulus_mpa:.3g} MPa)"
+    rows = [{"force_n": F, "f_hz": f, "displacement_mm": x, "cavity_volume_mm3": v, "reason": why, "source": source}
+            for F, f, x, v, why in at_forces(fc, forces_n)]
+
+    def constants(cal):
+        return None if cal is None else {"v0_mm3": cal.v0_mm3, "a": cal.a, "b": cal.b,
+                                         "area_convention": cal.area_convention}
+
+    summary = {
+        "source": source, "material": curve.material.note, "contact": curve.contact,
+        "shear_modulus_mpa": curve.material.shear_modulus_mpa, "complete": curve.complete,
+        "message": curve.message, "route": fc.route, "fem_note": fc.fem_note, "seconds": curve.seconds,
+        "nodes": curve.nodes, "cells": curve.cells, "element_size_mm": curve.element_size_mm,
+        "sensitivity_hz_per_n_at_0": fc.sensitivity_hz_per_n[0], "max_force_n": fc.states[-1].force_n,
+        "turn_force_n": fc.turn_force_n, "eq5": constants(fc.eq5), "eq5_paper_convention":
+            constants(fc.eq5_paper_convention), "fit_note": fc.fit_note,
+        "curve": [dataclasses.asdict(s) | {"sensitivity_hz_per_n": d, "peak_strain": p}
+                  for s, d, p in zip(fc.states, fc.sensitivity_hz_per_n, curve.column("peak_strain"))],
+    }
+    return rows, summary

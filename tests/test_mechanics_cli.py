@@ -1,0 +1,50 @@
+"""`matcad predict --force` through the cap mechanics, as a user runs it."""
+
+import json
+
+import pytest
+
+from tests.conftest import MINIMAL, run_cli
+
+FAST = MINIMAL + """[end_cap]
+outer_diameter = 8.0
+top_thickness = 2.0
+[mechanics]
+material = "neo_hookean"
+shear_modulus_mpa = 0.3
+displacement_mm = 1.0
+steps = 4
+"""
+
+
+def test_predict_force_without_calibration_uses_the_cap_mechanics(write_spec):
+    code, out, err = run_cli("predict", write_spec(FAST), "--json", "--force", "0", "4", "8", "100")
+    assert code == 0, err
+    data = json.loads(out)
+    curve = data["load_curve"]
+    assert [p["force_n"] for p in curve] == [0.0, 4.0, 8.0, 100.0]
+    assert all(set(p) >= {"force_n", "f_hz", "displacement_mm", "cavity_volume_mm3", "source"} for p in curve)
+    assert all(p["source"].startswith("cap mechanics (neo_hookean, sticking, G = 0.3 MPa)") for p in curve)
+    assert curve[0]["f_hz"] == pytest.approx(data["f0_hz"]) and curve[0]["displacement_mm"] == 0.0
+    assert curve[0]["cavity_volume_mm3"] == pytest.approx(data["cavity_volume_mm3"], rel=1e-12)
+    assert curve[0]["f_hz"] < curve[1]["f_hz"] < curve[2]["f_hz"]
+    assert 0 < curve[1]["displacement_mm"] < curve[2]["displacement_mm"] <= 1.0
+    assert curve[1]["cavity_volume_mm3"] > curve[2]["cavity_volume_mm3"]
+    assert curve[3]["f_hz"] is None and "beyond the computed curve" in curve[3]["reason"]
+    model = data["load_model"]
+    assert model["complete"] and model["sensitivity_hz_per_n_at_0"] > 0
+    assert model["eq5"]["area_convention"] == "pi_d2/4" and model["eq5"]["b"] > 0
+    assert len(model["curve"]) == 5
+
+
+def test_predict_force_table_names_each_source(write_spec):
+    code, out, err = run_cli("predict", write_spec(FAST), "--force", "2")
+    assert code == 0, err
+    assert "load curve from cap mechanics" in out and "df/dF" in out and "Eq. 5 fit to it (d2/4)" in out
+
+
+def test_bad_mechanics_travel_is_exit_2_naming_the_field(write_spec):
+    code, out, err = run_cli("predict", write_spec(FAST.replace("displacement_mm = 1.0", "displacement_mm = 9.0")),
+                             "--force", "1")
+    assert code == 2 and out == "" and "Traceback" not in err
+    assert "mechanics.displacement_mm" in err
