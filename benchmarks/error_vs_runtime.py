@@ -8,6 +8,7 @@ uncertainty budget uses). Run: .venv/bin/python benchmarks/error_vs_runtime.py
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import sys
@@ -19,11 +20,16 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from matcad import spec as spec_mod  # noqa: E402
-from matcad.acoustics import fem  # noqa: E402
+from matcad.acoustics import fem, fsi  # noqa: E402
 from matcad.acoustics.predict import predict  # noqa: E402
-from matcad.acoustics.resonator import CHEAP_MODELS, evaluate, resonator, shear_moduli_pa  # noqa: E402
+from matcad.acoustics.resonator import CHEAP_MODELS, evaluate, resonator, wall_arguments  # noqa: E402
 
 LEVELS = (2, 4, 8, 16)
+WALL_SWEEP_G_MPA = (0.1, 0.2, 0.35, 0.6, 1.0, 2.0, 4.0, 10.0)
+WALL_SWEEP_ETA = (0.1, 0.2)
+CLOSING_G_MPA = (0.2, 0.35, 0.6)
+"""The paper template's cap over G (kHz storage modulus) and η, both mouths: the elastic-wall model against the
+coupled FEM (level 8), the quasi-static model beside them, all relative to the rigid FEM."""
 CASES = {
     # name: (cavity D, L, neck d, l, mouth, wall)
     "paper taxel (mount)": (3.18, 4.76, 2.10, 6.35, "mount", "rigid"),
@@ -72,22 +78,138 @@ def reference(levels_f):
 def run_case(name, dims):
     spec = case_spec(dims)
     p = predict(spec)
-    shear = shear_moduli_pa(spec)[1] if spec.wall.model == "silicone" else None
-    geom = fem.geometry_from_spec(spec, shear)
-    k0 = 2 * math.pi * p.f0_hz / (p.speed_of_sound_m_s * 1e3)
-    runs = [fem.solve(geom, k0, level, p.speed_of_sound_m_s) for level in LEVELS]
+    geom = fem.geometry_from_spec(spec)
+    c = p.speed_of_sound_m_s
+    if spec.wall.model == "silicone":  # the coupled elastic cap + air FEM at the spec's middle kHz modulus and loss
+        cap = fsi.cap_from_spec(spec, *wall_arguments(spec, "elastic_wall"))
+        runs = [fsi.solve(geom, cap, p.f0_hz, level, c) for level in LEVELS]
+    else:
+        k0 = 2 * math.pi * p.f0_hz / (c * 1e3)
+        runs = [fem.solve(geom, k0, level, c) for level in LEVELS]
     f_ref = reference([r.f0_hz for r in runs])
     rows = []
-    # rigid-wall models are scored against the rigid FEM only; a silicone case scores the soft-wall model
-    models = ["soft_wall"] if spec.wall.model == "silicone" else [m for m in CHEAP_MODELS if m in p.models]
+    # rigid-wall models are scored against the rigid FEM only; a silicone case scores the two wall models
+    models = ["soft_wall", "elastic_wall"] if spec.wall.model == "silicone" else [
+        m for m in CHEAP_MODELS if m in p.models and m not in ("soft_wall", "elastic_wall")]
     for model in models:
-        f, seconds = _timed(lambda: float(evaluate(resonator(spec), model, shear)), 200)
+        f, seconds = _timed(lambda: float(evaluate(resonator(spec), model, *wall_arguments(spec, model))), 20)
         rows.append({"case": name, "model": model, "f_hz": f, "error": f / f_ref - 1, "seconds": seconds,
                      "valid": p.models[model].valid})
     for r in runs:
         rows.append({"case": name, "model": f"fem level {r.level}", "f_hz": r.f0_hz, "error": r.f0_hz / f_ref - 1,
                      "seconds": r.seconds, "valid": True, "dofs": r.dofs})
     return f_ref, rows
+
+
+def wall_sweep():
+    """The paper template's cap over G and η, both mouths: coupled FEM (level 8), elastic_wall, soft_wall."""
+    rows = []
+    for mouth in ("mount", "baffled"):
+        spec = spec_mod.load(ROOT / "templates" / "mat-paper.toml")
+        spec = dataclasses.replace(spec, neck=dataclasses.replace(spec.neck, mouth=mouth))
+        res = resonator(spec)
+        geom = fem.geometry_from_spec(spec)
+        c = res.c_m_s
+        rigid = fsi.solve(geom, None, float(evaluate(res, "transmission_line")), fem.DEFAULT_LEVEL, c)
+        for g_mpa in WALL_SWEEP_G_MPA:
+            for eta in WALL_SWEEP_ETA:
+                fast, seconds = _timed(lambda: float(evaluate(res, "elastic_wall", g_mpa * 1e6, eta)), 5)
+                run = fsi.solve(geom, fsi.cap_from_spec(spec, g_mpa * 1e6, eta), fast, fem.DEFAULT_LEVEL, c)
+                rows.append({"mouth": mouth, "g_mpa": g_mpa, "eta": eta, "fem_hz": run.f0_hz, "q": run.q,
+                             "fem_seconds": run.seconds, "wall_modes_hz": run.wall_modes_hz, "rigid_hz": rigid.f0_hz,
+                             "elastic_hz": fast, "elastic_seconds": seconds,
+                             "soft_hz": float(evaluate(res, "soft_wall", g_mpa * 1e6))})
+                print(f"  {mouth} G {g_mpa} eta {eta}: FEM {run.f0_hz:.0f} Hz ({run.seconds:.1f} s), elastic_wall "
+                      f"{fast:.0f} Hz ({fast / run.f0_hz - 1:+.2%})", flush=True)
+    return rows
+
+
+RATIO_VARIANTS = {
+    # name: changes to the paper template (relative to it as the measured reference)
+    "cavity L x0.75": {"cavity": {"length": 3.57}}, "cavity L x1.25": {"cavity": {"length": 5.95}},
+    "cavity D x0.85": {"cavity": {"diameter": 2.70}}, "cavity D x1.15": {"cavity": {"diameter": 3.66}},
+    "neck d x0.8": {"neck": {"diameter": 1.68}}, "neck d x1.2": {"neck": {"diameter": 2.52}},
+    "sheet 3 mm": {"neck": {"length": 3.0}}, "sheet 10 mm": {"neck": {"length": 10.0}},
+    "cap 10 mm, 3 mm top": {"end_cap": {"outer_diameter": 10.0, "top_thickness": 3.0}},
+    "cap 6 mm, 1 mm top": {"end_cap": {"outer_diameter": 6.0, "top_thickness": 1.0}},
+}
+
+
+def _variant(spec, changes):
+    return dataclasses.replace(spec, **{sec: dataclasses.replace(getattr(spec, sec), **vals)
+                                        for sec, vals in changes.items()})
+
+
+def ratio_sweep():
+    """Designs near the paper template predicted relative to it (as a measured reference) against absolutely:
+    each model's ratio error (new/reference vs the FEM's ratio) beside its absolute error, rigid and silicone."""
+    rows = []
+    for wall in ("rigid", "silicone"):
+        base = spec_mod.load(ROOT / "templates" / "mat-paper.toml")
+        base = dataclasses.replace(base, wall=dataclasses.replace(base.wall, model=wall))
+        models = ["transmission_line"] if wall == "rigid" else ["elastic_wall", "soft_wall"]
+
+        def fem_f(spec):
+            res = resonator(spec)
+            guess = float(evaluate(res, "transmission_line"))
+            if wall == "silicone":
+                cap = fsi.cap_from_spec(spec, *wall_arguments(spec, "elastic_wall"))
+                return fsi.solve(fem.geometry_from_spec(spec), cap, guess, fem.DEFAULT_LEVEL, res.c_m_s,
+                                 wall_modes=0).f0_hz
+            return fem.solve(fem.geometry_from_spec(spec), 2 * math.pi * guess / (res.c_m_s * 1e3),
+                             fem.DEFAULT_LEVEL, res.c_m_s).f0_hz
+
+        def model_f(spec, model):
+            return float(evaluate(resonator(spec), model, *wall_arguments(spec, model)))
+
+        f_ref = fem_f(base)
+        for name, changes in RATIO_VARIANTS.items():
+            if wall == "rigid" and name.startswith("cap"):
+                continue
+            spec = _variant(base, changes)
+            f_fem = fem_f(spec)
+            for model in models:
+                f_new, f_base = model_f(spec, model), model_f(base, model)
+                rows.append({"wall": wall, "variant": name, "model": model, "fem_hz": f_fem,
+                             "absolute": f_new / f_fem - 1, "ratio": (f_new / f_base) / (f_fem / f_ref) - 1})
+            print(f"  ratio {wall} {name}: FEM {f_fem:.0f} Hz", flush=True)
+    return rows
+
+
+def ratio_table(rows) -> list[str]:
+    lines = ["", "Prediction relative to a measured reference (`[reference]`): designs near the paper template, each "
+             "model's error in the ratio new/reference against the FEM's ratio (level "
+             f"{fem.DEFAULT_LEVEL}; silicone: the coupled FEM), beside its absolute error:", "",
+             "| wall | design (reference: paper template) | FEM [Hz] | model | absolute error | ratio error |",
+             "|---|---|---:|---|---:|---:|"]
+    lines += [f"| {r['wall']} | {r['variant']} | {r['fem_hz']:.0f} | {r['model']} | {100 * r['absolute']:+.2f} % | "
+              f"{100 * r['ratio']:+.2f} % |" for r in rows]
+    for model in dict.fromkeys(r["model"] for r in rows):
+        picked = [r for r in rows if r["model"] == model]
+        lines.append(f"\n{model}: max |absolute error| {100 * max(abs(r['absolute']) for r in picked):.2f} %, max "
+                     f"|ratio error| {100 * max(abs(r['ratio']) for r in picked):.2f} % over {len(picked)} designs.")
+    return lines
+
+
+def wall_table(rows) -> list[str]:
+    lines = ["", "The paper template's Dragon Skin cap (Ø8 mm, 2 mm top, flange clamped), coupled FEM (level "
+             f"{fem.DEFAULT_LEVEL}, peak of the driven response) against the fast `elastic_wall` and the quasi-static "
+             "`soft_wall`, over the kHz shear modulus G and loss factor η, both mouths (shifts relative to the "
+             "rigid-wall FEM peak):", "",
+             "| mouth | G [MPa] | η | coupled FEM [Hz] | vs rigid | Q | first wall modes [Hz] | FEM time | elastic_wall "
+             "[Hz] | error | soft_wall [Hz] | error |",
+             "|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        modes = ", ".join(f"{f:.0f}" for f in r["wall_modes_hz"])
+        lines.append(f"| {r['mouth']} | {r['g_mpa']:g} | {r['eta']:g} | {r['fem_hz']:.0f} | "
+                     f"{100 * (r['fem_hz'] / r['rigid_hz'] - 1):+.1f} % | {r['q']:.1f} | {modes} | "
+                     f"{r['fem_seconds']:.1f} s | {r['elastic_hz']:.0f} | {100 * (r['elastic_hz'] / r['fem_hz'] - 1):+.2f} % | "
+                     f"{r['soft_hz']:.0f} | {100 * (r['soft_hz'] / r['fem_hz'] - 1):+.1f} % |")
+    worst = max(rows, key=lambda r: abs(r["elastic_hz"] / r["fem_hz"] - 1))
+    lines += ["", f"Worst elastic_wall error: {100 * (worst['elastic_hz'] / worst['fem_hz'] - 1):+.2f} % "
+                  f"({worst['mouth']}, G = {worst['g_mpa']:g} MPa, η = {worst['eta']:g}); it includes the "
+                  "transmission line's own rigid-wall error for that mouth."]
+    return lines
 
 
 def stl_rows():
@@ -109,16 +231,18 @@ def stl_rows():
     return rows
 
 
-def write_outputs(results, stls):
+def write_outputs(results, stls, sweep, ratios):
     docs = ROOT / "docs"
     docs.mkdir(exist_ok=True)
     lines = ["| geometry | f_ref (FEM, extrapolated) [Hz] | " + " | ".join(
-        ["lumped", "end_corrected", "transmission_line", "soft_wall"] + [f"FEM L{lv}" for lv in LEVELS]) + " |",
-        "|---|---:|" + "---:|" * (4 + len(LEVELS))]
+        ["lumped", "end_corrected", "transmission_line", "soft_wall", "elastic_wall"]
+        + [f"FEM L{lv}" for lv in LEVELS]) + " |",
+        "|---|---:|" + "---:|" * (5 + len(LEVELS))]
     for name, (f_ref, rows) in results.items():
         by = {r["model"]: r for r in rows}
         cells = []
-        for key in ["lumped", "end_corrected", "transmission_line", "soft_wall"] + [f"fem level {lv}" for lv in LEVELS]:
+        for key in (["lumped", "end_corrected", "transmission_line", "soft_wall", "elastic_wall"]
+                    + [f"fem level {lv}" for lv in LEVELS]):
             r = by.get(key)
             cells.append("–" if r is None else f"{100 * r['error']:+.2f} %{'' if r['valid'] else '†'}")
         lines.append(f"| {name} | {f_ref:.1f} | " + " | ".join(cells) + " |")
@@ -126,10 +250,12 @@ def write_outputs(results, stls):
     for _, rows in results.values():
         for r in rows:
             timing.setdefault(r["model"], []).append(r["seconds"])
-    lines += ["", "† the model's own validity checks fail for that geometry (matcad warns).", "",
+    lines += ["", "† the model's own validity checks fail for that geometry (matcad warns). Silicone rows: the "
+              "reference is the coupled elastic cap + air FEM at the spec's middle kHz modulus and loss.", "",
               "Median run time per evaluation: " + ", ".join(
                   f"{m} {sorted(ts)[len(ts) // 2] * 1e6:.0f} µs" if sorted(ts)[len(ts) // 2] < 0.01 else
                   f"{m} {sorted(ts)[len(ts) // 2]:.2f} s" for m, ts in timing.items()) + ".", "",
+              *wall_table(sweep), *ratio_table(ratios), "",
               "STL tessellation of the paper's end cap (volume against the closed form):", "",
               "| chordal tol [mm] | angular tol [rad] | triangles | volume error | export time | size |",
               "|---:|---:|---:|---:|---:|---:|"]
@@ -143,12 +269,18 @@ def write_outputs(results, stls):
     readme.write_text(text[:start + len(README_MARKERS[0])] + "\n" + table + text[end:], encoding="utf-8")
 
     errors = {}
+    sweep_rows = [{"model": "elastic_wall", "error": r["elastic_hz"] / r["fem_hz"] - 1, "valid": True} for r in sweep]
     for model in list(CHEAP_MODELS) + ["fem"]:
         key = f"fem level {fem.DEFAULT_LEVEL}" if model == "fem" else model
         picked = [r for _, rows in results.values() for r in rows if r["model"] == key]
+        picked += [r for r in sweep_rows if r["model"] == key]
         valid = [r for r in picked if r["valid"]] or picked
         errors[model] = {"max_abs": max(abs(r["error"]) for r in valid), "cases": len(valid),
                          "of": len(picked), "measured_by": "benchmarks/error_vs_runtime.py"}
+        in_ratio = [r for r in ratios if r["model"] == model]
+        if in_ratio:
+            errors[model]["ratio_max_abs"] = max(abs(r["ratio"]) for r in in_ratio)
+            errors[model]["ratio_cases"] = len(in_ratio)
     (ROOT / "matcad" / "acoustics" / "model_errors.json").write_text(json.dumps(errors, indent=1) + "\n")
 
     import matplotlib
@@ -156,7 +288,8 @@ def write_outputs(results, stls):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 5))
-    for model, marker in (("lumped", "v"), ("end_corrected", "s"), ("transmission_line", "o"), ("soft_wall", "D")):
+    for model, marker in (("lumped", "v"), ("end_corrected", "s"), ("transmission_line", "o"), ("soft_wall", "D"),
+                          ("elastic_wall", "^")):
         pts = [(r["seconds"], abs(r["error"])) for _, rows in results.values() for r in rows if r["model"] == model]
         if pts:
             ax.scatter(*zip(*pts), marker=marker, label=model)
@@ -178,8 +311,10 @@ def main():
         t0 = time.perf_counter()
         results[name] = run_case(name, dims)
         print(f"{name}: f_ref {results[name][0]:.1f} Hz ({time.perf_counter() - t0:.1f} s)", flush=True)
+    sweep = wall_sweep()
+    ratios = ratio_sweep()
     stls = stl_rows()
-    write_outputs(results, stls)
+    write_outputs(results, stls, sweep, ratios)
     print((ROOT / "docs" / "error_vs_runtime.md").read_text())
     print(json.dumps(json.loads((ROOT / "matcad" / "acoustics" / "model_errors.json").read_text()), indent=1))
 

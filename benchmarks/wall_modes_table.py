@@ -28,8 +28,8 @@ def main():
     freqs, comps, static = [], [], []
     for outer, top, length, clamp in itertools.product(*axes):
         modes = fsi.unit_cap_modes(outer, top, length, clamp)
-        freqs.append([float(f"{f:.6g}") for f in modes.frequencies_hz])
-        comps.append([float(f"{c:.6g}") for c in modes.compliances_mm3_pa])
+        freqs.append([float(f"{f:.5g}") for f in modes.frequencies_hz])
+        comps.append([float(f"{c:.5g}") for c in modes.compliances_mm3_pa])
         static.append(float(f"{modes.static_mm3_pa:.6g}"))
     data = {"about": "cap wall modes at a = 1 mm, G = 1 MPa, rho = 1000 kg/m3; built by "
                      "benchmarks/wall_modes_table.py", "fem_level": fsi.TABLE_LEVEL,

@@ -38,6 +38,11 @@ class SiliconeGrade:
     yeoh_c_mpa: tuple[float, float, float] | None = None
     ogden_mu_alpha: tuple[float, float] | None = None
     hyperelastic_source: str = ""
+    loss_factor: tuple[float, float] = (0.1, 0.2)
+    """Shear loss factor η = G''/G' at 1-10 kHz (the wall model's G* = G(1 + iη))."""
+    khz_modulus_factor: tuple[float, float] = (1.0, 1.6)
+    """Storage modulus at 1-10 kHz over the static ``shear_modulus_mpa`` (elastomers stiffen with rate)."""
+    dynamic_source: str = ""
 
     @property
     def neo_hookean_mu_mpa(self) -> float:
@@ -60,19 +65,30 @@ GRADES: dict[str, SiliconeGrade] = {g.key: g for g in (
         hyperelastic_source="Yeoh C10 = 0.1536, C20 = 0.0016 MPa: a published uniaxial fit for Dragon Skin 30 "
                             "(quoted in the project's physics notes, original not re-checked); Ogden: "
                             "least-squares fit of one term to that Yeoh curve in uniaxial stress, "
-                            "stretch 0.6-2.0 (docs/materials.md)"),
+                            "stretch 0.6-2.0 (docs/materials.md)",
+        loss_factor=(0.1, 0.2), khz_modulus_factor=(1.0, 1.6),
+        dynamic_source="no kHz data sheet value exists; eta 0.1-0.2 and a modulus rise with frequency are the "
+                       "range reported for platinum-cure silicone rubbers of this hardness (matcad's physics "
+                       "notes); the 1.0-1.6 factor is matcad's stated assumption, to be replaced by a DMA "
+                       "measurement"),
     SiliconeGrade(
         key="ecoflex_00_30", label="Smooth-On Ecoflex 00-30", density_kg_m3=1070.0,
         shear_modulus_mpa=(0.02, 0.06), modulus_100_mpa=10 * PSI_MPA, shore="00-30",
         mix_ratio="1A:1B by weight", pot_life_min=45.0, cure_h_room=4.0, viscosity_cps=3000.0,
         tensile_mpa=200 * PSI_MPA, elongation_pct=900.0,
-        source="Smooth-On Ecoflex Series technical bulletin (specific gravity 1.07, 100 % modulus 10 psi)"),
+        source="Smooth-On Ecoflex Series technical bulletin (specific gravity 1.07, 100 % modulus 10 psi)",
+        loss_factor=(0.1, 0.3), khz_modulus_factor=(1.0, 2.0),
+        dynamic_source="no kHz data sheet value; a very soft, lightly crosslinked grade: matcad assumes a wider "
+                       "loss (0.1-0.3) and rate-stiffening (1.0-2.0) range than Dragon Skin 30"),
     SiliconeGrade(
         key="sylgard_184", label="Dow Sylgard 184 (10:1)", density_kg_m3=1030.0,
         shear_modulus_mpa=(0.44, 1.0), modulus_100_mpa=None, shore="43A", mix_ratio="10:1 base:curing agent by weight",
         pot_life_min=90.0, cure_h_room=48.0, viscosity_cps=3500.0, tensile_mpa=6.7, elongation_pct=140.0,
         source="Dow Sylgard 184 technical data sheet; E = 1.32-2.97 MPa by cure temperature, Johnston et al., "
-               "J. Micromech. Microeng. 24 (2014) 035017, G = E/3"),
+               "J. Micromech. Microeng. 24 (2014) 035017, G = E/3",
+        loss_factor=(0.05, 0.15), khz_modulus_factor=(1.0, 1.5),
+        dynamic_source="no kHz data sheet value; an unfilled, well crosslinked PDMS: matcad assumes lower loss "
+                       "(0.05-0.15) and 1.0-1.5 rate-stiffening"),
 )}
 DEFAULT_GRADE = "dragon_skin_30"
 

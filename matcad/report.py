@@ -133,6 +133,8 @@ def _markdown(r: dict) -> str:
               "| source | tolerance | low [Hz] | high [Hz] |", "|---|---|---:|---:|"]
     lines += [f"| {b['source']} | {_cell(b['tolerance'])} | {b['low_hz']:+.1f} | {b['high_hz']:+.1f} |"
               for b in p["budget"]]
+    if p["warnings"]:  # what the physics says and where a model does not hold (e.g. the paper's measured 4.0 kHz)
+        lines += ["", "Prediction notes:", ""] + [f"- {w}" for w in p["warnings"]]
     lines += ["", "## Design rules", "", "| level | rule | part | message | fix |", "|---|---|---|---|---|"]
     lines += [f"| {f['level']} | {f['id']} | {_part_link(f, r)} | {_cell(f['message'])} | {_cell(f['fix'])} |"
               for f in r["findings"]]

@@ -262,11 +262,18 @@ class Air(Section):
 class Wall(Section):
     """Cavity wall mechanics."""
 
-    model: str = _param("'rigid' (ideal walls) or 'silicone' (quasi-static wall compliance band)",
+    model: str = _param("'rigid' (ideal walls) or 'silicone' (elastic cap with inertia and loss)",
                         default="rigid", kind="choice", choices=("rigid", "silicone"))
     shear_modulus_mpa: tuple[float, float] | None = _param(
         "[low, high] static shear modulus of the cured silicone; default from silicone.grade "
         "(Dragon Skin 30: 0.2-0.6 MPa)", "MPa", None, kind="range", lo=0.0, hi=1e6)
+    loss_factor: tuple[float, float] | None = _param(
+        "[low, high] loss factor eta of the silicone at kHz (G* = G(1 + i eta)); default from silicone.grade "
+        "(Dragon Skin 30: 0.1-0.2)", "", None, kind="range", lo=0.0, hi=10.0, lo_open=False)
+    khz_modulus_factor: tuple[float, float] | None = _param(
+        "[low, high] storage modulus at kHz over the static shear_modulus_mpa; default from silicone.grade "
+        "(Dragon Skin 30: 1.0-1.6, an assumption, see docs/materials.md)", "", None, kind="range", lo=0.0,
+        hi=1e3)
 
 
 @dataclass(frozen=True)
@@ -325,6 +332,23 @@ class Calibration(Section):
 
 
 @dataclass(frozen=True)
+class Reference(Section):
+    """A taxel you built and recorded: matcad then predicts this design as the measured f0 times the physics
+    ratio (this design / the reference), which cancels most of what the models miss. Geometry fields left out
+    are this design's own; everything else (plate, mouth, silicone, air) is shared."""
+
+    f0_hz: float = _param("measured unloaded resonance of the reference taxel", "Hz", lo=0.0, hi=1e7)
+    f0_tolerance_hz: float = _param("+- uncertainty of that measurement", "Hz", 20.0, lo=0.0, hi=1e7,
+                                    lo_open=False)
+    cavity_diameter: float | None = _length("reference cavity diameter; default this design's", None)
+    cavity_length: float | None = _length("reference cavity length; default this design's", None)
+    neck_diameter: float | None = _length("reference neck diameter; default this design's", None)
+    neck_length: float | None = _length("reference neck length (sheet thickness); default this design's", None)
+    cap_outer_diameter: float | None = _length("reference end-cap outer diameter; default this design's", None)
+    cap_top_thickness: float | None = _length("reference end-cap top thickness; default this design's", None)
+
+
+@dataclass(frozen=True)
 class Spec:
     """A whole taxel design. Lengths in mm."""
 
@@ -347,6 +371,7 @@ class Spec:
     silicone: Silicone = field(default_factory=Silicone)
     calibration: Calibration | None = None
     mechanics: Mechanics = field(default_factory=Mechanics)
+    reference: Reference | None = None
 
     def __post_init__(self) -> None:
         name_meta = dict(dataclasses.fields(Spec)[0].metadata)
@@ -364,7 +389,7 @@ SECTIONS: dict[str, type] = {
     "cavity": Cavity, "neck": Neck, "plate": Plate, "guide": Guide, "spacer": Spacer, "end_cap": EndCap,
     "fasteners": Fasteners, "needle": Needle, "mount": Mount, "mold": Mold, "machine": Machine,
     "outputs": Outputs, "air": Air, "wall": Wall, "microphone": Microphone, "silicone": Silicone,
-    "calibration": Calibration, "mechanics": Mechanics}
+    "calibration": Calibration, "mechanics": Mechanics, "reference": Reference}
 SECTION_NAMES: dict[type, str] = {cls: name for name, cls in SECTIONS.items()}
 REQUIRED_SECTIONS = ("cavity", "neck")
 _NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
@@ -475,6 +500,11 @@ def _section(cls: type, path: str, data: Any) -> Any:
 
 
 def _cross_checks(spec: Spec) -> None:
+    if spec.reference is not None:
+        try:
+            reference_spec(spec)
+        except SpecError as err:
+            raise SpecError(f"reference ({err.field})", err.value, err.allowed) from None
     if spec.neck.diameter > spec.cavity.diameter:
         raise SpecError("neck.diameter", spec.neck.diameter,
                         f"must be <= cavity.diameter = {spec.cavity.diameter:g} mm (a neck cannot be "
@@ -531,7 +561,29 @@ def _resolve_defaults(spec: Spec) -> Spec:
     wall = spec.wall
     if wall.shear_modulus_mpa is None:
         wall = dataclasses.replace(wall, shear_modulus_mpa=grade.shear_modulus_mpa)
+    if wall.loss_factor is None:
+        wall = dataclasses.replace(wall, loss_factor=grade.loss_factor)
+    if wall.khz_modulus_factor is None:
+        wall = dataclasses.replace(wall, khz_modulus_factor=grade.khz_modulus_factor)
     return dataclasses.replace(spec, end_cap=cap, machine=machine, silicone=silicone, wall=wall)
+
+
+def reference_spec(spec: Spec) -> Spec:
+    """The reference taxel of ``spec``'s [reference] as a whole spec: this design with the reference's geometry."""
+    ref = spec.reference
+
+    def pick(value, own):
+        return own if value is None else value
+
+    return dataclasses.replace(
+        spec, reference=None,
+        cavity=dataclasses.replace(spec.cavity, diameter=pick(ref.cavity_diameter, spec.cavity.diameter),
+                                   length=pick(ref.cavity_length, spec.cavity.length)),
+        neck=dataclasses.replace(spec.neck, diameter=pick(ref.neck_diameter, spec.neck.diameter),
+                                 length=pick(ref.neck_length, spec.neck.length)),
+        end_cap=dataclasses.replace(spec.end_cap,
+                                    outer_diameter=pick(ref.cap_outer_diameter, spec.end_cap.outer_diameter),
+                                    top_thickness=pick(ref.cap_top_thickness, spec.end_cap.top_thickness)))
 
 
 def load(path: str | Path) -> Spec:

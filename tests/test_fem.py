@@ -73,27 +73,15 @@ def test_finds_fundamental_not_overtone():
     assert low < 343e3 / (4 * (6.35 + 4.76))  # below the first tube mode of the whole length
 
 
-def test_soft_wall_tends_to_rigid_and_matches_1d_model():
-    rigid = fem.solve(_geom(), _k(5300), 4, C).f0_hz
-    soft = [fem.solve(_geom(wall_shear_modulus_pa=g, cap_outer_radius=4.0), _k(4500), 4, C).f0_hz
-            for g in (0.2e6, 2e6, 2e8)]
-    assert soft[0] < soft[1] < soft[2] < rigid
-    assert soft[2] == pytest.approx(rigid, rel=2e-3)
-    n, extra = models.soft_wall_length_scale(0.2e6, 3.18, 8.0)
-    l_eff = 6.35 + models.baffled_end_correction_mm(1.05) + models.step_end_correction_mm(2.1, 3.18)
-    one_d = models.transmission_line_hz(C, math.pi * 1.05**2, math.pi * 1.59**2, l_eff, 4.76, n, extra)
-    assert soft[0] == pytest.approx(float(one_d), rel=0.02)
-
-
 def test_predict_model_fem_in_json():
-    p = predict(spec_mod.load(PAPER), model="fem")
+    p = predict(spec_mod.load(PAPER), model="fem")  # silicone: the coupled elastic cap + air FEM
     assert p.model == "fem"
-    fem_checks = p.models["fem"].checks
-    assert fem_checks["mode_in_cavity"] and fem_checks["fundamental_found"]
-    # the soft-wall FEM is quasi-static too: it carries the soft-wall model's wall check
-    assert fem_checks["quasi_static_wall"] == p.models["soft_wall"].checks["quasi_static_wall"]
+    assert p.models["fem"].checks["fundamental_found"]
+    assert "coupled elastic cap" in p.models["fem"].source
     assert p.band_hz[0] < p.f0_hz < p.band_hz[1]
-    assert p.models["fem"].f0_hz == pytest.approx(p.models["soft_wall"].f0_hz, rel=0.03)
+    assert p.models["fem"].f0_hz == pytest.approx(p.models["elastic_wall"].f0_hz, rel=0.03)
+    rigid = predict(dataclasses.replace(spec_mod.load(PAPER), wall=spec_mod.Wall()), model="fem")
+    assert rigid.models["fem"].checks["mode_in_cavity"]
 
 
 def test_unflanged_mouth_is_a_clear_error():
@@ -101,8 +89,23 @@ def test_unflanged_mouth_is_a_clear_error():
         fem.mesh(_geom(mouth="unflanged"))
 
 
-def test_soft_wall_applies_when_neck_is_as_wide_as_cavity():
-    wide = _geom(neck_radius=1.59)
-    rigid = fem.solve(wide, _k(7000), 4, C).f0_hz
-    soft = fem.solve(dataclasses.replace(wide, wall_shear_modulus_pa=0.3e6, cap_outer_radius=4.0), _k(6000), 4, C)
-    assert soft.f0_hz < 0.97 * rigid  # the silicone side wall is compliant whatever the neck
+def test_outline_mesh_volume_and_straight_outline_matches_draft():
+    # a bulged wall given as a polyline (e.g. a deformed cap): the mesh holds exactly the polyline's volume
+    zs = np.linspace(6.35, 6.35 + 4.76, 9)
+    rs = 1.59 + 0.2 * np.sin(np.pi * (zs - 6.35) / 4.76)
+    g = fem.outline_geometry(list(zip(rs, zs)), 1.05, 6.35, "baffled")
+    m = fem.mesh(g, 4)
+    p = m.p[:, m.t]
+    area = 0.5 * np.abs((p[0, 1] - p[0, 0]) * (p[1, 2] - p[1, 0]) - (p[0, 2] - p[0, 0]) * (p[1, 1] - p[1, 0]))
+    inside = p[1].mean(axis=0) > 6.35
+    volume = 2 * math.pi * np.sum(area[inside] * p[0].mean(axis=0)[inside])
+    frusta = sum(math.pi * (z1 - z0) * (r0 * r0 + r0 * r1 + r1 * r1) / 3
+                 for r0, r1, z0, z1 in zip(rs, rs[1:], zs, zs[1:]))
+    # the mesh's nodes sit on the polyline only at its vertices' heights; P1 geometry between them
+    assert volume == pytest.approx(frusta, rel=2e-3)
+    straight = fem.outline_geometry([(1.59, 6.35), (1.45, 6.35 + 4.76)], 1.05, 6.35, "baffled")
+    drafted = _geom(cavity_tip_radius=1.45)
+    assert fem.solve(straight, _k(5300), 4, C).f0_hz == pytest.approx(fem.solve(drafted, _k(5300), 4, C).f0_hz,
+                                                                       rel=1e-12)
+    with pytest.raises(ValueError, match="outline"):
+        fem.outline_geometry([(1.59, 6.35), (1.0, 8.0)], 1.05, 6.35, "baffled")

@@ -73,17 +73,17 @@ def test_temperature_range(temperature):
     assert colder.f0_hz < p.f0_hz
 
 
-def test_soft_wall_tends_smoothly_to_rigid():
-    shear_mpa = np.geomspace(1e-3, 1e5, 60)  # 1 kPa to effectively rigid
-    f = np.array([predict(_spec(wall__model="silicone", wall__shear_modulus_mpa=[g, g])).f0_hz
-                  for g in shear_mpa])
+def test_silicone_wall_finite_and_tends_to_rigid():
+    shear_mpa = np.geomspace(1e-3, 1e5, 25)  # 1 kPa to effectively rigid
+    specs = [_spec(wall__model="silicone", wall__shear_modulus_mpa=[g, g]) for g in shear_mpa]
+    elastic = np.array([predict(s).f0_hz for s in specs])
     rigid = predict(_spec()).f0_hz
-    assert np.all(np.isfinite(f)) and np.all(f > 0)
-    assert np.all(np.diff(f) > 0)
-    assert np.all(f < rigid * (1 + 1e-12))
-    assert f[-1] == pytest.approx(rigid, rel=1e-5)
-    # smooth: no step larger than the local trend
-    assert np.all(np.abs(np.diff(np.diff(np.log(f)))) < 0.05)
+    assert np.all(np.isfinite(elastic)) and np.all(elastic > 0)
+    assert elastic[-1] == pytest.approx(rigid, rel=1e-4)
+    # the quasi-static (massless) wall: monotone, always below rigid, smooth
+    static = np.array([predict(s).models["soft_wall"].f0_hz for s in specs])
+    assert np.all(np.diff(static) > 0) and np.all(static < rigid * (1 + 1e-12))
+    assert np.all(np.abs(np.diff(np.diff(np.log(static)))) < 0.2)
 
 
 def test_forces_up_to_and_past_eq5_validity():

@@ -6,9 +6,7 @@ draft) and the exterior below the plate (z < 0):
   spherical radiation condition ∂p/∂n = −(ik + 1/R) p on the arc (exact for the monopole near field);
 - ``mount``: the spacer gap of height h between plate and mount out to the gap radius R_g, with the
   cylindrical condition ∂p/∂n = −(ik + 1/(2R_g)) p on r = R_g.
-All other walls are rigid, except with ``wall_shear_modulus_pa``: the silicone cavity wall and closed end react
-locally with the quasi-static compliances of :func:`matcad.acoustics.models.soft_wall_length_scale`
-(∂p/∂n = k²·β·p, β = ρc²·u/p), which makes the FEM a reference for that model too.
+All other walls are rigid here; :mod:`matcad.acoustics.fsi` couples the elastic silicone cap to this air mesh.
 
 The radiation term depends on k, so the eigenproblem K + (ik + κ)C = k²M is solved by fixed-point iteration
 on k in the boundary term, each step a shift-invert Arnoldi solve near the current k. Of the modes found, the
@@ -24,8 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.acoustics.air import BULK_MODULUS_PA
-from matcad.acoustics.models import HALF_SPACE_MEAN_DISPLACEMENT, MM_PER_M
+from matcad.acoustics.models import MM_PER_M
 
 DEFAULT_LEVEL = 8
 """Elements across the neck radius; the paper taxel converges to < 0.1 % here (benchmarks/error_vs_runtime.py)."""
@@ -47,8 +44,10 @@ class FemGeometry:
     mouth: str
     gap: float = 0.0
     gap_radius: float = 0.0
-    wall_shear_modulus_pa: float | None = None
-    cap_outer_radius: float = 0.0
+    wall_outline: tuple[tuple[float, float], ...] | None = None
+    """Optional cavity side wall as a polyline of (r, z) points (mm), z rising from the neck step (z = l) to the
+    closed end (z = l + L); replaces the straight drafted wall, e.g. for a deformed cap. The closed end stays
+    flat at z = l + L and the wall must stay wider than the neck."""
 
 
 @dataclass(frozen=True)
@@ -63,16 +62,15 @@ class FemResult:
     seconds: float
 
 
-def geometry_from_spec(spec, shear_modulus_pa: float | None = None) -> FemGeometry:
-    """The FEM geometry of a spec (drafted cavity, mouth, gap); rigid walls unless a shear modulus is given."""
+def geometry_from_spec(spec) -> FemGeometry:
+    """The FEM geometry of a spec's air (drafted cavity, neck, mouth, gap), mm."""
     from matcad.acoustics.geometry import drafted_tip_diameter_mm
 
     tip = float(drafted_tip_diameter_mm(spec.cavity.diameter, spec.cavity.length, spec.mold.draft_deg))
     return FemGeometry(neck_radius=spec.neck.diameter / 2, neck_length=spec.neck.length,
                        cavity_radius=spec.cavity.diameter / 2, cavity_tip_radius=tip / 2,
                        cavity_length=spec.cavity.length, mouth=spec.neck.mouth, gap=spec.spacer.height,
-                       gap_radius=min(spec.plate.width, spec.plate.depth) / 2,
-                       wall_shear_modulus_pa=shear_modulus_pa, cap_outer_radius=spec.end_cap.outer_diameter / 2)
+                       gap_radius=min(spec.plate.width, spec.plate.depth) / 2)
 
 
 # ---------------------------------------------------------------- mesh
@@ -155,8 +153,27 @@ class Layout:
 
 
 def cavity_wall_radius(g: FemGeometry, z):
-    """Radius of the drafted cavity wall at height z (mm; z from the plate underside, cavity from l to l + L)."""
+    """Radius of the cavity wall at height z (mm; z from the plate underside, cavity from l to l + L): the drafted
+    straight wall, or ``wall_outline`` interpolated linearly."""
+    if g.wall_outline is not None:
+        r, zs = np.array(g.wall_outline, dtype=float).T
+        return np.interp(z, zs, r)
     return g.cavity_radius + (z - g.neck_length) / g.cavity_length * (g.cavity_tip_radius - g.cavity_radius)
+
+
+def outline_geometry(outline, neck_radius: float, neck_length: float, mouth: str, gap: float = 0.0,
+                     gap_radius: float = 0.0) -> FemGeometry:
+    """The FEM geometry of a cavity given by its side-wall outline, a polyline of (r, z) points (mm) from the
+    neck step (z = ``neck_length``) to the flat closed end; mesh it with :func:`mesh`, solve with :func:`solve`."""
+    pts = tuple((float(r), float(z)) for r, z in outline)
+    zs = [z for _, z in pts]
+    if len(pts) < 2 or any(b <= a for a, b in zip(zs, zs[1:])) or abs(zs[0] - neck_length) > 1e-9 * neck_length:
+        raise ValueError("outline must be >= 2 (r, z) points with z strictly rising from the neck length")
+    if min(r for r, _ in pts) < neck_radius:
+        raise ValueError("outline must stay at or outside the neck radius")
+    return FemGeometry(neck_radius=neck_radius, neck_length=neck_length, cavity_radius=pts[0][0],
+                       cavity_tip_radius=pts[-1][0], cavity_length=zs[-1] - neck_length, mouth=mouth, gap=gap,
+                       gap_radius=gap_radius, wall_outline=pts)
 
 
 def layout(g: FemGeometry, level: int = DEFAULT_LEVEL, cavity_breaks: tuple[float, ...] = ()) -> Layout:
@@ -170,9 +187,9 @@ def layout(g: FemGeometry, level: int = DEFAULT_LEVEL, cavity_breaks: tuple[floa
     z_cav = _graded_span(l, l + L, h, h_max, fine_end=False)
     for z in cavity_breaks:
         z_cav[1 + int(np.argmin(np.abs(z_cav[1:-1] - z)))] = z
-    width = g.cavity_radius - a
+    width = max(float(np.max(cavity_wall_radius(g, z_cav))) - a, 0.0)
     s = (_graded_span(0.0, width, min(h, width), max(min(h, width), h_max), fine_end=False) / width
-         if width > 1e-9 * a or g.cavity_tip_radius - a > 1e-9 * a else np.zeros(0))
+         if width > 1e-9 * a else np.zeros(0))
     return Layout(h, h_max, np.linspace(0.0, a, level + 1), _graded_span(0.0, l, h, h_max), z_cav, s)
 
 
@@ -286,12 +303,12 @@ def _forms():
 
 
 def _boundary_facets(m, g: FemGeometry):
-    """(radiation facets, κ, cavity-wall facets, closed-end facets) by facet midpoints."""
+    """(radiation facets, κ) by facet midpoints."""
     mid = m.p[:, m.facets].mean(axis=1)
     boundary = np.zeros(m.facets.shape[1], dtype=bool)
     boundary[m.boundary_facets()] = True
     r, z = mid
-    a, l, L = g.neck_radius, g.neck_length, g.cavity_length
+    a = g.neck_radius
     tol = 1e-6 * a
     if g.mouth == "baffled":
         big_r = EXTERIOR_RADIUS_PER_A * a
@@ -300,18 +317,7 @@ def _boundary_facets(m, g: FemGeometry):
     else:
         radiation = boundary & (r > g.gap_radius - tol)
         kappa = 1.0 / (2.0 * g.gap_radius)
-    top = boundary & (z > l + L - tol)
-    side = boundary & (z > l + tol) & (z < l + L - tol) & (r > tol)  # off the axis: the cavity's wall
-    return np.flatnonzero(radiation), kappa, np.flatnonzero(side), np.flatnonzero(top)
-
-
-def _wall_compliance(g: FemGeometry, r, kind: str):
-    """β = ρc² × wall displacement per pressure (mm), Lamé cylinder or half-space end (as models.py)."""
-    shear = g.wall_shear_modulus_pa
-    b = g.cap_outer_radius
-    if kind == "side":
-        return BULK_MODULUS_PA / shear * r / 2 * b * b / (b * b - r * r)
-    return np.full_like(r, BULK_MODULUS_PA / shear * HALF_SPACE_MEAN_DISPLACEMENT * g.cavity_tip_radius)
+    return np.flatnonzero(radiation), kappa
 
 
 def _eigs_near(a_mat, m_mat, sigma, count):
@@ -340,12 +346,8 @@ def solve(g: FemGeometry, k_guess_per_mm: float, level: int = DEFAULT_LEVEL, spe
     stiffness, mass, weighted_mass = _forms()
     k_mat = asm(stiffness, basis)
     m_mat = asm(mass, basis)
-    radiation, kappa, side, top = _boundary_facets(m, g)
+    radiation, kappa = _boundary_facets(m, g)
     c_mat = asm(mass, FacetBasis(m, element, facets=radiation))
-    if g.wall_shear_modulus_pa is not None:
-        for facets, kind in ((side, "side"), (top, "top")):
-            fb = FacetBasis(m, element, facets=facets)
-            m_mat = m_mat + asm(weighted_mass, fb, weight=_wall_compliance(g, fb.global_coordinates()[0], kind))
     cavity = (np.asarray(basis.global_coordinates()[1]) > g.neck_length).astype(float)
     m_cav = asm(weighted_mass, basis, weight=cavity)
 

@@ -238,7 +238,7 @@ def _assemble(cm: CoupledMesh, g: fem.FemGeometry, cap: Cap) -> _System:
     stiffness, mass, _ = fem._forms()
     normal_trace = _forms()[3]
     interface, ring, fixed, axis = _facets(cm, g, cap)
-    radiation, kappa, _, _ = fem._boundary_facets(m, g)
+    radiation, kappa = fem._boundary_facets(m, g)
 
     air_dofs = np.unique(b_air.element_dofs)
     u_all = np.unique(b_u.element_dofs)
@@ -415,7 +415,7 @@ def elastic_modes_hz(k, m, count: int) -> list[float]:
 
 
 TABLE_LEVEL = 6
-TABLE_MODES = 8
+TABLE_MODES = 20
 
 
 def unit_cap_modes(outer: float, top: float, length: float, clamp_fraction: float, level: int = TABLE_LEVEL,

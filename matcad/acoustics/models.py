@@ -7,7 +7,9 @@ Rungs:
 2. :func:`end_corrected_hz` — Eq. 1 with the neck lengthened by its two end corrections.
 3. :func:`transmission_line_hz` — plane waves in neck and cavity (Selamet et al., JASA 101(1), 1997); the
    default for rigid walls; valid from A ≪ S up to A = S.
-4. :func:`soft_wall_length_scale` feeds rung 3 with a quasi-static compliant wall (silicone cap).
+4. :func:`soft_wall_length_scale` feeds rung 3 with a quasi-static (massless) compliant wall; valid only when
+   the cap's wall modes lie ≥ 3× f. The silicone default is :mod:`matcad.acoustics.wall` (wall modes with mass
+   and loss), which moves f up when those modes lie below f, as they do for the paper's Dragon Skin cap.
 """
 
 import numpy as np
@@ -153,8 +155,10 @@ def soft_wall_length_scale(shear_modulus_pa, cavity_diameter_mm, cap_outer_diame
     Assumptions (all stated, none hidden): incompressible linear-elastic silicone of shear modulus G; the
     cylindrical wall deforms as a Lamé thick cylinder in plane strain with inner radius a and outer radius b
     (ΔS/S = p/G · b²/(b² − a²)); the closed end deforms like a half-space loaded on a disc of radius a
-    (w̄ = 0.4244 p a/G); the acrylic neck is rigid; wall inertia is neglected, so the model holds below the
-    wall's own breathing resonance (:func:`wall_breathing_hz`).
+    (w̄ = 0.4244 p a/G); the acrylic neck is rigid; wall inertia is neglected, so the model holds only well
+    below the cap's wall modes (≥ 3× f): above them the wall is mass-like and the true shift has the opposite
+    sign. The infinite tube also overstates a real cap's compliance (bonded base, clamped flange, finite top:
+    about 1.4× for the paper's cap against the coupled FEM).
 
     The wall slows waves in the cavity (Korteweg): n² = 1 + (ρc²/G)·b²/(b² − a²); the end compliance is an
     extra closed length ΔL = 0.4244·a·ρc²/(G·n²) (mm). Both → rigid (n = 1, ΔL = 0) as G → ∞.
@@ -172,8 +176,8 @@ def wall_breathing_hz(shear_modulus_pa, density_kg_m3, cavity_diameter_mm, cap_o
     """In-vacuo breathing resonance of an incompressible thick cylinder wall (Hz).
 
     Lamé stiffness 4πG(b² − a²)/b² per unit length against the radial-flow kinetic mass
-    2πρ a² ln(b/a): ω² = 2G(1 − a²/b²) / (ρ a² ln(b/a)). Above it the wall acts as a mass, not a spring,
-    and the quasi-static soft-wall band no longer bounds the answer.
+    2πρ a² ln(b/a): ω² = 2G(1 − a²/b²) / (ρ a² ln(b/a)), exact for the radial mode u_r ∝ 1/r of an
+    incompressible plane-strain tube (the closed form the coupled FEM's elastic operator is tested against).
     """
     a = np.asarray(cavity_diameter_mm, dtype=float) / 2.0 / MM_PER_M
     b = np.asarray(cap_outer_diameter_mm, dtype=float) / 2.0 / MM_PER_M

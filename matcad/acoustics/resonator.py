@@ -10,8 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.acoustics import geometry, models
+from matcad.acoustics import geometry, models, wall
 from matcad.acoustics.air import speed_of_sound_m_s
+from matcad.parts.features import cap_flange_thickness_mm
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,9 @@ class Resonator:
     inner_ingard: float
     inner_step: float
     cap_outer_diameter: float
+    cap_top_thickness: float
+    cap_clamp_height: float
+    silicone_density: float
 
     @property
     def neck_air_ratio(self) -> float:
@@ -55,30 +59,71 @@ def resonator(spec) -> Resonator:
                                                                gap_radius)),
         inner_ingard=float(models.ingard_end_correction_mm(neck.diameter, cav_diameter)),
         inner_step=float(models.step_end_correction_mm(neck.diameter, cav_diameter)),
-        cap_outer_diameter=spec.end_cap.outer_diameter)
+        cap_outer_diameter=spec.end_cap.outer_diameter, cap_top_thickness=spec.end_cap.top_thickness,
+        cap_clamp_height=cap_flange_thickness_mm(spec), silicone_density=spec.silicone.density_g_cm3 * 1000.0)
 
 
-def evaluate(res: Resonator, model: str, shear_modulus_pa=None):
-    """f0 (Hz) of one cheap model; ``soft_wall`` takes the shear modulus (Pa, scalar or array)."""
+def cap_shape(res: Resonator) -> wall.CapShape:
+    """The silicone cap around the as-built cavity (its equal-volume cylinder), mm."""
+    return wall.CapShape(cavity_radius=res.cavity_diameter / 2, cavity_length=res.cavity_length,
+                         outer_radius=res.cap_outer_diameter / 2, top_thickness=res.cap_top_thickness,
+                         clamp_height=res.cap_clamp_height)
+
+
+def wall_modes(res: Resonator, shear_modulus_pa: float) -> wall.Modes:
+    """The cap's wall modes at the given (dynamic) shear modulus, Pa."""
+    return wall.modes(cap_shape(res), shear_modulus_pa, res.silicone_density)
+
+
+def evaluate(res: Resonator, model: str, shear_modulus_pa=None, loss_factor: float = 0.0):
+    """f0 (Hz) of one cheap model; ``soft_wall`` takes the shear modulus (Pa, scalar or array), ``elastic_wall``
+    the (dynamic) shear modulus (Pa, scalar) and the loss factor."""
     if model == "lumped":
         return models.lumped_hz(res.c_m_s, res.neck_area, res.volume, res.neck_length)
     if model == "end_corrected":
         return models.end_corrected_hz(res.c_m_s, res.neck_area, res.volume,
                                        res.neck_length + res.outer_correction + res.inner_ingard)
     n, extra = 1.0, 0.0
+    l_eff = res.neck_length + res.outer_correction + res.inner_step
+    if model == "elastic_wall":
+        f_tl = evaluate(res, "transmission_line")
+        return f_tl * wall.peak_ratio(float(f_tl), res.c_m_s, res.neck_area, res.cavity_area, l_eff,
+                                      res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor)
     if model == "soft_wall":
         n, extra = models.soft_wall_length_scale(shear_modulus_pa, res.cavity_diameter, res.cap_outer_diameter)
     elif model != "transmission_line":
         raise ValueError(f"model {model!r} invalid, must be one of {list(CHEAP_MODELS)}")
-    return models.transmission_line_hz(res.c_m_s, res.neck_area, res.cavity_area,
-                                       res.neck_length + res.outer_correction + res.inner_step,
-                                       res.cavity_length, n, extra)
+    return models.transmission_line_hz(res.c_m_s, res.neck_area, res.cavity_area, l_eff, res.cavity_length, n,
+                                       extra)
 
 
-CHEAP_MODELS = ("lumped", "end_corrected", "transmission_line", "soft_wall")
+CHEAP_MODELS = ("lumped", "end_corrected", "transmission_line", "soft_wall", "elastic_wall")
 
 
 def shear_moduli_pa(spec) -> tuple[float, float, float]:
-    """(low, geometric mean, high) of the spec's shear-modulus range (Pa)."""
+    """(low, geometric mean, high) of the spec's static shear-modulus range (Pa)."""
     g_lo, g_hi = (x * 1e6 for x in spec.wall.shear_modulus_mpa)
     return g_lo, float(np.sqrt(g_lo * g_hi)), g_hi
+
+
+def dynamic_moduli_pa(spec) -> tuple[float, float, float]:
+    """(low, geometric mean, high) storage shear modulus at kHz (Pa): the static range times the kHz factor."""
+    f_lo, f_hi = spec.wall.khz_modulus_factor
+    g_lo, _, g_hi = shear_moduli_pa(spec)
+    lo, hi = g_lo * f_lo, g_hi * f_hi
+    return lo, float(np.sqrt(lo * hi)), hi
+
+
+def loss_factors(spec) -> tuple[float, float, float]:
+    """(low, mean, high) of the spec's loss-factor range."""
+    lo, hi = spec.wall.loss_factor
+    return lo, 0.5 * (lo + hi), hi
+
+
+def wall_arguments(spec, model: str) -> tuple:
+    """The (modulus, loss) arguments of :func:`evaluate` at the middle of the spec's ranges for a wall model."""
+    if model == "elastic_wall":
+        return dynamic_moduli_pa(spec)[1], loss_factors(spec)[1]
+    if model == "soft_wall":
+        return shear_moduli_pa(spec)[1], 0.0
+    return None, 0.0

@@ -1,10 +1,10 @@
 """The fast elastic-wall model: the silicone cap as a few wall modes (with mass, stiffness and loss) coupled to
 the transmission line. Pure numpy; no FEM at run time. Lengths mm, frequencies Hz, moduli Pa, compliances mm³/Pa.
 
-The cap's dynamic volume compliance (cavity volume swept per unit cavity pressure) is the modal sum with a static
-(mode-acceleration) correction for the modes left out:
+The cap's dynamic volume compliance (cavity volume swept per unit cavity pressure) is the modal sum, its static
+limit made exact (C_w(0) = C_0, the static compliance under uniform pressure):
 
-    C_w(ω) = (C_0 − Σ c_i)/(1 + iη) + Σ c_i / (1 + iη − ω²/ω_i²)
+    C_w(ω) = Σ c_i / (1 + iη − ω²/ω_i²)    (plus the remainder C_0 − Σ c_i as one more mode at the last ω_i)
 
 with ω_i the cap's in-vacuo modes and c_i = Φ_i²/ω_i² their volume compliances (Φ_i: volume swept per unit
 mass-normalised amplitude), from the coupled FEM's elastic operator (:mod:`matcad.acoustics.fsi`) on a grid of cap
@@ -36,7 +36,7 @@ TABLE_AXES = {
     "outer": (1.3, 1.6, 2.0, 2.52, 3.2, 4.0),
     "top": (0.4, 0.8, 1.26, 2.0, 3.0),
     "length": (1.0, 2.0, 3.0, 4.5, 7.0),
-    "clamp_fraction": (0.0, 0.17, 0.34, 0.5, 0.7),
+    "clamp_fraction": (0.0, 0.17, 0.34, 0.6),
 }
 """Cap shapes in cavity radii (outer radius, top thickness, cavity length) and the clamped fraction of the cavity
 height; the paper template (b/a 2.52, T/a 1.26, L/a 3.0, clamp 0.34) lies on the grid."""
@@ -95,8 +95,9 @@ def _ratios(shape: CapShape):
 
 
 def modes(shape: CapShape, shear_modulus_pa: float, density_kg_m3: float) -> Modes:
-    """The cap's wall modes, interpolated multilinearly (in log of the ratios) from wall_modes.json and scaled
-    to its size, modulus (Pa) and density (kg/m³)."""
+    """The cap's wall modes, interpolated multilinearly (in log of the ratios; log frequencies, log static
+    compliance, each mode's share of it) from wall_modes.json and scaled to its size, modulus (Pa) and density
+    (kg/m³)."""
     freqs, comps, static = _table()
     weights = []
     for name, v in zip(TABLE_AXES, _ratios(shape)):
@@ -112,21 +113,25 @@ def modes(shape: CapShape, shear_modulus_pa: float, density_kg_m3: float) -> Mod
     for corner in np.ndindex(2, 2, 2, 2):
         idx = tuple(weights[d][corner[d]][0] for d in range(4))
         w = math.prod(weights[d][corner[d]][1] for d in range(4))
-        if w:
+        if w:  # frequencies and the static compliance in log, each mode's share of it linearly
             f += w * np.log(freqs[idx])
-            c += w * comps[idx]
-            s += w * static[idx]
+            c += w * comps[idx] / static[idx]
+            s += w * math.log(static[idx])
     a = shape.cavity_radius
+    static_c = math.exp(s) * a**3 * UNIT_SHEAR_PA / shear_modulus_pa
     return Modes(np.exp(f) * math.sqrt(shear_modulus_pa / UNIT_SHEAR_PA * UNIT_DENSITY / density_kg_m3) / a,
-                 c * a**3 * UNIT_SHEAR_PA / shear_modulus_pa, s * a**3 * UNIT_SHEAR_PA / shear_modulus_pa)
+                 c * static_c, static_c)
 
 
 def dynamic_compliance_mm3_pa(f_hz, wall: Modes, loss_factor: float):
-    """C_w(f) = ΔV/p of the cap (mm³/Pa, complex; time e^{iωt}): modal sum plus the static remainder."""
+    """C_w(f) = ΔV/p of the cap (mm³/Pa, complex; time e^{iωt}): the modal sum, plus the compliance the retained
+    modes miss (static minus their sum) as one more mode at the highest retained frequency, so that it acts as a
+    spring below the retained modes and as a mass above them, like the modes it stands for."""
     f = np.asarray(f_hz, dtype=float)[..., None]
     g = 1.0 + 1j * loss_factor
-    modal = wall.compliances_mm3_pa / (g - (f / wall.frequencies_hz) ** 2)
-    return (wall.static_mm3_pa - wall.compliances_mm3_pa.sum()) / g + modal.sum(axis=-1)
+    freqs = np.append(wall.frequencies_hz, wall.frequencies_hz[-1])
+    comps = np.append(wall.compliances_mm3_pa, max(wall.static_mm3_pa - wall.compliances_mm3_pa.sum(), 0.0))
+    return (comps / (g - (f / freqs) ** 2)).sum(axis=-1)
 
 
 def _cavity_end_response(f_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall_compliance):

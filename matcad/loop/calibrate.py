@@ -7,7 +7,7 @@ grows as f⁻³ and the fit weights each point by (f/f̄)⁶; the parameter cova
 confidence and prediction bands in y map straight onto bands in f.
 
 ``k_free``: fix V0 to the as-built cavity volume and fit K instead (1/f² = V0/K − (b/K)F − (a/K)F²), so that K
-absorbs what the geometry's K misses (end corrections, soft walls).
+absorbs what the geometry's K misses (end corrections, the elastic wall).
 """
 
 from __future__ import annotations
