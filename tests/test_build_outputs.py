@@ -42,6 +42,11 @@ def test_report_manifest_matches_files(built):
     assert report["matcad_version"] and report["spec"]["name"] == spec.name
     assert report["prediction"]["f0_hz"] == pytest.approx(result.prediction.f0_hz)
     assert (out / "report.md").read_text().startswith(f"# {spec.name}")
+    # the report says what predict says: for the paper's taxel, physics against the one published measurement
+    for warning in report["prediction"]["warnings"]:
+        assert warning in (out / "report.md").read_text()
+    if spec.name == "mat-paper":
+        assert "not explained by the wall" in (out / "report.md").read_text()
 
 
 def test_dxf_units_layers_holes_outlines(built):
