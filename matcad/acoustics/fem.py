@@ -44,10 +44,6 @@ class FemGeometry:
     mouth: str
     gap: float = 0.0
     gap_radius: float = 0.0
-    wall_outline: tuple[tuple[float, float], ...] | None = None
-    """Optional cavity side wall as a polyline of (r, z) points (mm), z rising from the neck step (z = l) to the
-    closed end (z = l + L); replaces the straight drafted wall, e.g. for a deformed cap. The closed end stays
-    flat at z = l + L and the wall must stay wider than the neck."""
 
 
 @dataclass(frozen=True)
@@ -153,27 +149,8 @@ class Layout:
 
 
 def cavity_wall_radius(g: FemGeometry, z):
-    """Radius of the cavity wall at height z (mm; z from the plate underside, cavity from l to l + L): the drafted
-    straight wall, or ``wall_outline`` interpolated linearly."""
-    if g.wall_outline is not None:
-        r, zs = np.array(g.wall_outline, dtype=float).T
-        return np.interp(z, zs, r)
+    """Radius of the drafted cavity wall at height z (mm; z from the plate underside, cavity from l to l + L)."""
     return g.cavity_radius + (z - g.neck_length) / g.cavity_length * (g.cavity_tip_radius - g.cavity_radius)
-
-
-def outline_geometry(outline, neck_radius: float, neck_length: float, mouth: str, gap: float = 0.0,
-                     gap_radius: float = 0.0) -> FemGeometry:
-    """The FEM geometry of a cavity given by its side-wall outline, a polyline of (r, z) points (mm) from the
-    neck step (z = ``neck_length``) to the flat closed end; mesh it with :func:`mesh`, solve with :func:`solve`."""
-    pts = tuple((float(r), float(z)) for r, z in outline)
-    zs = [z for _, z in pts]
-    if len(pts) < 2 or any(b <= a for a, b in zip(zs, zs[1:])) or abs(zs[0] - neck_length) > 1e-9 * neck_length:
-        raise ValueError("outline must be >= 2 (r, z) points with z strictly rising from the neck length")
-    if min(r for r, _ in pts) < neck_radius:
-        raise ValueError("outline must stay at or outside the neck radius")
-    return FemGeometry(neck_radius=neck_radius, neck_length=neck_length, cavity_radius=pts[0][0],
-                       cavity_tip_radius=pts[-1][0], cavity_length=zs[-1] - neck_length, mouth=mouth, gap=gap,
-                       gap_radius=gap_radius, wall_outline=pts)
 
 
 def layout(g: FemGeometry, level: int = DEFAULT_LEVEL, cavity_breaks: tuple[float, ...] = ()) -> Layout:
@@ -338,8 +315,6 @@ def solve(g: FemGeometry, k_guess_per_mm: float, level: int = DEFAULT_LEVEL, spe
     t0 = time.perf_counter()
     m = mesh(g, level)
     if cavity_outline is not None:
-        if g.wall_shear_modulus_pa is not None:
-            raise ValueError("a deformed cavity outline takes rigid walls (wall_shear_modulus_pa = None)")
         m = deform_cavity(m, g, *cavity_outline)
     element = ElementTriP2()
     basis = Basis(m, element)
