@@ -40,13 +40,13 @@ MAX_CELLS = 4000
 
 
 def default_element_size_mm(sec: CapSection) -> float:
-    """Element size (mm): 8 across the top, 12 across the wall, 20 along the cavity, 6 across its radius, but no
+    """Element size (mm): 4 across the top, 12 across the wall, 20 along the cavity, 6 across its radius, but no
     finer than :data:`MAX_CELLS` cells over the section allow. On the paper cap this is 0.2 mm, where F(x) sits
     within 2 % of the finest mesh that reaches 1 mm (tests/test_mechanics.py)."""
     wall = sec.outer_radius - max(sec.cavity_radius, sec.cavity_tip_radius)
     area = (sec.outer_radius ** 2 * sec.height + (sec.flange_radius ** 2 - sec.outer_radius ** 2) * sec.flange_thickness
             - sec.cavity_radius ** 2 * sec.cavity_length) / max(sec.outer_radius, sec.flange_radius)
-    return max(min(sec.top_thickness / 8, wall / 12, sec.cavity_length / 20, sec.cavity_radius / 6),
+    return max(min(sec.top_thickness / 4, wall / 12, sec.cavity_length / 20, sec.cavity_radius / 6),
                math.sqrt(area / MAX_CELLS))
 
 

@@ -9,8 +9,9 @@ makes every top node a unilateral frictionless contact (``MultiPointContact``, a
 outside of the body may roll onto the plate without friction. F is the plate's reaction (N, the whole ring).
 
 Load steps are equal plate increments to ``displacement_mm``; a step whose Newton iterations (at most
-``MAX_NEWTON``) do not converge, or that inverts a cell, is cut in half, at most ``MAX_CUTS`` times; then the
-curve stops at the last converged step and :attr:`CapCurve.message` says where and why.
+``MAX_NEWTON``) do not converge, or that inverts a cell, is cut in half, at most ``MAX_CUTS`` times, and a whole
+curve spends at most ``NEWTON_BUDGET_PER_STEP`` × steps iterations; past either bound the curve stops at the last
+converged step and :attr:`CapCurve.message` says where and why.
 """
 
 from __future__ import annotations
@@ -28,6 +29,8 @@ from matcad.mechanics.section import CapSection, cavity_volume_mm3
 CONTACTS = ("sticking", "frictionless")
 MAX_NEWTON = 12
 MAX_CUTS = 5
+NEWTON_BUDGET_PER_STEP = 40
+"""All Newton iterations of a curve, failed ones included, stay below this × steps: a bound on the run time."""
 NEWTON_TOL = 1e-8
 PENALTY_PER_G_MM = 1e5
 """Contact penalty = this × G × outer radius (N/mm): a plate penetration below 1e-4 mm at the cap's forces."""
@@ -95,6 +98,18 @@ def _cell_strains(field_container, cells: int) -> np.ndarray:
     f = np.moveaxis(f, (0, 1), (-2, -1)).reshape(cells, 3, 3)
     stretch2 = np.linalg.eigvalsh(np.einsum("...ki,...kj->...ij", f, f))
     return np.max(np.abs(0.5 * np.log(stretch2)), axis=1)
+
+
+def _singular_corner(cm: CapMesh, sec: CapSection, point) -> str:
+    """Name the sharp corner next to ``point`` (r, z mm), where the surface creases first, or ''."""
+    near = 3 * cm.element_size_mm
+    if len(cm.cavity) and np.min(np.hypot(*(cm.points[cm.cavity] - point).T)) < near:
+        return " (the cavity surface creases there: its self-contact is not modelled)"
+    if np.hypot(point[0] - sec.outer_radius, point[1] - sec.flange_thickness) < near:
+        return " (the body folds over the clamp guide's edge there)"
+    if np.hypot(point[0] - sec.outer_radius, point[1] - sec.height) < near:
+        return " (the body folds onto the plate at the top edge there)"
+    return ""
 
 
 def cap_curve(spec) -> CapCurve:
@@ -196,6 +211,11 @@ def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking",
     for target in np.linspace(step, displacement_mm, steps):
         while x_done < target - 1e-12 * displacement_mm:
             dx = min(inc, target - x_done)
+            if iterations > NEWTON_BUDGET_PER_STEP * steps:
+                message = (f"stopped at x = {x_done:.4g} mm (last converged step) of {displacement_mm:g} mm: "
+                           f"{iterations} Newton iterations spent (budget {NEWTON_BUDGET_PER_STEP} per step), the "
+                           "curve is too hard to follow here")
+                break
             saved = u.values.copy()
             try:
                 its, state = solve_at(x_done + dx)
@@ -205,8 +225,7 @@ def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking",
                 inc = dx / 2
                 if inc < step / 2 ** MAX_CUTS:
                     reason = str(exc).strip().splitlines()[0]
-                    near = np.min(np.hypot(*(cm.points[cm.cavity] - hot).T)) < 2 * cm.element_size_mm
-                    crease = " (the cavity surface creases there: its self-contact is not modelled)" if near else ""
+                    crease = _singular_corner(cm, sec, hot)
                     message = (f"stopped at x = {x_done:.4g} mm (last converged step) of {displacement_mm:g} mm: "
                                f"no convergence at x = {x_done + dx:.4g} mm after {MAX_CUTS} step cuts ({reason}); "
                                f"G = {material.shear_modulus_mpa:g} MPa, top {sec.top_thickness:g} mm; peak strain "
@@ -218,6 +237,8 @@ def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking",
             x_done = x_done + dx
             inc = min(step, 2 * dx)
         if message:
+            if x_done > 0 and (not results or results[-1].displacement_mm < x_done):
+                results.append(state)  # the last converged sub-step: the curve ends where the message says
             break
         results.append(state)
     return CapCurve(section=sec, material=material, contact=contact, unloaded_volume_mm3=v0,
