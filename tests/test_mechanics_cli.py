@@ -48,3 +48,19 @@ def test_bad_mechanics_travel_is_exit_2_naming_the_field(write_spec):
                              "--force", "1")
     assert code == 2 and out == "" and "Traceback" not in err
     assert "mechanics.displacement_mm" in err
+
+
+def test_build_load_plot_path_stays_on_eq5_without_felupe():
+    """The build's load plot asks predict for Eq. 5 only (mechanics=False): no cap mechanics, no FElupe import."""
+    import subprocess
+    import sys
+
+    from tests.conftest import PAPER, ROOT
+
+    code = ("import sys; from matcad import spec; from matcad.acoustics.predict import predict; "
+            "from matcad.render.kit import load_forces_n; s = spec.load(%r); "
+            "p = predict(s, forces_n=load_forces_n(s), mechanics=False); "
+            "assert p.load_curve and all(q.source.startswith('calibration') for q in p.load_curve); "
+            "assert p.load_model is None; assert 'felupe' not in sys.modules" % str(PAPER))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr

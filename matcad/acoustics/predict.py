@@ -201,9 +201,10 @@ def _wall_results(spec, res) -> dict[str, ModelResult]:
     }
 
 
-def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None = None) -> Prediction:
+def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None = None,
+            mechanics: bool = True) -> Prediction:
     """Predict the unloaded resonance of ``spec`` with every model; f at ``forces_n`` (N) from the cap mechanics
-    (:mod:`matcad.mechanics`, imported only then) and, if calibrated, from Eq. 5 too.
+    (:mod:`matcad.mechanics`, imported only then; ``mechanics=False`` skips it) and, if calibrated, from Eq. 5 too.
 
     ``model`` overrides the automatic choice: one of the returned ``models`` keys, or ``fem`` (elements
     across the neck radius ``fem_level``, default :data:`matcad.acoustics.fem.DEFAULT_LEVEL`).
@@ -260,8 +261,6 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
     curve: tuple[LoadPoint, ...] = ()
     load_model = None
     if len(forces_n):
-        from matcad.mechanics.frequency import load_points
-
         if cal is not None:
             f_at = frequency_at_force_hz(cal, np.asarray(forces_n, dtype=float), c, neck.diameter, neck.length)
             curve = tuple(LoadPoint(float(force), None if np.isnan(f) else float(f), invalid_reason(cal, force),
@@ -269,6 +268,9 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
             if cal.area_convention == MAT_PAPER_2024.area_convention:
                 warnings.append("load curve uses the paper's A = d^2/4 convention with its fitted V0 (see DIGEST); "
                                 "its volumes are not physical cavity volumes")
+    if len(forces_n) and mechanics:
+        from matcad.mechanics.frequency import load_points
+
         # the FEM route on the deformed outlines when the FEM is the chosen model (DEFAULT_LEVEL imported above)
         rows, load_model = load_points(spec, forces_n, results[chosen].f0_hz,
                                        (fem_level or DEFAULT_LEVEL) if chosen == "fem" else None)

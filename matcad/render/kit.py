@@ -47,7 +47,7 @@ def render_figures(spec, prediction, folder: Path, meshes: dict) -> list[dict]:
     figures.append(band_plot(p, folder / BAND_PNG))
     forces = load_forces_n(spec)
     if len(forces):
-        figure = load_plot(predict(spec, forces_n=forces).to_dict(), folder / LOAD_PNG)
+        figure = load_plot(predict(spec, forces_n=forces, mechanics=False).to_dict(), folder / LOAD_PNG)
         if figure:
             figures.append(figure)
     for flat in laser_parts(spec):
