@@ -161,7 +161,7 @@ class Framer:
         self.scale = 2.0 / (self.fs * np.sum(self.window**2))
         self.freqs = np.fft.rfftfreq(self.mfft, 1.0 / self.fs)
         self._carry = np.zeros(0)
-        self._next = 0  # index of the next frame
+        self.frames = 0  # frames produced so far
 
     def feed(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(frame times s, power frames × bins) for every frame completed by ``x``."""
@@ -170,10 +170,10 @@ class Framer:
         if count == 0:
             self._carry = buf
             return np.zeros(0), np.zeros((0, len(self.freqs)))
-        idx = np.arange(count)[:, None] * self.hop + np.arange(self.n)[None, :]
-        power = np.abs(np.fft.rfft(buf[idx] * self.window, n=self.mfft, axis=1)) ** 2 * self.scale
-        times = ((self._next + np.arange(count)) * self.hop + self.n / 2) / self.fs
-        self._next += count
+        frames = np.lib.stride_tricks.sliding_window_view(buf, self.n)[: count * self.hop: self.hop]
+        power = np.abs(np.fft.rfft(frames * self.window, n=self.mfft, axis=1)) ** 2 * self.scale
+        times = ((self.frames + np.arange(count)) * self.hop + self.n / 2) / self.fs
+        self.frames += count
         self._carry = buf[count * self.hop:]
         return times, power
 
@@ -343,7 +343,7 @@ class BandTracker:
         if e >= WEAK_DB and (not self._run or stable):
             self._run.append(i)
         else:
-            self._close_run()
+            self._run = []
             if e >= WEAK_DB:
                 self._run = [i]
         if self._run and (len(self._run) >= MIN_RUN or max(self.excess[j] for j in self._run) >= STRONG_DB):
@@ -359,9 +359,6 @@ class BandTracker:
     def _bin_of(self, i):
         return (self.track[i] - self.freqs[self.in_band[0]]) / self.df
 
-    def _close_run(self):
-        self._run = []
-
     def _emit_until(self, stop):
         for j in range(self._voice_done, stop):
             if self.on_frame is not None:
@@ -375,7 +372,7 @@ class BandTracker:
             for back in reversed(self._back[1:]):
                 state = int(back[state])
             self._decide(state)
-        self._close_run()
+        self._run = []
         self._emit_until(len(self.track))
         if self._pool_acc:
             self._plot_cols.append(np.max(self._pool_acc, axis=0))
@@ -543,7 +540,7 @@ def analyze_stream(blocks, fs: float, bands, on_frame=None) -> list[Analysis]:
             total += power.sum(axis=0)
             for tr in trackers:
                 tr.push(times, power)
-    frames = max(1, framer._next)
+    frames = max(1, framer.frames)
     return [tr.finish(samples / fs, total / frames) for tr in trackers]
 
 
@@ -552,7 +549,7 @@ def analyze(x: np.ndarray, fs: float, band_hz: tuple[float, float]) -> Analysis:
 
     Raises LoopError (with the reason) when no frame holds the tone or when the ridge hugs a band edge.
     """
-    step = 1 << 20
+    step = 1 << 16
     return analyze_stream((x[i:i + step] for i in range(0, max(len(x), 1), step)), fs, [band_hz])[0]
 
 

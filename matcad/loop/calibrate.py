@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import csv
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -236,8 +236,6 @@ def fit(forces_n, frequencies_hz, k_mm3_hz2: float, v0_fixed_mm3: float | None =
         notes.append(f"one load cycle: between-cycle (hysteresis) variation not measured; "
                      f"{result.cycle_std_n:.2g} N assumed (the paper saw ~1 N between two cycles): give several "
                      "cycles (a 'cycle' column) to estimate it")
-    from dataclasses import replace
-
     return replace(result, temperature_c=temperature_c, notes=tuple(notes), excluded_n=tuple(force[~keep]))
 
 
@@ -277,6 +275,12 @@ def _fit_once(force, freq, k_mm3_hz2, v0_fixed_mm3, cycles, cycle_std_n) -> Cali
         tau2 = (tau_n * abs(theta[1] + 2 * theta[2] * mid)) ** 2
     cov = unscale @ cov_scaled @ unscale
     dof = n - 3
+    if not one_cycle and tau2 > 0:
+        # Welch–Satterthwaite: σ² has n − 3 − (k − 1) degrees of freedom, τ² only k − 1 (k cycles); the
+        # intervals use the effective dof of σ² + τ², so that τ from 2-3 cycles widens them as it should
+        k_cycles = len(np.unique(cycles))
+        dof_w, dof_b = max(n - 3 - (k_cycles - 1), 1), k_cycles - 1
+        dof = max(1, int((sigma2 + tau2) ** 2 / (sigma2 ** 2 / dof_w + tau2 ** 2 / dof_b)))
     if v0_fixed_mm3 is not None:
         # theta = (V0, b, a)/K with K = V0_fixed/theta0. Reading force from 1/f² needs theta alone (K cancels),
         # so holding K at its fitted value and scaling, (v0, b, a) = K·theta and cov = K²·cov(theta), is exact.

@@ -203,9 +203,9 @@ def scenario(name: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) ->
         force = press_profile(seconds, fs, [(s, s + 0.8, 12.0) for s in starts], ramp_s=0.15)
         x, truth = _base(seconds, fs, seed, force)
         x = _room(x, fs, seed, rt60=0.3)
-    elif name == "tapping":  # 4 taps a second to 10 N, 50 ms ramps
-        starts = np.arange(0.5, seconds - 0.5, 0.25)
-        force = press_profile(seconds, fs, [(s, s + 0.15, 10.0) for s in starts], ramp_s=0.05)
+    elif name == "tapping":  # 2 taps a second to 10 N: 50 ms ramps, 0.2 s held, 0.2 s released
+        starts = np.arange(0.5, seconds - 0.5, 0.5)
+        force = press_profile(seconds, fs, [(s, s + 0.3, 10.0) for s in starts], ramp_s=0.05)
         x, truth = _base(seconds, fs, seed, force)
         x = _room(x, fs, seed, rt60=0.3)
     elif name == "gaps":  # sings half the time; starts silent (the paper: may not sing unloaded)

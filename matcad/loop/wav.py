@@ -147,8 +147,8 @@ def read_mono(path: str | Path) -> tuple[np.ndarray, float]:
     return read_frames(path, info), info.sample_rate_hz
 
 
-BLOCK_FRAMES = 1 << 18
-"""Frames per block when streaming (~6 s at 44.1 kHz: a few MB whatever the recording's length)."""
+BLOCK_FRAMES = 1 << 16
+"""Frames per block when streaming (~1.5 s at 44.1 kHz: ~10 MB of spectra whatever the recording's length)."""
 RAW_FORMATS = {"s16le": ("int", 16), "s24le": ("int", 24), "s32le": ("int", 32), "u8": ("int", 8),
                "f32le": ("float", 32), "f64le": ("float", 64)}
 """Raw PCM sample formats for a live stream (names as in ffmpeg/arecord), little-endian."""
