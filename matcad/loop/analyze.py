@@ -71,7 +71,7 @@ MAX_GAP_FRAMES = 1
 MODE_JUMP_RATIO = 1.11
 JUMP_GAP_FRAMES = 8
 """A jump across at most this many frames (~0.37 s) with no voiced frame between the two levels is abrupt."""
-SECOND_SOURCE_FRACTION = 0.25
+SECOND_SOURCE_FRACTION = 0.5
 EDGE_BINS = 2
 PLOT_COLUMNS = 1200
 
@@ -455,11 +455,14 @@ def _segments(times, track, state, df) -> list[Segment]:
         abrupt = (last is not None and run[0] - last[1] <= JUMP_GAP_FRAMES
                   and not np.any((between - last[0]) * (between - mean) < 0))  # no ramp frame in between
         ratio = mean / reference
-        if abrupt and max(ratio, 1 / ratio) > MODE_JUMP_RATIO and max(mean / last[0], last[0] / mean) > MODE_JUMP_RATIO:
+        far = max(ratio, 1 / ratio) > MODE_JUMP_RATIO
+        if far and abrupt and max(mean / last[0], last[0] / mean) > MODE_JUMP_RATIO:
             flag = (f"abrupt jump x{mean / last[0]:.3f} from {last[0]:.0f} Hz, x{ratio:.3f} from the recording's "
                     f"median, more than a press can give (Eq. 5: x{MODE_JUMP_RATIO:g} over 0-25 N): a mode jump "
                     "(overblowing)")
-        last = (mean, run[-1])
+        elif far and last is not None and last[2] and max(mean / last[0], last[0] / mean) <= MODE_JUMP_RATIO:
+            flag = last[2]  # the same jumped mode, after a dropout
+        last = (mean, run[-1], flag)
         out.append(Segment(float(times[run[0]]), float(times[run[-1]]), len(run), mean, float(np.median(f)),
                            float(np.std(f)), flag))
     return out
