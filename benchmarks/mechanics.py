@@ -64,6 +64,12 @@ def main():
                   f"b = {cal.b:.4f} mm³/N")
         print(f"  paper Eq. 5 (d2/4): V0 = 32.21 mm³, a = -0.0086 mm³/N², b = 0.4626 mm³/N; f stops rising at "
               f"{fc.turn_force_n} (predicted) vs ~25 N (paper, Fig. 7)")
+        e = fc.eq5_paper_convention
+        print(f"  relative (independent of f0 and of the area convention): b/V0 = {e.b / e.v0_mm3:.5f} /N, "
+              f"a/V0 = {e.a / e.v0_mm3:.3e} /N² (paper: {0.4626 / 32.21:.5f}, {-0.0086 / 32.21:.3e}); f(F)/f0 at "
+              + ", ".join(f"{F:g} N: {np.interp(F, force, [s.f_hz for s in fc.states]) / fc.states[0].f_hz:.4f} "
+                          f"(paper {float(frequency_at_force_hz(MAT_PAPER_2024, F, c, spec.neck.diameter, spec.neck.length)) / float(frequency_at_force_hz(MAT_PAPER_2024, 0.0, c, spec.neck.diameter, spec.neck.length)):.4f})"
+                          for F in (5.0, 10.0, 15.4, 25.0)))
     spec = paper_spec("ogden")
     curve = cap_curve(spec)
     t0 = time.perf_counter()
