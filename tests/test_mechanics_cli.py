@@ -64,3 +64,15 @@ def test_build_load_plot_path_stays_on_eq5_without_felupe():
             "assert p.load_model is None; assert 'felupe' not in sys.modules" % str(PAPER))
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
+
+
+def test_predict_force_with_model_fem_takes_the_fem_route(write_spec):
+    code, out, err = run_cli("predict", write_spec(FAST), "--json", "--force", "3", "--model", "fem",
+                             "--fem-level", "3")
+    assert code == 0, err
+    data = json.loads(out)
+    model = data["load_model"]
+    assert model["route"] == "axisymmetric FEM on the deformed outline, level 3" and model["fem_note"] == ""
+    assert all(s["f_fem_hz"] > 0 for s in model["curve"])
+    assert model["curve"][0]["f_hz"] == pytest.approx(data["f0_hz"])
+    assert data["load_curve"][0]["f_hz"] > data["f0_hz"]
