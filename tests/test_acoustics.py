@@ -206,7 +206,10 @@ def test_uncertainty_budget_lines_and_band():
     plain = math.sqrt(sum(b.high_hz ** 2 for b in p.budget))
     assert high == pytest.approx(plain, rel=0.05)
     model = next(b for b in p.budget if b.source == "model")
-    assert model.high_hz == pytest.approx(model_errors()["elastic_wall"]["max_abs"] * p.f0_hz)
+    error = model_errors()["elastic_wall"]
+    # its own checks failing (a wall mode near f), the model line takes the error over every benchmark case
+    worst = error["max_abs"] if p.models[p.model].valid else error["max_abs_all"]
+    assert model.high_hz == pytest.approx(worst * p.f0_hz) and error["max_abs_all"] >= error["max_abs"]
     # a wider neck sings higher: the neck-diameter line is negative at d - tol, positive at d + tol
     neck = next(b for b in p.budget if b.source == "neck diameter")
     assert neck.low_hz < 0 < neck.high_hz

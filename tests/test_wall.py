@@ -74,3 +74,11 @@ def test_quasi_static_check_follows_the_wall_modes():
     stiff = wall.modes(shape, 100e6, 1080.0)
     assert not wall.quasi_static_valid(soft, 5000.0) and wall.quasi_static_valid(stiff, 5000.0)
     assert wall_modes(resonator(spec_mod.load(PAPER)), 0.35e6).coupled_hz()[0] < 2500
+
+
+def test_wall_mode_near_f_is_flagged():
+    modes = wall.Modes(np.array([1000.0, 2000.0, 3000.0]), np.array([1.0, 0.001, 1.0]), 2.001)
+    assert wall.mode_near(modes, 1100.0) == 1000.0
+    assert wall.mode_near(modes, 2700.0) == 3000.0  # 11 % away
+    assert wall.mode_near(modes, 2000.0) is None  # the 2 kHz mode sweeps almost no volume: not coupled
+    assert wall.mode_near(modes, 5000.0) is None

@@ -121,6 +121,10 @@ def _model_warnings(name: str, result: ModelResult, diameter_ratio: float) -> li
                              "moves f up when the modes lie below f; use elastic_wall or --model fem",
         "wall_shape_in_table": f"{name}: the cap's shape lies outside the wall-mode table (clamped to its edge); "
                                "check with --model fem",
+        "no_wall_mode_near_f": f"{name}: a cap wall mode with volume coupling lies within "
+                               f"{100 * wall_model.HYBRID_BAND:.0f} % of f0: cavity and wall hybridise, two "
+                               "resonances can compete, and this fast model's measured error is larger there (the "
+                               "band carries it); check with --model fem",
     }
     return [text[check] for check, ok in result.checks.items() if not ok]
 
@@ -149,14 +153,16 @@ def _fem(spec, c_m_s: float, f_guess_hz: float, level: int) -> ModelResult:
                                           f"dofs, Q = {run.q:.1f}, {run.seconds:.2f} s")
 
 
-def _relative(spec, model: str, f_model_hz: float) -> ModelResult:
-    """This design as the reference taxel's measured f0 times ``model``'s ratio (this design / reference)."""
+def _relative(spec, model: str, this: ModelResult) -> ModelResult:
+    """This design as the reference taxel's measured f0 times ``model``'s ratio (this design / reference); it
+    carries ``this`` design's checks of that model."""
     from matcad.spec import reference_spec
 
     ref = reference_spec(spec)
     f_ref = float(evaluate(resonator(ref), model, *wall_arguments(ref, model)))
+    f_model_hz = this.f0_hz
     ratio = f_model_hz / f_ref
-    return ModelResult(spec.reference.f0_hz * ratio, {},
+    return ModelResult(spec.reference.f0_hz * ratio, dict(this.checks),
                        f"measured reference {spec.reference.f0_hz:g} Hz x {model} ratio {ratio:.4f} "
                        f"(this design {f_model_hz:.0f} Hz / reference {f_ref:.0f} Hz by the same model)")
 
@@ -184,7 +190,8 @@ def _wall_results(spec, res) -> dict[str, ModelResult]:
     dynamic, loss = dynamic_moduli_pa(spec)[1], loss_factors(spec)[1]
     f_elastic = float(evaluate(res, "elastic_wall", dynamic, loss))
     modes = wall_modes(res, dynamic)
-    in_table = {"wall_shape_in_table": not wall_model.shape_outside_table(cap_shape_of(res))}
+    in_table = {"wall_shape_in_table": not wall_model.shape_outside_table(cap_shape_of(res)),
+                "no_wall_mode_near_f": wall_model.mode_near(modes, f_elastic) is None}
     coupled = ", ".join(f"{f:.0f}" for f in modes.coupled_hz()[:4])
     return {
         "soft_wall": ModelResult(
@@ -236,14 +243,14 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
 
         results["fem"] = _fem(spec, c, results[chosen].f0_hz, fem_level or DEFAULT_LEVEL)
     if spec.reference is not None:
-        results["relative"] = _relative(spec, chosen, results[chosen].f0_hz)
+        results["relative"] = _relative(spec, chosen, results[chosen])
         if model is None:
             chosen = "relative"
     if model is not None:
         if model not in results:
             raise ValueError(f"model {model!r} invalid, must be one of {sorted(results) + ['fem']}")
         chosen = model
-    lines = budget(spec, res, chosen, results[chosen].f0_hz)
+    lines = budget(spec, res, chosen, results[chosen].f0_hz, results[chosen].valid)
     low, high = total(lines, results[chosen].f0_hz)
 
     warnings = _model_warnings(chosen, results[chosen], xi)

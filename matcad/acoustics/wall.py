@@ -44,6 +44,9 @@ QUASI_STATIC_RATIO = 3.0
 """The quasi-static wall holds where every wall mode with volume coupling lies ≥ 3× f (DIGEST's published rule)."""
 SIGNIFICANT_MODE = 0.02
 """A mode "couples" when it carries ≥ 2 % of the static volume compliance."""
+HYBRID_BAND = 0.15
+"""A coupled wall mode within ±15 % of f hybridises with the cavity: two resonances can compete, and the fast
+model's error there is larger (measured in docs/error_vs_runtime.md)."""
 SWEEP = (0.5, 2.0, 601)
 UNIT_SHEAR_PA = 1e6
 UNIT_DENSITY = 1000.0
@@ -174,3 +177,12 @@ def quasi_static_valid(wall: Modes, f_hz: float) -> bool:
     """True where every wall mode with volume coupling lies ≥ :data:`QUASI_STATIC_RATIO` × f."""
     coupled = wall.coupled_hz()
     return bool(len(coupled) == 0 or coupled.min() >= QUASI_STATIC_RATIO * f_hz)
+
+
+def mode_near(wall: Modes, f_hz: float) -> float | None:
+    """The coupled wall mode (Hz) nearest ``f_hz`` if it lies within :data:`HYBRID_BAND` of it, else None."""
+    coupled = wall.coupled_hz()
+    if not len(coupled):
+        return None
+    nearest = float(coupled[np.argmin(np.abs(coupled - f_hz))])
+    return nearest if abs(nearest / f_hz - 1) <= HYBRID_BAND else None
