@@ -22,6 +22,18 @@ def _print_json(data) -> None:
     print(json.dumps(data, indent=2, allow_nan=False))
 
 
+def _load_spec(path, args):
+    """The validated spec at ``path`` (TOML or a build's report.json) with ``--set`` applied; likely unit slips
+    and silent defaults are printed to stderr as notes (never changing a value)."""
+    from matcad.plausibility import spec_notes
+    from matcad.spec_input import load_spec
+
+    spec, data = load_spec(path, getattr(args, "set", None))
+    for note in spec_notes(spec, data):
+        print(f"matcad: note: {note}", file=sys.stderr)
+    return spec
+
+
 def _format_prediction(spec, p) -> str:
     cav, neck = spec.cavity, spec.neck
     lines = [
@@ -75,13 +87,18 @@ def _format_load_curve(p) -> list[str]:
 
 
 def cmd_predict(args) -> int:
-    from matcad import spec as spec_mod
     from matcad.acoustics.predict import predict
 
-    spec = spec_mod.load(args.spec)
+    if args.fem_level is not None and args.model != "fem":
+        raise ValueError(f"--fem-level {args.fem_level} applies only with --model fem (it sets the FEM's mesh)")
     if args.fem_level is not None and not 1 <= args.fem_level <= 64:
         raise ValueError(f"--fem-level {args.fem_level} invalid, must be 1-64 elements across the neck radius")
-    result = predict(spec, forces_n=args.force or (), model=args.model, fem_level=args.fem_level)
+    if args.force_deprecated:
+        print("matcad: note: predict --force is deprecated (it clashed with build --force); use --load",
+              file=sys.stderr)
+    spec = _load_spec(args.spec, args)
+    result = predict(spec, forces_n=args.load or args.force_deprecated or (), model=args.model,
+                     fem_level=args.fem_level)
     if args.json:
         _print_json(result.to_dict())
     else:
@@ -98,10 +115,9 @@ def _format_findings(findings) -> str:
 
 
 def cmd_check(args) -> int:
-    from matcad import spec as spec_mod
     from matcad.rules import check, errors
 
-    findings = check(spec_mod.load(args.spec))
+    findings = check(_load_spec(args.spec, args))
     if args.json:
         _print_json({"findings": [f.to_dict() for f in findings],
                      "verdict": "fail" if errors(findings) else "pass"})
@@ -111,10 +127,9 @@ def cmd_check(args) -> int:
 
 
 def cmd_build(args) -> int:
-    from matcad import spec as spec_mod
     from matcad.build import DesignRuleFailure, build
 
-    spec = spec_mod.load(args.spec)
+    spec = _load_spec(args.spec, args)
     try:
         result = build(spec, out_dir=args.out, force=args.force)
     except DesignRuleFailure as exc:
@@ -141,10 +156,9 @@ def cmd_build(args) -> int:
 
 
 def cmd_coupon(args) -> int:
-    from matcad import spec as spec_mod
     from matcad.build import build_coupon
 
-    target, table = build_coupon(spec_mod.load(args.spec), out_dir=args.out)
+    target, table = build_coupon(_load_spec(args.spec, args), out_dir=args.out)
     if args.json:
         _print_json({"out_dir": str(target), **table})
     else:
@@ -160,11 +174,10 @@ def _band(args):
             raise ValueError(f"--band {lo:g} {hi:g} invalid, must be 0 <= LO < HI (Hz)")
         return lo, hi
     if args.spec:
-        from matcad import spec as spec_mod
         from matcad.acoustics.predict import predict
         from matcad.loop.analyze import band_from_prediction
 
-        return band_from_prediction(predict(spec_mod.load(args.spec)).band_hz)
+        return band_from_prediction(predict(_load_spec(args.spec, args)).band_hz)
     raise ValueError("analyze needs --spec SPEC (its predicted band) or --band LO HI (Hz)")
 
 
@@ -228,16 +241,18 @@ def cmd_analyze(args) -> int:
 
 
 def cmd_calibrate(args) -> int:
-    from matcad import spec as spec_mod
     from matcad.loop.calibrate import fit_from_spec, plot, read_csv
     from matcad.output import staged_output
+    from matcad.plausibility import frequency_notes
 
-    spec = spec_mod.load(args.spec)
+    spec = _load_spec(args.spec, args)
     if args.temperature_c is not None and not -60.0 <= args.temperature_c <= 100.0:
         raise ValueError(f"--temperature-c {args.temperature_c:g} invalid, must be -60 to 100 degC")
     if args.cycle_std_n is not None and not 0.0 <= args.cycle_std_n <= 100.0:
         raise ValueError(f"--cycle-std-n {args.cycle_std_n:g} invalid, must be 0-100 N")
     forces, freqs, cycles = read_csv(args.data)
+    for note in frequency_notes(freqs, f"{args.data} frequency_hz"):
+        print(f"matcad: note: {note}", file=sys.stderr)
     cal = fit_from_spec(forces, freqs, spec, k_free=args.k_free, cycles=cycles, temperature_c=args.temperature_c,
                         cycle_std_n=args.cycle_std_n)
     target = _loop_output(args, "calibrate", str(args.data))
@@ -352,6 +367,28 @@ def cmd_schema(args) -> int:
     return EXIT_OK
 
 
+def cmd_init(args) -> int:
+    from matcad.init import new_spec
+
+    try:
+        path = new_spec(args.name, args.template, args.out)
+    except FileExistsError as exc:
+        raise ValueError(f"{exc.filename}: exists; refusing to overwrite it (choose another NAME or --out)") from None
+    if args.json:
+        _print_json({"spec": str(path), "template": args.template})
+    else:
+        print(f"{path}: a copy of the {args.template} template named {args.name!r}; edit it, then "
+              f"`matcad predict {path}` and `matcad build {path}`")
+    return EXIT_OK
+
+
+def cmd_completion(args) -> int:
+    from matcad.completion import script
+
+    print(script(_parser(), args.shell), end="")
+    return EXIT_OK
+
+
 def cmd_serve(args) -> int:
     from matcad.serve import DEFAULT_PORT, HOST, make_server
 
@@ -387,23 +424,30 @@ def _parser() -> argparse.ArgumentParser:
             cmd.add_argument("--out", type=Path, help=f"output folder (default {out_default})")
         return cmd
 
+    def spec_arg(cmd, flag=None, **kw):
+        """The spec argument (positional, or ``flag``) and --set overrides, for every spec-taking command."""
+        cmd.add_argument(flag or "spec", help="spec TOML file, or a build's report.json (its resolved spec)", **kw)
+        cmd.add_argument("--set", action="append", metavar="KEY=VALUE",
+                         help="override one spec field, value as TOML (e.g. --set neck.diameter=2.0); repeatable")
+
     p = command("predict", cmd_predict, "predict the taxel's resonance frequency from a spec")
-    p.add_argument("spec", help="spec TOML file")
-    p.add_argument("--force", type=float, nargs="+", metavar="F",
+    spec_arg(p)
+    p.add_argument("--load", type=float, nargs="+", metavar="F",
                    help="normal loads in N: f(F) from the cap mechanics ([mechanics]; FElupe) and, with a "
                         "[calibration], from paper Eq. 5 as well")
+    p.add_argument("--force", dest="force_deprecated", type=float, nargs="+", metavar="F",
+                   help="deprecated spelling of --load")
     p.add_argument("--model", help="use this model's f0 instead of the automatic choice ('fem' adds the FEM)")
     p.add_argument("--fem-level", type=int, help="FEM mesh refinement: elements across the neck radius (default 8)")
 
-    command("check", cmd_check, "run the design rules without building (exit 1 on errors)").add_argument(
-        "spec", help="spec TOML file")
+    spec_arg(command("check", cmd_check, "run the design rules without building (exit 1 on errors)"))
 
     b = command("build", cmd_build, "write the fabrication kit and report to out/<name>/", "out/<name>")
-    b.add_argument("spec", help="spec TOML file")
+    spec_arg(b)
     b.add_argument("--force", action="store_true", help="build despite design-rule errors")
 
-    command("coupon", cmd_coupon, "test coupons sweeping neck, dowel and needle-bore sizes",
-            "out/<name>-coupon").add_argument("spec", help="spec TOML file")
+    spec_arg(command("coupon", cmd_coupon, "test coupons sweeping neck, dowel and needle-bore sizes",
+                     "out/<name>-coupon"))
 
     a = command("analyze", cmd_analyze, "the taxel's frequency in a recording (spectrogram ridge)",
                 "out/analyze-<recording>-<hash>")
@@ -412,12 +456,13 @@ def _parser() -> argparse.ArgumentParser:
     group = a.add_mutually_exclusive_group()
     group.add_argument("--spec", help="spec TOML: analyse its predicted band (-10 %% / +25 %% for load)")
     group.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="analysis band in Hz")
+    a.add_argument("--set", action="append", metavar="KEY=VALUE", help="override one field of --spec (TOML value)")
 
     c = command("calibrate", cmd_calibrate, "fit paper Eq. 5 to force/frequency pairs, with uncertainty",
                 "out/calibrate-<data>-<hash>")
     c.add_argument("data", help="CSV with force_n and frequency_hz columns (and optionally cycle: several load "
                                 "cycles give the between-cycle variance)")
-    c.add_argument("--spec", required=True, help="spec TOML of the taxel (its as-built K or V0)")
+    spec_arg(c, "--spec", required=True)
     c.add_argument("--k-free", action="store_true", help="fix V0 to the as-built cavity and fit K instead")
     c.add_argument("--temperature-c", type=float, help="air temperature during calibration (degC; default the "
                                                        "spec's [air] temperature_c), recorded for `sense`")
@@ -439,6 +484,16 @@ def _parser() -> argparse.ArgumentParser:
         cmd.add_argument("--channels", type=int, default=1, help="raw PCM channels (default 1), averaged")
 
     command("schema", cmd_schema, "print every spec field with unit, default and allowed range")
+
+    i = command("init", cmd_init, "start a new spec from a shipped template (never overwrites)")
+    i.add_argument("name", help="design name (also the file name NAME.toml and the build folder out/NAME)")
+    i.add_argument("--from", dest="template", default="mat-paper",
+                   help="template: mat-paper (default), mat-laser-only, mat-sla-array")
+    i.add_argument("--out", type=Path, help="spec file to write (default NAME.toml)")
+
+    sh = sub.add_parser("completion", help="print a shell completion script (bash; zsh via bashcompinit)")
+    sh.set_defaults(func=cmd_completion)
+    sh.add_argument("shell", choices=("bash", "zsh"))
 
     sv = sub.add_parser("serve", help="a local design page: the spec as a form, live prediction, build to a zip")
     sv.set_defaults(func=cmd_serve)

@@ -24,27 +24,14 @@ from importlib import resources
 from pathlib import Path
 from urllib.parse import parse_qs, urlparse
 
+from matcad.init import DEFAULT_TEMPLATE
+
 HOST = "127.0.0.1"
 DEFAULT_PORT = 8765
 MAX_BODY_BYTES = 64 * 1024
 """A spec is a few kB of JSON; anything bigger is refused before it is read."""
 BUILD_LOCK = threading.Lock()
-DEFAULT_TEMPLATE = "mat-paper"
 MIME = {".png": "image/png", ".svg": "image/svg+xml"}
-
-
-def template_path(name: str) -> Path:
-    """A shipped template by name (``templates/<name>.toml`` inside the package)."""
-    folder = resources.files("matcad") / "templates"
-    names = sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-    if name not in names:
-        raise ValueError(f"template {name!r} invalid, must be one of {', '.join(names)}")
-    return Path(str(folder / f"{name}.toml"))
-
-
-def template_names() -> list[str]:
-    folder = resources.files("matcad") / "templates"
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
 def _error(field, message: str) -> dict:
@@ -101,6 +88,7 @@ def build_json(payload: dict) -> tuple[int, dict]:
 
 def page_html(template: str) -> str:
     """The design page with the schema and the template's values built in (no network, no external files)."""
+    from matcad.init import template_names, template_path
     from matcad.spec import schema
 
     raw = tomllib.loads(template_path(template).read_text(encoding="utf-8"))

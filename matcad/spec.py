@@ -304,7 +304,7 @@ class Calibration(Section):
                       lo=-1e12, hi=1e12, lo_open=False)
     area_convention: str = _param(
         "neck area used with v0: 'pi_d2/4' (physical, A = pi d^2/4) or 'd2/4' (the paper's fit, "
-        "see DIGEST)", default="pi_d2/4", kind="choice", choices=("pi_d2/4", "d2/4"))
+        "see docs/paper.md)", default="pi_d2/4", kind="choice", choices=("pi_d2/4", "d2/4"))
     k_mm3_hz2: float | None = _param("K = c^2 A / (4 pi^2 l) the fit used; when given it replaces the one "
                                      "computed from the neck and area_convention (written by `matcad calibrate`)",
                                      "mm^3 Hz^2", None, lo=0.0, hi=1e30)
@@ -540,7 +540,7 @@ def from_dict(data: dict) -> Spec:
 
 
 KEY_CLEARANCE_MM = {"fdm": 0.2, "sla": 0.1}
-"""Registration-key clearance per side by printer process (DIGEST, shop practice)."""
+"""Registration-key clearance per side by printer process (docs/physics.md, shop practice)."""
 
 
 def _resolve_defaults(spec: Spec) -> Spec:

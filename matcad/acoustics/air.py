@@ -10,7 +10,7 @@ BULK_MODULUS_PA = GAMMA * STANDARD_PRESSURE_PA
 
 
 def speed_of_sound_m_s(temperature_c):
-    """Speed of sound in dry air, c = 331.3·sqrt(1 + T/273.15) (m/s), T in °C (DIGEST; ideal gas).
+    """Speed of sound in dry air, c = 331.3·sqrt(1 + T/273.15) (m/s), T in °C (docs/physics.md; ideal gas).
 
     343.2 m/s at 20 °C; +0.17 %/°C near room temperature.
     """
@@ -29,7 +29,7 @@ def boundary_layer_shift(frequency_hz, neck_radius_mm):
     """Relative drop of the phase speed in a tube of radius a from viscous and thermal boundary layers,
     ε = sqrt(ν/ω)/(a·√2)·(1 + (γ − 1)/√Pr) (Kirchhoff 1868; Pierce, Acoustics, 1989, §10-4); wide-tube limit
     (boundary layer ≪ a). Applied to the neck, where the air moves, it estimates how much lower a real taxel
-    sings than the lossless models: ~2 % on the paper's 2.1 mm neck at 5 kHz (DIGEST), more on smaller ones.
+    sings than the lossless models: ~2 % on the paper's 2.1 mm neck at 5 kHz (docs/physics.md), more on smaller ones.
     """
     omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
     a_m = np.asarray(neck_radius_mm, dtype=float) / 1e3

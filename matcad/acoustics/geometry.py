@@ -45,7 +45,7 @@ def drafted_cavity_volume_mm3(diameter_mm, length_mm, draft_deg):
     """As-cast cavity volume with core-pin draft: a frustum from D (neck side) narrowing over L (mm³).
 
     1° of draft on the paper's taxel removes 5.1 % of the volume: +2.7 % in f by the lumped V^-1/2 law
-    (DIGEST), +2.1 % by the transmission line.
+    (docs/physics.md), +2.1 % by the transmission line.
     """
     tip = drafted_tip_diameter_mm(diameter_mm, length_mm, draft_deg)
     return frustum_volume_mm3(diameter_mm, tip, length_mm)

@@ -42,7 +42,7 @@ def mount_end_correction_mm(neck_radius_mm, gap_mm, gap_radius_mm):
     """Outer end correction of a flanged mouth with a parallel surface (the air-supply mount) ``gap_mm`` below.
 
     Baffled correction plus the inertance of radial flow in the gap from r = a + h out to the gap's vent
-    radius R_g, expressed as neck length: a²/(2h)·ln(R_g/(a+h)) (DIGEST; radial-flow inertance
+    radius R_g, expressed as neck length: a²/(2h)·ln(R_g/(a+h)) (docs/physics.md; radial-flow inertance
     ρ ln(R2/R1)/(2πh)). Clipped at zero when a + h ≥ R_g. Tends to the baffled value as h grows (mm).
     """
     a = np.asarray(neck_radius_mm, dtype=float)

@@ -273,7 +273,7 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
             curve = tuple(LoadPoint(float(force), None if np.isnan(f) else float(f), invalid_reason(cal, force),
                                     source=f"calibration {cal.name} (Eq. 5)") for force, f in zip(forces_n, f_at))
             if cal.area_convention == MAT_PAPER_2024.area_convention:
-                warnings.append("load curve uses the paper's A = d^2/4 convention with its fitted V0 (see DIGEST); "
+                warnings.append("load curve uses the paper's A = d^2/4 convention with its fitted V0 (see docs/paper.md); "
                                 "its volumes are not physical cavity volumes")
     if len(forces_n) and mechanics:
         from matcad.mechanics.frequency import load_points

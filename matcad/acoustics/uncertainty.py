@@ -25,7 +25,7 @@ from matcad.acoustics.resonator import (CHEAP_MODELS, dynamic_moduli_pa, evaluat
                                         shear_moduli_pa, wall_arguments)
 
 NECK_DIAMETER_TOL_MM = {"laser": 0.1, "drilled": 0.02}
-"""Laser-cut acrylic holds ±0.1 mm (DIGEST); a pilot drilled to size ±0.02 mm."""
+"""Laser-cut acrylic holds ±0.1 mm (docs/physics.md); a pilot drilled to size ±0.02 mm."""
 MEASURED_SHEET_TOL_MM = 0.05
 """A calipered sheet."""
 CAVITY_DIAMETER_TOL_MM = {"fdm": 0.1, "sla": 0.05}

@@ -41,7 +41,7 @@ TABLE_AXES = {
 """Cap shapes in cavity radii (outer radius, top thickness, cavity length) and the clamped fraction of the cavity
 height; the paper template (b/a 2.52, T/a 1.26, L/a 3.0, clamp 0.34) lies on the grid."""
 QUASI_STATIC_RATIO = 3.0
-"""The quasi-static wall holds where every wall mode with volume coupling lies ≥ 3× f (DIGEST's published rule)."""
+"""The quasi-static wall holds where every wall mode with volume coupling lies ≥ 3× f (docs/physics.md)."""
 SIGNIFICANT_MODE = 0.02
 """A mode "couples" when it carries ≥ 2 % of the static volume compliance."""
 HYBRID_BAND = 0.15

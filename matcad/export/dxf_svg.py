@@ -36,7 +36,17 @@ def rounded_rect_points(x0, y0, x1, y1, r):
 
 
 def write_dxf(plan: CutPlan, path: Path) -> None:
-    """Write ``plan`` as DXF R2010 in mm."""
+    """Write ``plan`` as DXF R2010 in mm, byte-for-byte reproducible (no creation time, GUIDs or timestamps)."""
+    import ezdxf
+
+    fixed, ezdxf.options.write_fixed_meta_data_for_testing = ezdxf.options.write_fixed_meta_data_for_testing, True
+    try:
+        _write_dxf(plan, path)
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = fixed
+
+
+def _write_dxf(plan: CutPlan, path: Path) -> None:
     import ezdxf
     from ezdxf import units
 
@@ -58,6 +68,8 @@ def write_dxf(plan: CutPlan, path: Path) -> None:
         x0, y0, side = plan.reference_square
         msp.add_lwpolyline(rounded_rect_points(x0, y0, x0 + side, y0 + side, 0.0), format="xyb", close=True,
                            dxfattribs={"layer": "REFERENCE"})
+    for dxftype in sorted(doc.entitydb.dxf_types_in_use()):  # CLASSES in a fixed order, not set (hash) order
+        doc.classes.add_class(dxftype)
     doc.saveas(path)
 
 

@@ -22,7 +22,7 @@ PIN_FIT_ALLOWANCE_MM = {
 }
 """Finished hole diameter minus pin diameter (mm) by process and fit. FDM holes print ~0.1-0.2 mm undersize,
 so its nominal-size hole is already a press fit. A laser "press" hole is drawn at pin size, but laser-cut
-acrylic holds only ±0.1 mm (DIGEST): the design rules reject it. Laser values are for the hole as cut after
+acrylic holds only ±0.1 mm (docs/physics.md): the design rules reject it. Laser values are for the hole as cut after
 kerf compensation."""
 
 STOCK_ACRYLIC_MM = (1.0, 1.5, 1.59, 2.0, 2.5, 3.0, 3.18, 4.0, 4.76, 5.0, 6.0, 6.35, 8.0, 9.53, 10.0, 12.0,

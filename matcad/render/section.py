@@ -153,12 +153,18 @@ def _labels(spec, present: set[str], draw: _Drawing) -> None:
 
 
 def annotate_section(spec, path: Path) -> None:
-    """Add part labels and the design's dimensions (mm) to the section SVG at ``path``, growing its canvas."""
+    """Add part labels and the design's dimensions (mm) to the section SVG at ``path``, growing its canvas; each
+    layer's paths are put in a fixed order so the same spec always gives the same bytes."""
     ET.register_namespace("", SVG_NS)
     tree = ET.parse(path)
     root = tree.getroot()
     present = {g.get("id").rsplit("_", 1)[0] if g.get("id", "").startswith("spacer_") else g.get("id")
                for g in root.iter(f"{{{SVG_NS}}}g") if g.get("id")}
+    for g in root.iter(f"{{{SVG_NS}}}g"):  # the kernel's path order varies run to run; one layer's order is moot
+        paths = [el for el in g if el.tag == f"{{{SVG_NS}}}path"]
+        for el in paths:
+            g.remove(el)
+        g.extend(sorted(paths, key=lambda el: el.get("d", "")))
     x, y, w, h = (float(v) for v in root.get("viewBox").split())
     draw = _Drawing(font=max(0.5, 0.03 * max(w, h)))
     draw.box = [x, y, x + w, y + h]
@@ -176,4 +182,5 @@ def annotate_section(spec, path: Path) -> None:
     root.set("viewBox", f"{x0:.4f} {y0:.4f} {x1 - x0:.4f} {y1 - y0:.4f}")
     root.set("width", f"{x1 - x0:.4f}mm")
     root.set("height", f"{y1 - y0:.4f}mm")
+    ET.indent(tree, space="  ")
     tree.write(path, encoding="utf-8", xml_declaration=True)

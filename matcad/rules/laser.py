@@ -10,7 +10,7 @@ from matcad.parts.flat import Flat, drawn_holes
 from matcad.rules import Finding
 
 TAPER_RATIO = 0.7
-"""CO₂-laser holes smaller than ~0.7 × sheet thickness come out visibly tapered (DIGEST)."""
+"""CO₂-laser holes smaller than ~0.7 × sheet thickness come out visibly tapered (docs/physics.md)."""
 
 
 def _webs(flat: Flat) -> list[tuple[float, str]]:

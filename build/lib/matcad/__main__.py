@@ -1,0 +1,3 @@
+from matcad.cli import run
+
+run()

@@ -1,0 +1,1 @@
+"""Acoustic core: pure numpy, never imports a CAD kernel. Lengths in mm, frequencies in Hz."""

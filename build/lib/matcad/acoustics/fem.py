@@ -1,0 +1,371 @@
+"""Axisymmetric acoustic FEM reference (scikit-fem, P2 triangles). Lengths mm, wavenumbers 1/mm, f in Hz.
+
+Solves ∇·(r∇p) + k² r p = 0 in the (r, z) half-plane over the neck (0..l), the cavity (l..l+L, with core-pin
+draft) and the exterior below the plate (z < 0):
+- ``baffled``: a quarter disc of radius R around the mouth in a rigid baffle (the plate underside), with the
+  spherical radiation condition ∂p/∂n = −(ik + 1/R) p on the arc (exact for the monopole near field);
+- ``mount``: the spacer gap of height h between plate and mount out to the gap radius R_g, with the
+  cylindrical condition ∂p/∂n = −(ik + 1/(2R_g)) p on r = R_g.
+All other walls are rigid, except with ``wall_shear_modulus_pa``: the silicone cavity wall and closed end react
+locally with the quasi-static compliances of :func:`matcad.acoustics.models.soft_wall_length_scale`
+(∂p/∂n = k²·β·p, β = ρc²·u/p), which makes the FEM a reference for that model too.
+
+The radiation term depends on k, so the eigenproblem K + (ik + κ)C = k²M is solved by fixed-point iteration
+on k in the boundary term, each step a shift-invert Arnoldi solve near the current k. Of the modes found, the
+Helmholtz mode is the one with the largest share of its energy in the cavity (spurious exterior "box" modes
+have almost none), with Q = Re k / (2 |Im k|) above ``MIN_Q``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from matcad.acoustics.air import BULK_MODULUS_PA
+from matcad.acoustics.models import HALF_SPACE_MEAN_DISPLACEMENT, MM_PER_M
+
+DEFAULT_LEVEL = 8
+"""Elements across the neck radius; the paper taxel converges to < 0.1 % here (benchmarks/error_vs_runtime.py)."""
+EXTERIOR_RADIUS_PER_A = 15.0
+GROWTH = 1.25
+MIN_Q = 1.0
+FIXED_POINT_ITERATIONS = 6
+
+
+@dataclass(frozen=True)
+class FemGeometry:
+    """Everything the FEM needs (mm, Pa); build it from a spec with :func:`geometry_from_spec`."""
+
+    neck_radius: float
+    neck_length: float
+    cavity_radius: float
+    cavity_tip_radius: float
+    cavity_length: float
+    mouth: str
+    gap: float = 0.0
+    gap_radius: float = 0.0
+    wall_shear_modulus_pa: float | None = None
+    cap_outer_radius: float = 0.0
+
+
+@dataclass(frozen=True)
+class FemResult:
+    f0_hz: float
+    q: float
+    k_per_mm: complex
+    cavity_energy_fraction: float
+    dofs: int
+    triangles: int
+    level: int
+    seconds: float
+
+
+def geometry_from_spec(spec, shear_modulus_pa: float | None = None) -> FemGeometry:
+    """The FEM geometry of a spec (drafted cavity, mouth, gap); rigid walls unless a shear modulus is given."""
+    from matcad.acoustics.geometry import drafted_tip_diameter_mm
+
+    tip = float(drafted_tip_diameter_mm(spec.cavity.diameter, spec.cavity.length, spec.mold.draft_deg))
+    return FemGeometry(neck_radius=spec.neck.diameter / 2, neck_length=spec.neck.length,
+                       cavity_radius=spec.cavity.diameter / 2, cavity_tip_radius=tip / 2,
+                       cavity_length=spec.cavity.length, mouth=spec.neck.mouth, gap=spec.spacer.height,
+                       gap_radius=min(spec.plate.width, spec.plate.depth) / 2,
+                       wall_shear_modulus_pa=shear_modulus_pa, cap_outer_radius=spec.end_cap.outer_diameter / 2)
+
+
+# ---------------------------------------------------------------- mesh
+def _graded(start: float, stop: float, first: float, growth: float = GROWTH) -> np.ndarray:
+    """Nodes from start to stop, first cell ``first`` long, each next one ``growth`` times longer."""
+    nodes = [start]
+    step = first
+    while nodes[-1] + step < stop - 0.5 * step:
+        nodes.append(nodes[-1] + step)
+        step *= growth
+    nodes.append(stop)
+    return np.array(nodes)
+
+
+def _uniform(start: float, stop: float, h: float) -> np.ndarray:
+    return np.linspace(start, stop, max(1, math.ceil((stop - start) / h - 1e-9)) + 1)
+
+
+def _graded_span(start: float, stop: float, h: float, h_max: float, fine_start=True, fine_end=True) -> np.ndarray:
+    """Nodes from start to stop: cells of ``h`` at the fine end(s), growing with the distance d from the nearest
+    fine end as h + (GROWTH − 1)·d, capped at ``h_max``; marched, then scaled to end exactly at ``stop``."""
+    span = stop - start
+
+    def size(x):
+        d = min([x] * fine_start + [span - x] * fine_end, default=span)
+        return min(h_max, h + (GROWTH - 1.0) * d)
+
+    nodes = [0.0]
+    while nodes[-1] < span * (1 - 1e-9):
+        nodes.append(nodes[-1] + size(nodes[-1]))
+    return start + np.array(nodes) * (span / nodes[-1])
+
+
+def _grid_cells(points: np.ndarray, split_cross: bool):
+    """Triangles of a (nu+1) x (nv+1) grid of points (index i*(nv+1)+j); cross split adds centre points."""
+    nu, nv = points.shape[0] - 1, points.shape[1] - 1
+    flat = points.reshape(-1, 2)
+    idx = np.arange(flat.shape[0]).reshape(nu + 1, nv + 1)
+    a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
+    c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    if not split_cross:
+        return flat, np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    centre = (flat[a] + flat[b] + flat[c] + flat[d]) / 4
+    m = flat.shape[0] + np.arange(len(a))
+    tris = np.vstack([np.column_stack([a, b, m]), np.column_stack([b, c, m]),
+                      np.column_stack([c, d, m]), np.column_stack([d, a, m])])
+    return np.vstack([flat, centre]), tris
+
+
+def _block(r_of, zs: np.ndarray, s: np.ndarray):
+    """Structured block: point (r_of(s_i, z_j), z_j)."""
+    ss, zz = np.meshgrid(s, zs, indexing="ij")
+    return _grid_cells(np.stack([r_of(ss, zz), zz], axis=-1), split_cross=False)
+
+
+def _quarter_disc(radii: np.ndarray):
+    """Quarter disc below z = 0 whose nodes on both axes sit exactly at ``radii`` (Fong's square-to-disc
+    map, then a radial remap); cells are cross-split so the arc's corner cell has no sliver."""
+    n = len(radii) - 1
+    u = np.linspace(0.0, 1.0, n + 1)
+    uu, vv = np.meshgrid(u, u, indexing="ij")
+    x = uu * np.sqrt(1 - vv * vv / 2)
+    y = vv * np.sqrt(1 - uu * uu / 2)
+    rho = np.hypot(x, y)
+    scale = np.where(rho > 0, np.interp(rho, u, radii) / np.where(rho > 0, rho, 1.0), 0.0)
+    return _grid_cells(np.stack([x * scale, -y * scale], axis=-1), split_cross=True)
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The node lines the air mesh is built on (mm); the coupled cap mesh reuses them so both meshes share
+    nodes on the cavity wall."""
+
+    h: float
+    h_max: float
+    r_neck: np.ndarray
+    z_neck: np.ndarray
+    z_cavity: np.ndarray
+    s_annulus: np.ndarray
+
+
+def cavity_wall_radius(g: FemGeometry, z):
+    """Radius of the drafted cavity wall at height z (mm; z from the plate underside, cavity from l to l + L)."""
+    return g.cavity_radius + (z - g.neck_length) / g.cavity_length * (g.cavity_tip_radius - g.cavity_radius)
+
+
+def layout(g: FemGeometry, level: int = DEFAULT_LEVEL, cavity_breaks: tuple[float, ...] = ()) -> Layout:
+    """Node lines at ``level`` elements across the neck radius; ``cavity_breaks`` are heights (mm) that must be
+    node heights in the cavity (e.g. the top of the clamped flange); the nearest node line moves onto each."""
+    a, l, L = g.neck_radius, g.neck_length, g.cavity_length
+    h = a / level
+    # away from the two re-entrant corners (mouth edge, neck-to-cavity step) cells grow to a size set by the
+    # geometry's own scale, with P2 that keeps the smooth regions as accurate as the corners
+    h_max = max(h, min(l, L, 2 * g.cavity_radius) / 6)
+    z_cav = _graded_span(l, l + L, h, h_max, fine_end=False)
+    for z in cavity_breaks:
+        z_cav[1 + int(np.argmin(np.abs(z_cav[1:-1] - z)))] = z
+    width = g.cavity_radius - a
+    s = (_graded_span(0.0, width, min(h, width), max(min(h, width), h_max), fine_end=False) / width
+         if width > 1e-9 * a or g.cavity_tip_radius - a > 1e-9 * a else np.zeros(0))
+    return Layout(h, h_max, np.linspace(0.0, a, level + 1), _graded_span(0.0, l, h, h_max), z_cav, s)
+
+
+def air_blocks(g: FemGeometry, lay: Layout) -> list:
+    """The air's structured blocks (neck, cavity core, cavity annulus, exterior) as (points, triangles)."""
+    a = g.neck_radius
+    r_neck, z_cav = lay.r_neck, lay.z_cavity
+    blocks = [_block(lambda s, z: s, lay.z_neck, r_neck), _block(lambda s, z: s, z_cav, r_neck)]
+    if len(lay.s_annulus):
+        blocks.append(_block(lambda s_, z: a + s_ * (cavity_wall_radius(g, z) - a), z_cav, lay.s_annulus))
+    if g.mouth == "mount":
+        radii = np.concatenate([r_neck, _graded(a, g.gap_radius, lay.h)[1:]])
+        z_gap = _uniform(-g.gap, 0.0, max(lay.h, g.gap / 16))
+        blocks.append(_block(lambda s, z: s, z_gap, radii))
+    elif g.mouth == "baffled":
+        radii = np.concatenate([r_neck, _graded(a, EXTERIOR_RADIUS_PER_A * a, lay.h)[1:]])
+        blocks.append(_quarter_disc(radii))
+    else:
+        raise ValueError(f"mouth {g.mouth!r} invalid for the FEM, must be one of 'baffled', 'mount'")
+    return blocks
+
+
+def merge_blocks(blocks: list, h: float):
+    """One skfem MeshTri from (points, triangles) blocks, coincident nodes merged; also the first triangle index
+    of each block (so callers can tell subdomains apart)."""
+    from skfem import MeshTri
+
+    points, tris, offset, starts, count = [], [], 0, [], 0
+    for p, t in blocks:
+        points.append(p)
+        tris.append(t + offset)
+        offset += len(p)
+        starts.append(count)
+        count += len(t)
+    p = np.vstack(points)
+    key = np.round(p / (h * 1e-6)).astype(np.int64)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    t = inverse.ravel()[np.vstack(tris)]
+    return MeshTri(p[first].T.copy(), t.T.copy()), starts
+
+
+def mesh(g: FemGeometry, level: int = DEFAULT_LEVEL):
+    """The taxel's (r, z) mesh at ``level`` elements across the neck radius; returns a skfem MeshTri."""
+    lay = layout(g, level)
+    return merge_blocks(air_blocks(g, lay), lay.h)[0]
+
+
+def _arc_param(curve: np.ndarray) -> np.ndarray:
+    seg = np.hypot(*np.diff(curve, axis=0).T)
+    t = np.concatenate([[0.0], np.cumsum(seg)])
+    return t / t[-1]
+
+
+def deform_cavity(m, g: FemGeometry, wall_rz, end_rz):
+    """The mesh ``m`` of :func:`mesh` with its cavity (z > neck length) mapped onto a deformed cavity outline.
+
+    ``wall_rz`` (k, 2): the wall from its foot on the plate to the closed end's corner; ``end_rz`` (j, 2): the
+    closed end from that corner to the axis; both (r, z) in mm in the cap's frame (plate face z = 0), e.g. from
+    :mod:`matcad.mechanics`. Each cavity node at (s = r / wall radius, t = height / L) goes to the transfinite
+    (Coons) interpolation of the four sides (plate, axis, wall and end, each by normalised arc length).
+    Raises ValueError when the map folds a triangle (an outline too distorted for it).
+    """
+    from skfem import MeshTri
+
+    wall, end = np.asarray(wall_rz, dtype=float), np.asarray(end_rz, dtype=float)[::-1]
+    l, L = g.neck_length, g.cavity_length
+    r, z = m.p
+    inside = z > l + 1e-9 * L
+    t = (z[inside] - l) / L
+    s = r[inside] / (g.cavity_radius + t * (g.cavity_tip_radius - g.cavity_radius))
+
+    def on(curve, u):
+        param = _arc_param(curve)
+        return np.stack([np.interp(u, param, curve[:, 0]), np.interp(u, param, curve[:, 1])], axis=-1)
+
+    foot, corner, top_axis = wall[0], wall[-1], end[0]
+    bottom = np.stack([s * foot[0], np.zeros_like(s)], axis=-1)
+    axis = np.stack([np.zeros_like(t), t * top_axis[1]], axis=-1)
+    ss, tt = s[:, None], t[:, None]
+    mapped = ((1 - tt) * bottom + tt * on(end, s) + (1 - ss) * axis + ss * on(wall, t)
+              - (ss * (1 - tt) * foot + (1 - ss) * tt * top_axis + ss * tt * corner))
+    p = m.p.copy()
+    p[0, inside], p[1, inside] = mapped[:, 0], l + mapped[:, 1]
+    def signed_areas(q):
+        a, b, c = (q[:, m.t[i]] for i in range(3))
+        return (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+
+    if np.any(signed_areas(p) * np.sign(signed_areas(m.p)) <= 0):
+        raise ValueError("the deformed cavity outline folds the acoustic mesh (outline too distorted)")
+    return MeshTri(p, m.t)
+
+
+# ---------------------------------------------------------------- solve
+def _forms():
+    from skfem import BilinearForm
+    from skfem.helpers import dot, grad
+
+    @BilinearForm
+    def stiffness(u, v, w):
+        return dot(grad(u), grad(v)) * w.x[0]
+
+    @BilinearForm
+    def mass(u, v, w):
+        return u * v * w.x[0]
+
+    @BilinearForm
+    def weighted_mass(u, v, w):
+        return u * v * w.x[0] * w["weight"]
+
+    return stiffness, mass, weighted_mass
+
+
+def _boundary_facets(m, g: FemGeometry):
+    """(radiation facets, κ, cavity-wall facets, closed-end facets) by facet midpoints."""
+    mid = m.p[:, m.facets].mean(axis=1)
+    boundary = np.zeros(m.facets.shape[1], dtype=bool)
+    boundary[m.boundary_facets()] = True
+    r, z = mid
+    a, l, L = g.neck_radius, g.neck_length, g.cavity_length
+    tol = 1e-6 * a
+    if g.mouth == "baffled":
+        big_r = EXTERIOR_RADIUS_PER_A * a
+        radiation = boundary & (np.hypot(r, z) > 0.9 * big_r) & (z < -tol)
+        kappa = 1.0 / big_r
+    else:
+        radiation = boundary & (r > g.gap_radius - tol)
+        kappa = 1.0 / (2.0 * g.gap_radius)
+    top = boundary & (z > l + L - tol)
+    side = boundary & (z > l + tol) & (z < l + L - tol) & (r > tol)  # off the axis: the cavity's wall
+    return np.flatnonzero(radiation), kappa, np.flatnonzero(side), np.flatnonzero(top)
+
+
+def _wall_compliance(g: FemGeometry, r, kind: str):
+    """β = ρc² × wall displacement per pressure (mm), Lamé cylinder or half-space end (as models.py)."""
+    shear = g.wall_shear_modulus_pa
+    b = g.cap_outer_radius
+    if kind == "side":
+        return BULK_MODULUS_PA / shear * r / 2 * b * b / (b * b - r * r)
+    return np.full_like(r, BULK_MODULUS_PA / shear * HALF_SPACE_MEAN_DISPLACEMENT * g.cavity_tip_radius)
+
+
+def _eigs_near(a_mat, m_mat, sigma, count):
+    from scipy.sparse.linalg import LinearOperator, eigs, splu
+
+    lu = splu((a_mat - sigma * m_mat).tocsc())
+    op = LinearOperator(a_mat.shape, matvec=lambda x: lu.solve(m_mat @ x), dtype=complex)
+    nu, vecs = eigs(op, k=count, which="LM", tol=1e-12)
+    return sigma + 1.0 / nu, vecs
+
+
+def solve(g: FemGeometry, k_guess_per_mm: float, level: int = DEFAULT_LEVEL, speed_of_sound_m_s: float = 343.0,
+          modes: int = 6, cavity_outline=None) -> FemResult:
+    """The Helmholtz mode nearest ``k_guess_per_mm`` (e.g. the transmission-line estimate); with
+    ``cavity_outline`` = (wall_rz, end_rz), on that deformed cavity (:func:`deform_cavity`, rigid walls)."""
+    from skfem import Basis, ElementTriP2, FacetBasis, asm
+
+    t0 = time.perf_counter()
+    m = mesh(g, level)
+    if cavity_outline is not None:
+        if g.wall_shear_modulus_pa is not None:
+            raise ValueError("a deformed cavity outline takes rigid walls (wall_shear_modulus_pa = None)")
+        m = deform_cavity(m, g, *cavity_outline)
+    element = ElementTriP2()
+    basis = Basis(m, element)
+    stiffness, mass, weighted_mass = _forms()
+    k_mat = asm(stiffness, basis)
+    m_mat = asm(mass, basis)
+    radiation, kappa, side, top = _boundary_facets(m, g)
+    c_mat = asm(mass, FacetBasis(m, element, facets=radiation))
+    if g.wall_shear_modulus_pa is not None:
+        for facets, kind in ((side, "side"), (top, "top")):
+            fb = FacetBasis(m, element, facets=facets)
+            m_mat = m_mat + asm(weighted_mass, fb, weight=_wall_compliance(g, fb.global_coordinates()[0], kind))
+    cavity = (np.asarray(basis.global_coordinates()[1]) > g.neck_length).astype(float)
+    m_cav = asm(weighted_mass, basis, weight=cavity)
+
+    k = complex(k_guess_per_mm)
+    best = None
+    for _ in range(FIXED_POINT_ITERATIONS):
+        a_mat = (k_mat + (1j * k + kappa) * c_mat).astype(complex)
+        lam, vecs = _eigs_near(a_mat, m_mat, k * k, modes)
+        ks = np.sqrt(lam)
+        ks = np.where(ks.real < 0, -ks, ks)
+        energy = np.real(np.einsum("ij,ij->j", vecs.conj(), m_mat @ vecs))
+        fraction = np.real(np.einsum("ij,ij->j", vecs.conj(), m_cav @ vecs)) / energy
+        q = ks.real / (2 * np.abs(ks.imag) + 1e-300)
+        fraction = np.where((ks.real > 0) & (q > MIN_Q), fraction, -np.inf)
+        i = int(np.argmax(fraction))
+        converged = abs(ks[i] - k) <= 1e-10 * abs(k)
+        k, best = ks[i], (ks[i], float(fraction[i]), float(q[i]))
+        if converged:
+            break
+    k, fraction, q = best
+    f = speed_of_sound_m_s * MM_PER_M * k.real / (2 * math.pi)
+    return FemResult(f0_hz=float(f), q=q, k_per_mm=complex(k), cavity_energy_fraction=fraction, dofs=basis.N,
+                     triangles=m.t.shape[1], level=level, seconds=time.perf_counter() - t0)

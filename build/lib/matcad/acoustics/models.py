@@ -1,0 +1,181 @@
+"""The prediction ladder, cheapest first. Pure, vectorised functions (numpy arrays in, arrays out).
+
+Units: lengths mm, areas mm², volumes mm³, speed of sound m/s, shear modulus Pa, frequencies Hz.
+
+Rungs:
+1. :func:`lumped_hz` — paper Eq. 1 (Helmholtz/Rayleigh), optional c_f·ξ correction.
+2. :func:`end_corrected_hz` — Eq. 1 with the neck lengthened by its two end corrections.
+3. :func:`transmission_line_hz` — plane waves in neck and cavity (Selamet et al., JASA 101(1), 1997); the
+   default for rigid walls; valid from A ≪ S up to A = S.
+4. :func:`soft_wall_length_scale` feeds rung 3 with a quasi-static compliant wall (silicone cap).
+"""
+
+import numpy as np
+
+from matcad.acoustics.air import BULK_MODULUS_PA
+
+MM_PER_M = 1e3
+INGARD_XI_LIMIT = 0.4
+"""Ingard (1953) states his orifice correction for ξ = d/D < 0.4 only."""
+HALF_SPACE_MEAN_DISPLACEMENT = 16.0 * 0.75 / (3.0 * np.pi * 3.0)
+"""Mean normal displacement of an incompressible half-space under uniform pressure p on a disc of radius a,
+w̄ = 16(1-ν²) p a / (3π E) with ν = 1/2, E = 3G, i.e. 0.4244 p a / G (Johnson, Contact Mechanics, §3.4)."""
+
+
+def _c_mm_s(speed_of_sound_m_s):
+    return np.asarray(speed_of_sound_m_s, dtype=float) * MM_PER_M
+
+
+def baffled_end_correction_mm(neck_radius_mm):
+    """Outer end correction of a neck opening into an infinite flat baffle: 8a/(3π) ≈ 0.849a (mm), Rayleigh."""
+    return 8.0 * np.asarray(neck_radius_mm, dtype=float) / (3.0 * np.pi)
+
+
+def unflanged_end_correction_mm(neck_radius_mm):
+    """Outer end correction of a thin unflanged tube end: 0.6133a (mm), Levine & Schwinger 1948."""
+    return 0.6133 * np.asarray(neck_radius_mm, dtype=float)
+
+
+def mount_end_correction_mm(neck_radius_mm, gap_mm, gap_radius_mm):
+    """Outer end correction of a flanged mouth with a parallel surface (the air-supply mount) ``gap_mm`` below.
+
+    Baffled correction plus the inertance of radial flow in the gap from r = a + h out to the gap's vent
+    radius R_g, expressed as neck length: a²/(2h)·ln(R_g/(a+h)) (docs/physics.md; radial-flow inertance
+    ρ ln(R2/R1)/(2πh)). Clipped at zero when a + h ≥ R_g. Tends to the baffled value as h grows (mm).
+    """
+    a = np.asarray(neck_radius_mm, dtype=float)
+    h = np.asarray(gap_mm, dtype=float)
+    radial = a * a / (2.0 * h) * np.log(np.maximum(gap_radius_mm / (a + h), 1.0))
+    return baffled_end_correction_mm(a) + radial
+
+
+def mouth_end_correction_mm(mouth, neck_radius_mm, gap_mm, gap_radius_mm):
+    """Outer end correction for the spec's ``neck.mouth`` choice (mm)."""
+    if mouth == "baffled":
+        return baffled_end_correction_mm(neck_radius_mm)
+    if mouth == "unflanged":
+        return unflanged_end_correction_mm(neck_radius_mm)
+    if mouth == "mount":
+        return mount_end_correction_mm(neck_radius_mm, gap_mm, gap_radius_mm)
+    raise ValueError(f"mouth {mouth!r} invalid, must be one of 'baffled', 'unflanged', 'mount'")
+
+
+def ingard_end_correction_mm(neck_diameter_mm, cavity_diameter_mm):
+    """Inner (orifice-into-cavity) correction 0.48·sqrt(A)·(1 − 1.25ξ) (mm), Ingard, JASA 25, 1953.
+
+    Stated valid for ξ = d/D < 0.4 only; clipped at zero where the formula turns negative (ξ > 0.8).
+    """
+    d = np.asarray(neck_diameter_mm, dtype=float)
+    xi = d / cavity_diameter_mm
+    return np.maximum(0.48 * np.sqrt(np.pi) * d / 2.0 * (1.0 - 1.25 * xi), 0.0)
+
+
+def step_end_correction_mm(neck_diameter_mm, cavity_diameter_mm):
+    """Inner correction of an axisymmetric step d → D for the whole range 0 < ξ ≤ 1 (mm).
+
+    0.82a(1 − 1.35ξ + 0.31ξ³), Kergomard & Garcia, J. Sound Vib. 114(3), 1987: tends to the flanged value
+    0.82a as ξ → 0; clipped at zero near ξ = 1 where there is no step (the fit gives −0.033a there).
+    """
+    a = np.asarray(neck_diameter_mm, dtype=float) / 2.0
+    xi = 2.0 * a / cavity_diameter_mm
+    return np.maximum(0.82 * a * (1.0 - 1.35 * xi + 0.31 * xi**3), 0.0)
+
+
+def lumped_hz(speed_of_sound_m_s, neck_area_mm2, cavity_volume_mm3, neck_length_mm, c_f=0.0, xi=0.0):
+    """Helmholtz resonance, paper Eq. 1: f = c/(2π)·sqrt(A / (V_c·l·(1 + c_f·ξ))) (Hz).
+
+    With c_f = 0 (the default) this is the uncorrected lumped model; it assumes kl, kL ≪ 1 and
+    A·l ≪ V_c, and overestimates the paper's taxel by ~23 %.
+    """
+    return (_c_mm_s(speed_of_sound_m_s) / (2.0 * np.pi)
+            * np.sqrt(neck_area_mm2 / (cavity_volume_mm3 * neck_length_mm * (1.0 + c_f * xi))))
+
+
+def end_corrected_hz(speed_of_sound_m_s, neck_area_mm2, cavity_volume_mm3, effective_neck_length_mm):
+    """Eq. 1 (c_f = 0) with the neck's effective length l + δ_outer + δ_inner (Hz), Rayleigh/Ingard."""
+    return lumped_hz(speed_of_sound_m_s, neck_area_mm2, cavity_volume_mm3, effective_neck_length_mm)
+
+
+def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, rtol=1e-13, max_iter=100):
+    """Fundamental root k (1/mm) of tan(k·l)·tan(k·L) = r, with r = A/S (Selamet et al. 1997).
+
+    The fundamental is the only root with both tangents on their first branch, k in (0, π/(2M)), M = max(l, L).
+    In u = ln k, Φ(u) = ln tan(kl) + ln tan(kL) − ln r is increasing and convex there (d ln tan x / d ln x =
+    2x/sin 2x grows with x). The start is right of the root and left of the pole: the smaller of the lumped
+    guess sqrt(r/(lL)) (tan x ≥ x) and π·sqrt(r/(8mM + 4rM²)), m = min(l, L) (tan x ≥ 8x/(π² − 4x²) on
+    the longer segment). Newton in u therefore descends monotonically onto the fundamental in ~5 steps and
+    never jumps to an overtone; a bisection safeguard inside the bracket guards against rounding.
+    Broadcasts over array inputs.
+    """
+    r, ln, lc = np.broadcast_arrays(*(np.asarray(x, dtype=float)
+                                      for x in (area_ratio, neck_length_mm, cavity_length_mm)))
+    long, short = np.maximum(ln, lc), np.minimum(ln, lc)
+    lo = np.zeros_like(r)
+    hi = np.pi / (2.0 * long)
+    k = np.minimum(np.sqrt(r / (ln * lc)), np.pi * np.sqrt(r / (8.0 * short * long + 4.0 * r * long * long)))
+    for _ in range(max_iter):
+        t1, t2 = np.tan(k * ln), np.tan(k * lc)
+        phi = np.log(t1 * t2 / r)
+        dphi_du = k * (ln * (t1 + 1.0 / t1) + lc * (t2 + 1.0 / t2))
+        lo = np.where(phi < 0.0, k, lo)
+        hi = np.where(phi > 0.0, k, hi)
+        newton = k * np.exp(-phi / dphi_du)
+        k_new = np.where((newton >= lo) & (newton <= hi), newton, 0.5 * (lo + hi))
+        done = np.all(np.abs(k_new - k) <= rtol * k_new)
+        k = k_new
+        if done:
+            break
+    return k
+
+
+def transmission_line_hz(speed_of_sound_m_s, neck_area_mm2, cavity_area_mm2, effective_neck_length_mm,
+                         cavity_length_mm, wall_length_factor=1.0, wall_extra_length_mm=0.0):
+    """Fundamental of the neck + closed-cavity transmission line (Hz), Selamet et al., JASA 101(1), 1997.
+
+    Plane waves in a neck (area A, effective length l + end corrections, open end) and a cavity (area S,
+    length L, closed end); resonance where tan(k·l_eff)·tan(k·L) = A/S. Limits: the lumped Eq. 1 as
+    kl, kL → 0; a quarter-wave tube of length l_eff + L when A = S.
+
+    A compliant cavity wall (see :func:`soft_wall_length_scale`) slows waves in the cavity by
+    n = ``wall_length_factor`` and adds ``wall_extra_length_mm`` of closed-end compliance; the equation
+    becomes tan(k·l_eff)·tan(k·n·L') = A/(n·S) with L' = L + extra, the same form, solved the same way.
+    """
+    n = np.asarray(wall_length_factor, dtype=float)
+    r = np.asarray(neck_area_mm2, dtype=float) / (cavity_area_mm2 * n)
+    k = transmission_line_wavenumber(r, effective_neck_length_mm,
+                                     n * (np.asarray(cavity_length_mm, dtype=float) + wall_extra_length_mm))
+    return _c_mm_s(speed_of_sound_m_s) * k / (2.0 * np.pi)
+
+
+def soft_wall_length_scale(shear_modulus_pa, cavity_diameter_mm, cap_outer_diameter_mm):
+    """Quasi-static silicone-wall compliance as (n, ΔL) for :func:`transmission_line_hz`.
+
+    Assumptions (all stated, none hidden): incompressible linear-elastic silicone of shear modulus G; the
+    cylindrical wall deforms as a Lamé thick cylinder in plane strain with inner radius a and outer radius b
+    (ΔS/S = p/G · b²/(b² − a²)); the closed end deforms like a half-space loaded on a disc of radius a
+    (w̄ = 0.4244 p a/G); the acrylic neck is rigid; wall inertia is neglected, so the model holds below the
+    wall's own breathing resonance (:func:`wall_breathing_hz`).
+
+    The wall slows waves in the cavity (Korteweg): n² = 1 + (ρc²/G)·b²/(b² − a²); the end compliance is an
+    extra closed length ΔL = 0.4244·a·ρc²/(G·n²) (mm). Both → rigid (n = 1, ΔL = 0) as G → ∞.
+    """
+    g = np.asarray(shear_modulus_pa, dtype=float)
+    a = np.asarray(cavity_diameter_mm, dtype=float) / 2.0
+    b = np.asarray(cap_outer_diameter_mm, dtype=float) / 2.0
+    stiffness_ratio = BULK_MODULUS_PA / g
+    n2 = 1.0 + stiffness_ratio * b * b / (b * b - a * a)
+    extra = HALF_SPACE_MEAN_DISPLACEMENT * a * stiffness_ratio / n2
+    return np.sqrt(n2), extra
+
+
+def wall_breathing_hz(shear_modulus_pa, density_kg_m3, cavity_diameter_mm, cap_outer_diameter_mm):
+    """In-vacuo breathing resonance of an incompressible thick cylinder wall (Hz).
+
+    Lamé stiffness 4πG(b² − a²)/b² per unit length against the radial-flow kinetic mass
+    2πρ a² ln(b/a): ω² = 2G(1 − a²/b²) / (ρ a² ln(b/a)). Above it the wall acts as a mass, not a spring,
+    and the quasi-static soft-wall band no longer bounds the answer.
+    """
+    a = np.asarray(cavity_diameter_mm, dtype=float) / 2.0 / MM_PER_M
+    b = np.asarray(cap_outer_diameter_mm, dtype=float) / 2.0 / MM_PER_M
+    omega2 = 2.0 * shear_modulus_pa * (1.0 - a * a / (b * b)) / (density_kg_m3 * a * a * np.log(b / a))
+    return np.sqrt(omega2) / (2.0 * np.pi)

@@ -1,0 +1,114 @@
+"""Uncertainty budget of a prediction: one line per source, combined root-sum-square into the band (Hz).
+
+Sources: the chosen model's own error (measured against the converged FEM by
+benchmarks/error_vs_runtime.py, stored in model_errors.json), fabrication (neck diameter as cut or drilled,
+sheet thickness per ISO 7823-1 unless measured, printed cavity diameter, core-pin draft), air temperature,
+viscous/thermal boundary layers (one-sided: every model here is lossless) and the silicone's shear modulus. Each line re-evaluates the chosen model (or, for the FEM, the cheap model it
+refines) with that one input moved to the ends of its tolerance; lines are independent, so lows and highs
+add in quadrature separately, in ln f (relative shifts), which keeps a wide band above zero.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from matcad.acoustics.air import boundary_layer_drop
+from matcad.acoustics.resonator import CHEAP_MODELS, evaluate, resonator, shear_moduli_pa
+
+NECK_DIAMETER_TOL_MM = {"laser": 0.1, "drilled": 0.02}
+"""Laser-cut acrylic holds ±0.1 mm (docs/physics.md); a pilot drilled to size ±0.02 mm."""
+MEASURED_SHEET_TOL_MM = 0.05
+"""A calipered sheet."""
+CAVITY_DIAMETER_TOL_MM = {"fdm": 0.1, "sla": 0.05}
+DRAFT_TOL_DEG = 0.25
+TEMPERATURE_TOL_C = 3.0
+"""A lab's day-to-day swing; an explicit speed of sound is taken as exact."""
+
+
+@dataclass(frozen=True)
+class BudgetLine:
+    """One source: what varies, by how much, and the f shift at each end (Hz, low ≤ 0 ≤ high)."""
+
+    source: str
+    tolerance: str
+    low_hz: float
+    high_hz: float
+
+
+def model_errors() -> dict:
+    """Relative model errors against the converged FEM, as measured by benchmarks/error_vs_runtime.py."""
+    return json.loads((Path(__file__).parent / "model_errors.json").read_text(encoding="utf-8"))
+
+
+def _replace(spec, section: str, **values):
+    return dataclasses.replace(spec, **{section: dataclasses.replace(getattr(spec, section), **values)})
+
+
+def budget(spec, res, model: str, f0_hz: float) -> list[BudgetLine]:
+    """Every source's contribution for ``model`` at ``f0_hz``; ``res`` is ``resonator(spec)``."""
+    cheap = model if model in CHEAP_MODELS else ("soft_wall" if spec.wall.model == "silicone" else
+                                                 "transmission_line")
+    shear = shear_moduli_pa(spec)[1] if cheap == "soft_wall" else None
+    base = float(evaluate(res, cheap, shear))
+    scale = f0_hz / base  # sensitivities of the cheap model, applied to the chosen f0
+
+    def shifts(variants):
+        fs = [float(evaluate(resonator(v), cheap, shear)) * scale - f0_hz for v in variants]
+        return min(fs + [0.0]), max(fs + [0.0])
+
+    lines = []
+    error = model_errors()[model]
+    lines.append(BudgetLine("model", f"{model}: max |error| {100 * error['max_abs']:.2f} % vs FEM over "
+                                     f"{error['cases']} geometries", -error["max_abs"] * f0_hz,
+                            error["max_abs"] * f0_hz))
+    drilled = spec.plate.neck_pilot
+    tol = NECK_DIAMETER_TOL_MM["drilled" if drilled else "laser"]
+    d = spec.neck.diameter
+    # a neck smaller than the tolerance is a design-rule matter; here it may at most halve
+    d_variants = [_replace(spec, "neck", diameter=x) for x in (max(d - tol, d / 2), min(d + tol, spec.cavity.diameter))]
+    lines.append(BudgetLine("neck diameter", f"+-{tol:g} mm ({'drilled' if drilled else 'laser cut'})",
+                            *shifts(d_variants)))
+    t = spec.neck.length
+    tol = MEASURED_SHEET_TOL_MM if spec.plate.thickness_measured else 0.4 + 0.1 * t
+    what = "measured" if spec.plate.thickness_measured else "ISO 7823-1 cast sheet"
+    lines.append(BudgetLine("neck length (sheet)", f"+-{tol:.3g} mm ({what})",
+                            *shifts([_replace(spec, "neck", length=max(t - tol, 0.05 * t)),
+                                     _replace(spec, "neck", length=t + tol)])))
+    tol = CAVITY_DIAMETER_TOL_MM[spec.machine.printer]
+    D = spec.cavity.diameter
+    lines.append(BudgetLine("cavity diameter (core pin)", f"+-{tol:g} mm ({spec.machine.printer})",
+                            *shifts([_replace(spec, "cavity", diameter=max(D - tol, d)),
+                                     _replace(spec, "cavity", diameter=D + tol)])))
+    draft = spec.mold.draft_deg
+    max_draft = math.degrees(math.atan(D / (2 * spec.cavity.length))) * 0.99
+    lines.append(BudgetLine("core-pin draft", f"{draft:g} +-{DRAFT_TOL_DEG:g} deg",
+                            *shifts([_replace(spec, "mold", draft_deg=max(draft - DRAFT_TOL_DEG, 0.0)),
+                                     _replace(spec, "mold", draft_deg=min(draft + DRAFT_TOL_DEG, max_draft))])))
+    if spec.air.speed_of_sound is None:
+        temp = spec.air.temperature_c
+        lines.append(BudgetLine("air temperature", f"{temp:g} +-{TEMPERATURE_TOL_C:g} C",
+                                *shifts([_replace(spec, "air", temperature_c=max(temp - TEMPERATURE_TOL_C, -273.0)),
+                                         _replace(spec, "air", temperature_c=temp + TEMPERATURE_TOL_C)])))
+    drop = boundary_layer_drop(f0_hz, spec.neck.diameter / 2)
+    lines.append(BudgetLine("boundary layers", f"viscous + thermal, not in the lossless models: -{100 * drop:.1f} %",
+                            -drop * f0_hz, 0.0))
+    if cheap == "soft_wall":
+        g_lo, _, g_hi = shear_moduli_pa(spec)
+        fs = [float(evaluate(res, cheap, g)) * scale - f0_hz for g in (g_lo, g_hi)]
+        lines.append(BudgetLine("silicone shear modulus", f"{g_lo / 1e6:g}-{g_hi / 1e6:g} MPa",
+                                min(fs + [0.0]), max(fs + [0.0])))
+    return lines
+
+
+def total(lines: list[BudgetLine], f0_hz: float) -> tuple[float, float]:
+    """Lows and highs combined root-sum-square in ln f, as offsets from ``f0_hz`` (Hz): the same as a plain
+    root-sum-square of small shifts, and never below zero frequency when shifts are large."""
+    def rss(shifts):
+        return math.sqrt(sum(math.log1p(x / f0_hz) ** 2 for x in shifts))
+
+    return (f0_hz * (math.exp(-rss(x.low_hz for x in lines)) - 1.0),
+            f0_hz * (math.exp(rss(x.high_hz for x in lines)) - 1.0))

@@ -1,0 +1,171 @@
+"""The fast elastic-wall model: the silicone cap as a few wall modes (with mass, stiffness and loss) coupled to
+the transmission line. Pure numpy; no FEM at run time. Lengths mm, frequencies Hz, moduli Pa, compliances mm³/Pa.
+
+The cap's dynamic volume compliance (cavity volume swept per unit cavity pressure) is the modal sum with a static
+(mode-acceleration) correction for the modes left out:
+
+    C_w(ω) = (C_0 − Σ c_i)/(1 + iη) + Σ c_i / (1 + iη − ω²/ω_i²)
+
+with ω_i the cap's in-vacuo modes and c_i = Φ_i²/ω_i² their volume compliances (Φ_i: volume swept per unit
+mass-normalised amplitude), from the coupled FEM's elastic operator (:mod:`matcad.acoustics.fsi`) on a grid of cap
+shapes, shipped as wall_modes.json (built by benchmarks/wall_modes_table.py) and interpolated multilinearly.
+Linear elasticity scales them exactly: ω_i ∝ sqrt(G/ρ)/a and c_i ∝ a³/G. Below its modes the wall is a spring
+(C_w > 0, f down); above them a mass (C_w < 0, f up).
+
+The cavity is the transmission line of :func:`matcad.acoustics.models.transmission_line_hz` terminated at its
+closed end by the wall admittance iωC_w; the neck (with its end corrections) is driven at the mouth through the
+radiation resistance ρck²/(2π). As for the coupled FEM, the resonance reported is the peak of |p| at the
+cavity's closed end over frequency; the model returns f_TL × (peak with wall / peak with a rigid wall), so it
+tends exactly to the transmission line as G → ∞.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from matcad.acoustics.air import BULK_MODULUS_PA
+
+TABLE_PATH = Path(__file__).parent / "wall_modes.json"
+TABLE_AXES = {
+    "outer": (1.3, 1.6, 2.0, 2.52, 3.2, 4.0),
+    "top": (0.4, 0.8, 1.26, 2.0, 3.0),
+    "length": (1.0, 2.0, 3.0, 4.5, 7.0),
+    "clamp_fraction": (0.0, 0.17, 0.34, 0.5, 0.7),
+}
+"""Cap shapes in cavity radii (outer radius, top thickness, cavity length) and the clamped fraction of the cavity
+height; the paper template (b/a 2.52, T/a 1.26, L/a 3.0, clamp 0.34) lies on the grid."""
+QUASI_STATIC_RATIO = 3.0
+"""The quasi-static wall holds where every wall mode with volume coupling lies ≥ 3× f (docs/physics.md)."""
+SIGNIFICANT_MODE = 0.02
+"""A mode "couples" when it carries ≥ 2 % of the static volume compliance."""
+SWEEP = (0.5, 2.0, 601)
+UNIT_SHEAR_PA = 1e6
+UNIT_DENSITY = 1000.0
+"""The table's cap is at a = 1 mm, G = 1 MPa, ρ = 1000 kg/m³."""
+
+
+@dataclass(frozen=True)
+class CapShape:
+    """A cap in millimetres: cavity radius a, length L; outer radius b; top thickness T; clamped height t_c."""
+
+    cavity_radius: float
+    cavity_length: float
+    outer_radius: float
+    top_thickness: float
+    clamp_height: float
+
+
+@dataclass(frozen=True)
+class Modes:
+    """Wall modes of one cap at one (G, ρ): frequencies (Hz), volume compliances and static compliance (mm³/Pa)."""
+
+    frequencies_hz: np.ndarray
+    compliances_mm3_pa: np.ndarray
+    static_mm3_pa: float
+
+    def coupled_hz(self) -> np.ndarray:
+        """Frequencies of the modes that carry ≥ :data:`SIGNIFICANT_MODE` of the static compliance."""
+        return self.frequencies_hz[self.compliances_mm3_pa >= SIGNIFICANT_MODE * self.static_mm3_pa]
+
+
+@lru_cache(maxsize=1)
+def _table():
+    data = json.loads(TABLE_PATH.read_text(encoding="utf-8"))
+    shape = [len(TABLE_AXES[k]) for k in TABLE_AXES]
+    return (np.array(data["frequencies_hz"]).reshape(*shape, -1),
+            np.array(data["compliances_mm3_pa"]).reshape(*shape, -1), np.array(data["static_mm3_pa"]).reshape(shape))
+
+
+def shape_outside_table(shape: CapShape) -> list[str]:
+    """Names of the shape ratios outside the table's grid (they are clamped to its edge)."""
+    values = _ratios(shape)
+    return [name for name, v in zip(TABLE_AXES, values) if not TABLE_AXES[name][0] <= v <= TABLE_AXES[name][-1]]
+
+
+def _ratios(shape: CapShape):
+    a = shape.cavity_radius
+    return (shape.outer_radius / a, shape.top_thickness / a, shape.cavity_length / a,
+            min(shape.clamp_height / shape.cavity_length, 1.0))
+
+
+def modes(shape: CapShape, shear_modulus_pa: float, density_kg_m3: float) -> Modes:
+    """The cap's wall modes, interpolated multilinearly (in log of the ratios) from wall_modes.json and scaled
+    to its size, modulus (Pa) and density (kg/m³)."""
+    freqs, comps, static = _table()
+    weights = []
+    for name, v in zip(TABLE_AXES, _ratios(shape)):
+        axis = np.array(TABLE_AXES[name])
+        x = np.clip(v, axis[0], axis[-1])
+        i = int(np.clip(np.searchsorted(axis, x) - 1, 0, len(axis) - 2))
+        lo, hi = (axis[i], axis[i + 1]) if name == "clamp_fraction" else (math.log(axis[i]), math.log(axis[i + 1]))
+        t = ((x if name == "clamp_fraction" else math.log(x)) - lo) / (hi - lo)
+        weights.append(((i, 1 - t), (i + 1, t)))
+    f = np.zeros(freqs.shape[-1])
+    c = np.zeros(comps.shape[-1])
+    s = 0.0
+    for corner in np.ndindex(2, 2, 2, 2):
+        idx = tuple(weights[d][corner[d]][0] for d in range(4))
+        w = math.prod(weights[d][corner[d]][1] for d in range(4))
+        if w:
+            f += w * np.log(freqs[idx])
+            c += w * comps[idx]
+            s += w * static[idx]
+    a = shape.cavity_radius
+    return Modes(np.exp(f) * math.sqrt(shear_modulus_pa / UNIT_SHEAR_PA * UNIT_DENSITY / density_kg_m3) / a,
+                 c * a**3 * UNIT_SHEAR_PA / shear_modulus_pa, s * a**3 * UNIT_SHEAR_PA / shear_modulus_pa)
+
+
+def dynamic_compliance_mm3_pa(f_hz, wall: Modes, loss_factor: float):
+    """C_w(f) = ΔV/p of the cap (mm³/Pa, complex; time e^{iωt}): modal sum plus the static remainder."""
+    f = np.asarray(f_hz, dtype=float)[..., None]
+    g = 1.0 + 1j * loss_factor
+    modal = wall.compliances_mm3_pa / (g - (f / wall.frequencies_hz) ** 2)
+    return (wall.static_mm3_pa - wall.compliances_mm3_pa.sum()) / g + modal.sum(axis=-1)
+
+
+def _cavity_end_response(f_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall_compliance):
+    """|p| at the cavity's closed end per unit pressure at the mouth source (transfer matrices, mm, Pa, s)."""
+    c = c_m_s * 1e3
+    omega = 2 * np.pi * f_hz
+    k = omega / c
+    rho = BULK_MODULUS_PA / c**2
+    z_cav, z_neck = rho * c / cavity_area, rho * c / neck_area
+    p = np.ones_like(omega, dtype=complex)
+    u = 1j * omega * wall_compliance * p  # volume velocity into the wall at the closed end
+    kl = k * cavity_length
+    p, u = np.cos(kl) * p + 1j * z_cav * np.sin(kl) * u, 1j * np.sin(kl) / z_cav * p + np.cos(kl) * u
+    kl = k * neck_length_eff
+    p, u = np.cos(kl) * p + 1j * z_neck * np.sin(kl) * u, 1j * np.sin(kl) / z_neck * p + np.cos(kl) * u
+    return 1.0 / np.abs(p + rho * c * k * k / (2 * np.pi) * u)
+
+
+def _peak_hz(f_grid, response) -> float:
+    """Frequency of the largest value of ``response`` on the grid, refined by a parabola through 1/|H|²."""
+    i = int(np.clip(np.argmax(response), 1, len(f_grid) - 2))
+    y = 1.0 / response[i - 1:i + 2] ** 2
+    x = np.log(f_grid[i - 1:i + 2])
+    denom = y[0] - 2 * y[1] + y[2]
+    shift = 0.5 * (y[0] - y[2]) / denom if denom > 0 else 0.0
+    return float(np.exp(x[1] + np.clip(shift, -1, 1) * (x[2] - x[1])))
+
+
+def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
+               loss_factor: float) -> float:
+    """Peak of the cavity pressure with the elastic wall over the peak with a rigid wall (same network)."""
+    f = f_tl_hz * np.geomspace(*SWEEP[:2], SWEEP[2])
+    geometry = (c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length)
+    soft = _peak_hz(f, _cavity_end_response(f, *geometry, dynamic_compliance_mm3_pa(f, wall, loss_factor)))
+    rigid = _peak_hz(f, _cavity_end_response(f, *geometry, 0.0))
+    return soft / rigid
+
+
+def quasi_static_valid(wall: Modes, f_hz: float) -> bool:
+    """True where every wall mode with volume coupling lies ≥ :data:`QUASI_STATIC_RATIO` × f."""
+    coupled = wall.coupled_hz()
+    return bool(len(coupled) == 0 or coupled.min() >= QUASI_STATIC_RATIO * f_hz)

@@ -1,0 +1,127 @@
+"""spec → only the parts it asks for → a temporary folder → one atomic move into place → report.
+
+Nothing is ever half-written: files go to a hidden sibling folder of the target, and only a complete build
+replaces the target (the previous build is kept until the new one is in place). A spec whose outputs are all
+laser parts never imports the CAD kernel.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from matcad.acoustics.predict import Prediction, predict
+from matcad.output import staged_output
+from matcad.export.dxf_svg import write_dxf, write_svg
+from matcad.parts.catalogue import laser_parts, needs_cad_kernel, printed_parts
+from matcad.parts.flat import cut_plan
+from matcad.rules import Finding, check, errors
+
+
+UNFORCEABLE = ("laser.drawn_size",)
+"""Rule ids that --force cannot override: the file itself could not be written correctly."""
+
+
+class DesignRuleFailure(Exception):
+    """The spec breaks at least one design rule at level error."""
+
+    def __init__(self, findings: list[Finding]):
+        self.findings = findings
+        super().__init__("; ".join(f"{f.id}: {f.message}" for f in errors(findings)))
+
+
+@dataclass(frozen=True)
+class BuildResult:
+    out_dir: Path
+    files: tuple[str, ...]
+    findings: tuple[Finding, ...]
+    prediction: Prediction
+    report: dict
+
+
+def default_out_dir(spec, suffix: str = "", root: Path = Path("out")) -> Path:
+    return root / f"{spec.name}{suffix}"
+
+
+def write_laser_part(flat, spec, folder: Path) -> list[dict]:
+    """DXF + SVG of one laser part, kerf compensated; returns each hole as cut, with its compensation."""
+    plan = cut_plan(flat, spec.machine.laser_kerf, spec.outputs.reference_square)
+    write_dxf(plan, folder / f"{flat.name}.dxf")
+    write_svg(plan, folder / f"{flat.name}.svg")
+    return [{"part": flat.name, "purpose": c.purpose, "x_mm": c.x, "y_mm": c.y, "finished_mm": c.finished_diameter,
+             "drawn_mm": c.diameter, "compensation_mm": c.compensation} for c in plan.circles]
+
+
+def write_printed_part(name: str, solid, spec, folder: Path) -> dict:
+    """STL + STEP of one solid in its print pose (:data:`PRINT_POSES`); returns the STL's read-back checks,
+    the B-rep volume and the pose (bed face, design → print frame matrix)."""
+    from matcad.export.mesh import mesh_checks, write_step, write_stl
+    from matcad.parts.catalogue import PRINT_POSES, in_print_pose
+
+    posed, matrix = in_print_pose(name, solid)
+    stl = folder / f"{name}.stl"
+    write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance, matrix)
+    write_step(posed, folder / f"{name}.step")
+    pose = PRINT_POSES[name]
+    return mesh_checks(stl) | {"brep_volume_mm3": float(posed.volume), "printed": pose.printed,
+                               "bed_face": pose.bed_face, "rotation_x_deg": pose.rx_deg,
+                               "design_to_print": matrix}
+
+
+def _write_laser(spec, folder: Path) -> list[dict]:
+    """DXF + SVG per laser part; returns every hole as cut."""
+    return [hole for flat in laser_parts(spec) for hole in write_laser_part(flat, spec, folder)]
+
+
+def _write_solids(spec, folder: Path) -> dict[str, dict]:
+    """STL + STEP per printed part, assembly.step and section.svg; returns the STL read-back checks."""
+    from matcad.export.mesh import write_step
+
+    checks = {f"{name}.stl": write_printed_part(name, solid, spec, folder)
+              for name, solid in printed_parts(spec).items()}
+    if spec.outputs.assembly:
+        from matcad.parts.assembly import assembled_parts, assembly, write_section_svg
+
+        parts = assembled_parts(spec)
+        write_step(assembly(spec, parts), folder / "assembly.step")
+        write_section_svg(spec, folder / "section.svg", parts)
+    return checks
+
+
+def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:
+    """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
+    from matcad.render.kit import render_figures
+    from matcad.report import make_report, write_report
+
+    prediction = predict(spec)
+    findings = check(spec, prediction)
+    blocking = [f for f in errors(findings) if not force or f.id in UNFORCEABLE]
+    if blocking:
+        raise DesignRuleFailure(findings)
+    target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
+    with staged_output(target) as tmp:
+        holes = _write_laser(spec, tmp)
+        meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
+        figures = render_figures(spec, prediction, tmp, meshes)
+        report = make_report(spec, prediction, findings, holes, meshes, tmp) | {"figures": figures}
+        write_report(report, tmp)
+    files = tuple(sorted(p.name for p in target.iterdir()))
+    return BuildResult(target, files, tuple(findings), prediction, report)
+
+
+def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
+    """Write the laser and printed test coupons to ``out_dir`` (default out/<name>-coupon) with a hole table."""
+    import json
+
+    from matcad.parts.coupon import laser_coupon, printed_coupon, printed_coupon_holes
+
+    target = Path(out_dir) if out_dir is not None else default_out_dir(spec, "-coupon")
+    with staged_output(target) as tmp:
+        laser = write_laser_part(laser_coupon(spec), spec, tmp)
+        mesh = write_printed_part("coupon_printed", printed_coupon(spec), spec, tmp)
+        table = {"name": spec.name, "laser_kerf_mm": spec.machine.laser_kerf, "printer": spec.machine.printer,
+                 "laser_holes": laser, "mesh": mesh,
+                 "printed_holes": [{"purpose": h.purpose, "x_mm": h.x, "y_mm": h.y, "diameter_mm": h.diameter}
+                                   for h in printed_coupon_holes(spec)]}
+        (tmp / "report.json").write_text(json.dumps(table, indent=2) + "\n", encoding="utf-8")
+    return target, table

@@ -1,0 +1,517 @@
+"""Command line. Thin: parse, call one function, print text or --json, map errors to exit codes.
+
+Exit codes: 0 ok; 1 design-rule failure, or for analyze/calibrate/sense no trustworthy result (no tone, a
+tone at the band edge, degenerate data, a force outside the calibrated range); 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from matcad import __version__
+
+EXIT_OK, EXIT_RULES, EXIT_INPUT = 0, 1, 2
+
+
+def _print_json(data) -> None:
+    import json
+
+    print(json.dumps(data, indent=2, allow_nan=False))
+
+
+def _load_spec(path, args):
+    """The validated spec at ``path`` (TOML or a build's report.json) with ``--set`` applied; likely unit slips
+    and silent defaults are printed to stderr as notes (never changing a value)."""
+    from matcad.plausibility import spec_notes
+    from matcad.spec_input import load_spec
+
+    spec, data = load_spec(path, getattr(args, "set", None))
+    for note in spec_notes(spec, data):
+        print(f"matcad: note: {note}", file=sys.stderr)
+    return spec
+
+
+def _format_prediction(spec, p) -> str:
+    cav, neck = spec.cavity, spec.neck
+    lines = [
+        f"{spec.name}: cavity D {cav.diameter:g} x L {cav.length:g} mm, neck d {neck.diameter:g} x "
+        f"l {neck.length:g} mm, mouth {neck.mouth}, wall {spec.wall.model}",
+        f"  cavity volume   {p.cavity_volume_mm3:10.4f} mm^3    neck area {p.neck_area_mm2:.4f} mm^2",
+        f"  A*l/V           {p.neck_air_ratio:10.4f}         xi = d/D  {p.diameter_ratio:.4f}",
+        f"  speed of sound  {p.speed_of_sound_m_s:10.2f} m/s     end corrections: outer "
+        f"{p.outer_end_correction_mm:.3f} mm, inner {p.inner_end_correction_mm:.3f} mm",
+        "",
+        f"  {'model':<18} {'f0 [Hz]':>9}  {'valid':<5}  failed checks",
+    ]
+    for name, r in p.models.items():
+        failed = ", ".join(k for k, ok in r.checks.items() if not ok) or "-"
+        mark = "*" if name == p.model else " "
+        lines.append(f"{mark} {name:<18} {r.f0_hz:9.1f}  {'yes' if r.valid else 'no':<5}  {failed}")
+    lines += ["", f"  f0 = {p.f0_hz:.0f} Hz ({p.model}), band {p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz "
+                  "(root-sum-square in ln f of):"]
+    lines += [f"    {b.source:<28} {b.tolerance:<52} {b.low_hz:+8.1f} {b.high_hz:+8.1f} Hz" for b in p.budget]
+    if p.load_curve:
+        lines += ["", f"  load curve, paper Eq. 5, calibration {p.calibration}:", f"  {'F [N]':>9} {'f [Hz]':>9}"]
+        for pt in p.load_curve:
+            value = f"{pt.f_hz:9.1f}" if pt.f_hz is not None else f"{'n/a':>9}  {pt.reason}"
+            lines.append(f"  {pt.force_n:9.3f} {value}")
+    if p.warnings:
+        lines += ["", "  warnings:"] + [f"  - {w}" for w in p.warnings]
+    return "\n".join(lines)
+
+
+def cmd_predict(args) -> int:
+    from matcad.acoustics.predict import predict
+
+    if args.fem_level is not None and args.model != "fem":
+        raise ValueError(f"--fem-level {args.fem_level} applies only with --model fem (it sets the FEM's mesh)")
+    if args.fem_level is not None and not 1 <= args.fem_level <= 64:
+        raise ValueError(f"--fem-level {args.fem_level} invalid, must be 1-64 elements across the neck radius")
+    if args.force_deprecated:
+        print("matcad: note: predict --force is deprecated (it clashed with build --force); use --load",
+              file=sys.stderr)
+    spec = _load_spec(args.spec, args)
+    result = predict(spec, forces_n=args.load or args.force_deprecated or (), model=args.model,
+                     fem_level=args.fem_level)
+    if args.json:
+        _print_json(result.to_dict())
+    else:
+        print(_format_prediction(spec, result))
+    return EXIT_OK
+
+
+def _format_findings(findings) -> str:
+    if not findings:
+        return "  no findings"
+    return "\n".join(f"  {f.level:<7} {f.id:<24} {f.message}" + (f"\n  {'':<7} {'':<24} fix: {f.fix}" if f.fix
+                                                                  and f.level != "info" else "")
+                     for f in findings)
+
+
+def cmd_check(args) -> int:
+    from matcad.rules import check, errors
+
+    findings = check(_load_spec(args.spec, args))
+    if args.json:
+        _print_json({"findings": [f.to_dict() for f in findings],
+                     "verdict": "fail" if errors(findings) else "pass"})
+    else:
+        print(_format_findings(findings))
+    return EXIT_RULES if errors(findings) else EXIT_OK
+
+
+def cmd_build(args) -> int:
+    from matcad.build import DesignRuleFailure, build
+
+    spec = _load_spec(args.spec, args)
+    try:
+        result = build(spec, out_dir=args.out, force=args.force)
+    except DesignRuleFailure as exc:
+        if args.json:
+            _print_json({"verdict": "fail", "written": [], "findings": [f.to_dict() for f in exc.findings]})
+        else:
+            print(_format_findings([f for f in exc.findings if f.level == "error"]))
+            print("matcad: design-rule errors: nothing written (fix the spec or use --force)", file=sys.stderr)
+        return EXIT_RULES
+    if args.json:
+        _print_json({"verdict": result.report["verdict"], "out_dir": str(result.out_dir),
+                     "written": list(result.files), "f0_hz": result.prediction.f0_hz,
+                     "band_hz": list(result.prediction.band_hz),
+                     "findings": [f.to_dict() for f in result.findings]})
+    else:
+        p = result.prediction
+        print(f"{spec.name}: {len(result.files)} files in {result.out_dir}/")
+        for name in result.files:
+            print(f"  {name}")
+        print(f"f0 = {p.f0_hz:.0f} Hz ({p.model}), band {p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz; "
+              f"verdict {result.report['verdict']}")
+        print(_format_findings([f for f in result.findings if f.level != "info"]))
+    return EXIT_OK
+
+
+def cmd_coupon(args) -> int:
+    from matcad.build import build_coupon
+
+    target, table = build_coupon(_load_spec(args.spec, args), out_dir=args.out)
+    if args.json:
+        _print_json({"out_dir": str(target), **table})
+    else:
+        print(f"coupons in {target}/: coupon_laser.dxf/.svg (neck and dowel sweeps, engraved sizes), "
+              "coupon_printed.stl/.step (needle bores and dowel holes, ascending left to right)")
+    return EXIT_OK
+
+
+def _band(args):
+    if args.band:
+        lo, hi = args.band
+        if not (0 <= lo < hi):
+            raise ValueError(f"--band {lo:g} {hi:g} invalid, must be 0 <= LO < HI (Hz)")
+        return lo, hi
+    if args.spec:
+        from matcad.acoustics.predict import predict
+        from matcad.loop.analyze import band_from_prediction
+
+        return band_from_prediction(predict(_load_spec(args.spec, args)).band_hz)
+    raise ValueError("analyze needs --spec SPEC (its predicted band) or --band LO HI (Hz)")
+
+
+def _recording_blocks(args):
+    """(sample blocks, rate Hz, name) of the recording argument: a WAV file read in blocks, or '-' for standard
+    input (WAV, or raw PCM with --format/--rate)."""
+    from matcad.loop import wav
+
+    if str(args.recording) == "-":
+        stream = sys.stdin.buffer
+        info = wav.stream_info(stream, getattr(args, "rate", None), getattr(args, "format", None),
+                               getattr(args, "channels", 1))
+        return wav.iter_stream(stream, info), info.sample_rate_hz, "standard input"
+    if getattr(args, "format", None):
+        raise ValueError("--format/--rate describe raw PCM on standard input: give the recording as '-'")
+    info = wav.read_info(args.recording)
+    return wav.iter_blocks(args.recording, info), info.sample_rate_hz, str(args.recording)
+
+
+def _loop_output(args, kind: str, source: str) -> Path:
+    from matcad.loop.outputs import output_folder
+
+    return output_folder(args.out, kind, source)
+
+
+def _print_segments(analysis, forces=None) -> None:
+    for i, seg in enumerate(analysis.segments):
+        line = (f"  {seg.start_s:8.2f}-{seg.end_s:8.2f} s  {seg.mean_hz:9.2f} Hz (sd {seg.std_hz:5.2f})")
+        if forces is not None and seg.flag == "":
+            f, lo, hi = forces[i]
+            line += f"  F = {f:.3f} N (95 %: {lo:.3f} .. {hi:.3f})" if f == f else "  outside the calibrated range"
+        print(line + (f"  [{seg.flag}]" if seg.flag else ""))
+
+
+def cmd_analyze(args) -> int:
+    from matcad.loop.analyze import analyze_stream, plot, write_segments_csv, write_track_csv
+    from matcad.output import staged_output
+
+    band = _band(args)
+    blocks, fs, name = _recording_blocks(args)
+    result = analyze_stream(blocks, fs, [band])[0]
+    target = _loop_output(args, "analyze", name)
+    with staged_output(target) as tmp:
+        write_track_csv(result, tmp / "track.csv")
+        write_segments_csv(result, tmp / "segments.csv")
+        plot(result, tmp / "spectrogram.png")
+        _write_json(tmp / "report.json", {"recording": name, **result.to_dict()})
+    if args.json:
+        _print_json({**result.to_dict(), "out_dir": str(target)})
+    else:
+        print(f"{name}: mean {result.mean_hz:.2f} Hz, median {result.median_hz:.2f} Hz, sd {result.std_hz:.2f} Hz "
+              f"over {int(result.voiced.sum())} voiced of {len(result.track_hz)} frames (tone "
+              f"{100 * result.tone_fraction:.0f} %); line {result.snr_db:.1f} dB over the floor, prominence "
+              f"{result.prominence_db:.1f} dB (band {result.band_hz[0]:.0f}-{result.band_hz[1]:.0f} Hz)")
+        print(f"  {len(result.segments)} steady segments:")
+        _print_segments(result)
+        for w in result.warnings:
+            print(f"  warning: {w}")
+        print(f"  track.csv, segments.csv, spectrogram.png, report.json in {target}/")
+    return EXIT_OK
+
+
+def cmd_calibrate(args) -> int:
+    from matcad.loop.calibrate import fit_from_spec, plot, read_csv
+    from matcad.output import staged_output
+    from matcad.plausibility import frequency_notes
+
+    spec = _load_spec(args.spec, args)
+    if args.temperature_c is not None and not -60.0 <= args.temperature_c <= 100.0:
+        raise ValueError(f"--temperature-c {args.temperature_c:g} invalid, must be -60 to 100 degC")
+    if args.cycle_std_n is not None and not 0.0 <= args.cycle_std_n <= 100.0:
+        raise ValueError(f"--cycle-std-n {args.cycle_std_n:g} invalid, must be 0-100 N")
+    forces, freqs, cycles = read_csv(args.data)
+    for note in frequency_notes(freqs, f"{args.data} frequency_hz"):
+        print(f"matcad: note: {note}", file=sys.stderr)
+    cal = fit_from_spec(forces, freqs, spec, k_free=args.k_free, cycles=cycles, temperature_c=args.temperature_c,
+                        cycle_std_n=args.cycle_std_n)
+    target = _loop_output(args, "calibrate", str(args.data))
+    with staged_output(target) as tmp:
+        (tmp / "calibration.toml").write_text(cal.to_toml(), encoding="utf-8")
+        plot(cal, tmp / "residuals.png")
+        _write_json(tmp / "report.json", {"data": str(args.data), "spec": spec.name, **cal.to_dict()})
+    if args.json:
+        _print_json({**cal.to_dict(), "out_dir": str(target)})
+    else:
+        d = cal.to_dict()
+        print(f"Eq. 5 fit to {d['points']} points, {d['force_range_n'][0]:g}-{d['force_range_n'][1]:g} N "
+              f"({'K free, V0 = as-built cavity' if cal.k_free else 'K from the as-built geometry'}):")
+        for name in ("v0", "b", "a"):
+            value = d["v0_mm3"] if name == "v0" else d[name]
+            lo, hi = d[f"{name}_ci95"]
+            print(f"  {name:<3}= {value:.6g} +- {d[name + '_se']:.3g}  (95 %: {lo:.6g} .. {hi:.6g})")
+        print(f"  residual RMS {d['residual_rms_hz']:.2f} Hz; between cycles {cal.cycle_std_n:.3g} N "
+              f"({cal.cycles} cycle(s)); at {cal.temperature_c:g} degC")
+        for note in cal.notes:
+            print(f"  note: {note}")
+        print(f"  calibration.toml, residuals.png in {target}/")
+    return EXIT_OK
+
+
+def cmd_sense(args) -> int:
+    import numpy as np
+
+    from matcad.loop.analyze import analyze_stream, plot, write_segments_csv
+    from matcad.loop.sense import SensorCalibration, force_with_interval, require_in_range, sense
+    from matcad.output import staged_output
+    from matcad.spec import load_calibration
+
+    cal = SensorCalibration.from_spec_calibration(load_calibration(args.calibration))
+    cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
+    f_lo, f_hi = cal.frequency_range_hz()
+    blocks, fs, name = _recording_blocks(args)
+    on_frame = None
+    if args.live:
+        def on_frame(_, time_s, freq, _excess):
+            if freq == freq:
+                force, half = force_with_interval(cal, [freq], temperature_c=args.temperature_c)
+                text = (f"F = {force[0]:.3f} +- {half[0]:.3f} N" if np.isfinite(force[0])
+                        else "outside the calibrated range")
+                print(f"{time_s:9.3f} s  {freq:9.2f} Hz  {text}", flush=True)
+            else:
+                print(f"{time_s:9.3f} s  no tone", flush=True)
+    result = analyze_stream(blocks, fs, [(0.8 * f_lo, 1.25 * f_hi)], on_frame)[0]
+    reading = sense(result, cal, args.temperature_c)
+    target = _loop_output(args, "sense", name) if not (args.live and args.out is None) else None
+    if target is not None:
+        with staged_output(target) as tmp:
+            write_segments_csv(result, tmp / "segments.csv", reading.segments_n)
+            rows = ["time_s,frequency_hz,force_n,force_low_n,force_high_n"]
+            for t, f, force, (lo, hi), v in zip(result.times_s, result.track_hz, reading.frames_n,
+                                                reading.frames_interval_n, result.voiced):
+                cells = [f"{t:.6f}", f"{f:.4f}" if v else ""] + ["" if not np.isfinite(c) else f"{c:.4f}"
+                                                                 for c in (force, lo, hi)]
+                rows.append(",".join(cells))
+            (tmp / "forces.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+            plot(result, tmp / "force.png", (reading.frames_n, *reading.frames_interval_n.T))
+            _write_json(tmp / "report.json", {"recording": name, "calibration": str(args.calibration),
+                                              **reading.to_dict(), "analysis": result.to_dict(),
+                                              "segment_forces_n": [[None if not np.isfinite(v) else float(v)
+                                                                    for v in row] for row in reading.segments_n]})
+    warnings = list(result.warnings) + list(reading.warnings)
+    if args.json:
+        frames = [{"time_s": float(t), "frequency_hz": float(f) if v else None,
+                   "force_n": None if np.isnan(force) else float(force),
+                   "force_interval_n": None if np.isnan(force) else [float(lo), float(hi)]}
+                  for t, f, v, force, (lo, hi) in zip(result.times_s, result.track_hz, result.voiced,
+                                                      reading.frames_n, reading.frames_interval_n)]
+        segments = [{**seg.to_dict(), "force_n": None if not np.isfinite(f) else float(f),
+                     "force_interval_n": None if not np.isfinite(f) else [float(lo), float(hi)]}
+                    for seg, (f, lo, hi) in zip(result.segments, reading.segments_n)]
+        _print_json({**reading.to_dict(), "tone_fraction": result.tone_fraction, "warnings": warnings,
+                     "segments": segments, "frames": frames,
+                     "out_dir": None if target is None else str(target)})
+    else:
+        if np.isfinite(reading.force_n):
+            lo, hi = reading.force_interval_n
+            print(f"{name}: F = {reading.force_n:.3f} N (95 %: {lo:.3f} .. {hi:.3f} N) at "
+                  f"{reading.frequency_hz:.2f} Hz; {int(np.sum(np.isfinite(reading.frames_n)))} of "
+                  f"{len(reading.frames_n)} frames with a force (tone in {100 * result.tone_fraction:.0f} %)")
+        print(f"  {len(result.segments)} steady segments:")
+        _print_segments(result, reading.segments_n)
+        for w in warnings:
+            print(f"  warning: {w}")
+        if target is not None:
+            print(f"  forces.csv, segments.csv, force.png, report.json in {target}/")
+    require_in_range(reading)
+    return EXIT_OK
+
+
+def _write_json(path: Path, data) -> None:
+    import json
+
+    path.write_text(json.dumps(data, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+
+
+def cmd_schema(args) -> int:
+    from matcad.spec import schema
+
+    rows = schema()
+    if args.json:
+        _print_json(rows)
+        return EXIT_OK
+    for row in rows:
+        default = "(required)" if row["required"] else f"default {row['default']!r}"
+        unit = f" [{row['unit']}]" if row["unit"] else ""
+        print(f"{row['key']}{unit}  {default}\n    {row['doc']}\n    allowed: {row['allowed']}")
+    return EXIT_OK
+
+
+def cmd_init(args) -> int:
+    from matcad.init import new_spec
+
+    try:
+        path = new_spec(args.name, args.template, args.out)
+    except FileExistsError as exc:
+        raise ValueError(f"{exc.filename}: exists; refusing to overwrite it (choose another NAME or --out)") from None
+    if args.json:
+        _print_json({"spec": str(path), "template": args.template})
+    else:
+        print(f"{path}: a copy of the {args.template} template named {args.name!r}; edit it, then "
+              f"`matcad predict {path}` and `matcad build {path}`")
+    return EXIT_OK
+
+
+def cmd_completion(args) -> int:
+    from matcad.completion import script
+
+    print(script(_parser(), args.shell), end="")
+    return EXIT_OK
+
+
+def cmd_serve(args) -> int:
+    from matcad.serve import DEFAULT_PORT, HOST, make_server
+
+    port = DEFAULT_PORT if args.port is None else args.port
+    if not 0 <= port <= 65535:
+        raise ValueError(f"--port {port} invalid, must be 0-65535 (0 picks a free port)")
+    server = make_server(port)
+    print(f"matcad design page on http://{HOST}:{server.server_address[1]}/ (local only; Ctrl-C stops it)",
+          flush=True)
+    try:
+        server.serve_forever()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.server_close()
+    return EXIT_OK
+
+
+def _parser() -> argparse.ArgumentParser:
+    import matcad
+
+    parser = argparse.ArgumentParser(prog="matcad", description=matcad.__doc__,
+                                     epilog="exit codes: 0 ok; 1 design-rule error or no trustworthy result; "
+                                            "2 bad input")
+    parser.add_argument("--version", action="version", version=f"matcad {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    def command(name, func, help_text, out_default=None):
+        cmd = sub.add_parser(name, help=help_text)
+        cmd.set_defaults(func=func)
+        cmd.add_argument("--json", action="store_true", help="print JSON instead of text")
+        if out_default:
+            cmd.add_argument("--out", type=Path, help=f"output folder (default {out_default})")
+        return cmd
+
+    def spec_arg(cmd, flag=None, **kw):
+        """The spec argument (positional, or ``flag``) and --set overrides, for every spec-taking command."""
+        cmd.add_argument(flag or "spec", help="spec TOML file, or a build's report.json (its resolved spec)", **kw)
+        cmd.add_argument("--set", action="append", metavar="KEY=VALUE",
+                         help="override one spec field, value as TOML (e.g. --set neck.diameter=2.0); repeatable")
+
+    p = command("predict", cmd_predict, "predict the taxel's resonance frequency from a spec")
+    spec_arg(p)
+    p.add_argument("--load", type=float, nargs="+", metavar="F",
+                   help="normal loads in N: add paper Eq. 5 f(F) using the spec's [calibration]")
+    p.add_argument("--force", dest="force_deprecated", type=float, nargs="+", metavar="F",
+                   help="deprecated spelling of --load")
+    p.add_argument("--model", help="use this model's f0 instead of the automatic choice ('fem' adds the FEM)")
+    p.add_argument("--fem-level", type=int, help="FEM mesh refinement: elements across the neck radius (default 8)")
+
+    spec_arg(command("check", cmd_check, "run the design rules without building (exit 1 on errors)"))
+
+    b = command("build", cmd_build, "write the fabrication kit and report to out/<name>/", "out/<name>")
+    spec_arg(b)
+    b.add_argument("--force", action="store_true", help="build despite design-rule errors")
+
+    spec_arg(command("coupon", cmd_coupon, "test coupons sweeping neck, dowel and needle-bore sizes",
+                     "out/<name>-coupon"))
+
+    a = command("analyze", cmd_analyze, "the taxel's frequency in a recording (spectrogram ridge)",
+                "out/analyze-<recording>-<hash>")
+    a.add_argument("recording", help="WAV file (mono/stereo; 8-32-bit integer or float; any sample rate), or "
+                                     "'-' for standard input")
+    group = a.add_mutually_exclusive_group()
+    group.add_argument("--spec", help="spec TOML: analyse its predicted band (-10 %% / +25 %% for load)")
+    group.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="analysis band in Hz")
+    a.add_argument("--set", action="append", metavar="KEY=VALUE", help="override one field of --spec (TOML value)")
+
+    c = command("calibrate", cmd_calibrate, "fit paper Eq. 5 to force/frequency pairs, with uncertainty",
+                "out/calibrate-<data>-<hash>")
+    c.add_argument("data", help="CSV with force_n and frequency_hz columns (and optionally cycle: several load "
+                                "cycles give the between-cycle variance)")
+    spec_arg(c, "--spec", required=True)
+    c.add_argument("--k-free", action="store_true", help="fix V0 to the as-built cavity and fit K instead")
+    c.add_argument("--temperature-c", type=float, help="air temperature during calibration (degC; default the "
+                                                       "spec's [air] temperature_c), recorded for `sense`")
+    c.add_argument("--cycle-std-n", type=float, help="between-cycle (hysteresis) sd in N assumed when DATA holds "
+                                                     "one load cycle (default 0.7, from the paper's ~1 N)")
+
+    n = command("sense", cmd_sense, "force from a recording through a calibration, with 95 %% intervals",
+                "out/sense-<recording>-<hash>")
+    n.add_argument("recording", help="WAV file, or '-' for standard input (WAV, or raw PCM with --format --rate)")
+    n.add_argument("--calibration", required=True, help="calibration.toml from `matcad calibrate`, or a spec")
+    n.add_argument("--temperature-c", type=float, help="air temperature now (degC): frequencies are scaled by "
+                                                       "sqrt(T_cal/T) to the calibration's temperature")
+    n.add_argument("--live", action="store_true", help="print each frame's force as it is decided (~1 s lag); "
+                                                       "no output folder unless --out")
+    for cmd in (a, n):
+        cmd.add_argument("--format", choices=("s16le", "s24le", "s32le", "u8", "f32le", "f64le"),
+                         help="raw PCM sample format on standard input (default: a WAV header is expected)")
+        cmd.add_argument("--rate", type=float, help="raw PCM sample rate (Hz)")
+        cmd.add_argument("--channels", type=int, default=1, help="raw PCM channels (default 1), averaged")
+
+    command("schema", cmd_schema, "print every spec field with unit, default and allowed range")
+
+    i = command("init", cmd_init, "start a new spec from a shipped template (never overwrites)")
+    i.add_argument("name", help="design name (also the file name NAME.toml and the build folder out/NAME)")
+    i.add_argument("--from", dest="template", default="mat-paper",
+                   help="template: mat-paper (default), mat-laser-only, mat-sla-array")
+    i.add_argument("--out", type=Path, help="spec file to write (default NAME.toml)")
+
+    sh = sub.add_parser("completion", help="print a shell completion script (bash; zsh via bashcompinit)")
+    sh.set_defaults(func=cmd_completion)
+    sh.add_argument("shell", choices=("bash", "zsh"))
+
+    sv = sub.add_parser("serve", help="a local design page: the spec as a form, live prediction, build to a zip")
+    sv.set_defaults(func=cmd_serve)
+    sv.add_argument("--port", type=int, help="port on 127.0.0.1 (default 8765; 0 picks a free one)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    from matcad.errors import OutputError
+    from matcad.loop import LoopError
+    from matcad.spec import SpecError
+
+    try:
+        return args.func(args)
+    except SpecError as exc:
+        print(f"matcad: spec error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except OutputError as exc:
+        print(f"matcad: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except LoopError as exc:
+        print(f"matcad: {exc}", file=sys.stderr)
+        return EXIT_RULES
+    except OSError as exc:  # unwritable output folder, unreadable input: the user's file system, not a bug
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"matcad: error: {where}{exc.strerror or exc} (check the path and its permissions)", file=sys.stderr)
+        return EXIT_INPUT
+    except ValueError as exc:
+        print(f"matcad: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours
+        sys.stdout = open(os.devnull, "w")
+        return EXIT_OK
+
+
+def run() -> None:
+    """Console entry point. After a command that loaded OpenCASCADE, every output file is closed and moved into
+    place, yet interpreter teardown would spend 0.3-0.7 s destroying kernel objects: flush and leave at once."""
+    code = main()
+    if "OCP" in sys.modules:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)

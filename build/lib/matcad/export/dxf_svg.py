@@ -1,0 +1,115 @@
+"""DXF and SVG writers for laser cut plans. Units mm everywhere; one layer / colour per operation.
+
+DXF: $INSUNITS = 4 (mm), native CIRCLE, closed LWPOLYLINE outlines with bulge arcs (no splines), layers
+CUT_INNER, CUT_OUTER, ENGRAVE, REFERENCE with distinct ACI colours; inner cuts are written first so a laser
+that follows file order cuts holes before freeing the part.
+SVG: width/height in mm with a matching viewBox (1 user unit = 1 mm), one stroke colour per operation — for
+Glowforge-class lasers that read SVG, not DXF.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from xml.sax.saxutils import escape
+
+from matcad.parts.flat import CutPlan
+
+LAYERS = {
+    # name: (DXF ACI colour, SVG stroke, meaning)
+    "CUT_INNER": (5, "#0000ff", "cut through, inner features (holes) first"),
+    "CUT_OUTER": (1, "#ff0000", "cut through, part outlines last"),
+    "ENGRAVE": (3, "#00a000", "engrave/score, do not cut through"),
+    "REFERENCE": (6, "#ff00ff", "10 mm reference square to check scale on import; do not cut"),
+}
+QUARTER_BULGE = math.tan(math.pi / 8)  # bulge of a 90° arc
+
+
+def rounded_rect_points(x0, y0, x1, y1, r):
+    """Closed rounded rectangle as (x, y, bulge) vertices, counter-clockwise (mm)."""
+    r = max(0.0, min(r, (x1 - x0) / 2, (y1 - y0) / 2))
+    if r == 0:
+        return [(x0, y0, 0.0), (x1, y0, 0.0), (x1, y1, 0.0), (x0, y1, 0.0)]
+    b = QUARTER_BULGE
+    return [(x0 + r, y0, 0.0), (x1 - r, y0, b), (x1, y0 + r, 0.0), (x1, y1 - r, b),
+            (x1 - r, y1, 0.0), (x0 + r, y1, b), (x0, y1 - r, 0.0), (x0, y0 + r, b)]
+
+
+def write_dxf(plan: CutPlan, path: Path) -> None:
+    """Write ``plan`` as DXF R2010 in mm, byte-for-byte reproducible (no creation time, GUIDs or timestamps)."""
+    import ezdxf
+
+    fixed, ezdxf.options.write_fixed_meta_data_for_testing = ezdxf.options.write_fixed_meta_data_for_testing, True
+    try:
+        _write_dxf(plan, path)
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = fixed
+
+
+def _write_dxf(plan: CutPlan, path: Path) -> None:
+    import ezdxf
+    from ezdxf import units
+
+    doc = ezdxf.new("R2010", setup=False)
+    doc.units = units.MM
+    doc.header["$INSUNITS"] = 4
+    doc.header["$MEASUREMENT"] = 1
+    for name, (aci, _, meaning) in LAYERS.items():
+        doc.layers.add(name, color=aci).description = meaning
+    msp = doc.modelspace()
+    for c in plan.circles:
+        msp.add_circle((c.x, c.y), c.diameter / 2, dxfattribs={"layer": "CUT_INNER"})
+    for t in plan.texts:
+        msp.add_text(t.text, height=t.height, dxfattribs={"layer": "ENGRAVE", "insert": (t.x, t.y)})
+    for x0, y0, x1, y1, r in plan.outlines:
+        msp.add_lwpolyline(rounded_rect_points(x0, y0, x1, y1, r), format="xyb", close=True,
+                           dxfattribs={"layer": "CUT_OUTER"})
+    if plan.reference_square:
+        x0, y0, side = plan.reference_square
+        msp.add_lwpolyline(rounded_rect_points(x0, y0, x0 + side, y0 + side, 0.0), format="xyb", close=True,
+                           dxfattribs={"layer": "REFERENCE"})
+    for dxftype in sorted(doc.entitydb.dxf_types_in_use()):  # CLASSES in a fixed order, not set (hash) order
+        doc.classes.add_class(dxftype)
+    doc.saveas(path)
+
+
+def _svg_rounded_rect(x0, y0, x1, y1, r) -> str:
+    # SVG y grows downward: mirror y so the drawing matches the DXF
+    r = max(0.0, min(r, (x1 - x0) / 2, (y1 - y0) / 2))
+    top, bottom = -y1, -y0
+    arc = f"A {r:.6f} {r:.6f} 0 0 1"
+    return (f"M {x0 + r:.6f} {top:.6f} H {x1 - r:.6f} {arc} {x1:.6f} {top + r:.6f} V {bottom - r:.6f} "
+            f"{arc} {x1 - r:.6f} {bottom:.6f} H {x0 + r:.6f} {arc} {x0:.6f} {bottom - r:.6f} "
+            f"V {top + r:.6f} {arc} {x0 + r:.6f} {top:.6f} Z")
+
+
+def write_svg(plan: CutPlan, path: Path) -> None:
+    """Write ``plan`` as SVG with mm size and a 1 unit = 1 mm viewBox; a group per operation."""
+    x0, y0, x1, y1 = plan.extents
+    margin = 1.0
+    vx, vy = x0 - margin, -y1 - margin
+    w, h = x1 - x0 + 2 * margin, y1 - y0 + 2 * margin
+    stroke = {name: colour for name, (_, colour, _) in LAYERS.items()}
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
+           f'<svg xmlns="http://www.w3.org/2000/svg" width="{w:.6f}mm" height="{h:.6f}mm" '
+           f'viewBox="{vx:.6f} {vy:.6f} {w:.6f} {h:.6f}">',
+           f"<title>{escape(plan.flat.name)} ({plan.flat.thickness:g} mm sheet, kerf {plan.kerf:g} mm "
+           "compensated)</title>"]
+    group = 'fill="none" stroke-width="0.1"'
+    out.append(f'<g id="CUT_INNER" stroke="{stroke["CUT_INNER"]}" {group}>')
+    out += [f'<circle cx="{c.x:.6f}" cy="{-c.y:.6f}" r="{c.diameter / 2:.6f}"/>' for c in plan.circles]
+    out.append("</g>")
+    if plan.texts:
+        out.append(f'<g id="ENGRAVE" fill="{stroke["ENGRAVE"]}" stroke="none">')
+        out += [f'<text x="{t.x:.6f}" y="{-t.y:.6f}" font-size="{t.height:.6f}" font-family="sans-serif">'
+                f"{escape(t.text)}</text>" for t in plan.texts]
+        out.append("</g>")
+    out.append(f'<g id="CUT_OUTER" stroke="{stroke["CUT_OUTER"]}" {group}>')
+    out += [f'<path d="{_svg_rounded_rect(*o)}"/>' for o in plan.outlines]
+    out.append("</g>")
+    if plan.reference_square:
+        sx, sy, side = plan.reference_square
+        out.append(f'<g id="REFERENCE" stroke="{stroke["REFERENCE"]}" {group}>'
+                   f'<rect x="{sx:.6f}" y="{-(sy + side):.6f}" width="{side:.6f}" height="{side:.6f}"/></g>')
+    out.append("</svg>")
+    Path(path).write_text("\n".join(out) + "\n", encoding="utf-8")

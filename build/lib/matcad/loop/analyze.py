@@ -1,0 +1,613 @@
+"""Frequency of a taxel's tone from a recording, frame by frame, in blocks (bounded memory, live streams).
+
+The paper used MATLAB spectrogram + tfridge and a pspectrum peak in 4–5.5 kHz. Here, per frame (Hann window
+~93 ms, 2× zero padding, 50 % overlap; :class:`Framer`):
+
+1. *Strength over the local floor.* Each bin's power is divided by the running median of the power over
+   ±:data:`FLOOR_BINS`/2 bins (≈ ±170 Hz) around it: the excess in dB. The median follows coloured noise (pink,
+   brown, a speech or fan hump) where a band-wide mean would not. Under white or smoothly coloured noise a bin's
+   power is exponential, its median μ·ln 2, so P(excess > x dB) = exp(−ln 2 · 10^(x/10)) per bin.
+2. *Mains combs removed.* A line with lines of similar level (within :data:`COMB_LEVEL_DB`) at ±Δ and ±2Δ
+   (Δ = 50, 60, 100 or 120 Hz; 3 of the 4 places) belongs to hum or buzz, not to a taxel, whose neighbours are
+   not a comb: its bins are removed before tracking.
+3. *Ridge with a jump allowance.* A Viterbi path through the excess: moving Δ bins costs
+   :data:`JUMP_PENALTY_DB`·Δ² up to :data:`MAX_STEP_BINS`, any larger jump a flat :data:`JUMP_COST_DB` — so the
+   ridge follows a slow wobble smoothly, re-acquires after a gap and follows a press that jumps 300 Hz between
+   frames. Decisions are made with a fixed lag of :data:`LAG_FRAMES` frames (~1 s), which bounds memory.
+4. *Voicing.* A frame is voiced (the tone is there) when the ridge stands ≥ :data:`STRONG_DB` over the floor
+   (white noise: P(false alarm) < 1e-7 per frame by the exponential law; measured 0 in tests/test_loop.py), or ≥ :data:`WEAK_DB` in a
+   run of ≥ :data:`MIN_RUN` frames whose ridge stays within ±:data:`STABLE_BINS` bins (a narrow stable line:
+   speech harmonics at 4–6 kHz glide and smear, noise peaks do not persist). The threshold is a strength and a
+   stability, never a fraction of the file: 1 s of clear tone in a 10 min file is found.
+5. *Segments.* Voiced frames are cut into steady segments at gaps and at steps larger than :data:`STEP_HZ`
+   between frames; a segment that sits more than :data:`MODE_JUMP_RATIO` above or below the one before it,
+   without a ramp in between, cannot be a press (Eq. 5 spans ~+11 % from 0 to 25 N): it is flagged as a mode
+   jump (overblowing) and its frames are left out of the statistics.
+6. *Other sources.* A second stable line in the band (a neighbouring taxel) is reported with its frequency and
+   level; a stronger tone outside the band (hum, a harmonic) is reported, never taken.
+
+Frequencies Hz, times s, levels dB.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from matcad.loop import LoopError
+
+WINDOW_S = 0.093
+"""~4096 samples at 44.1 kHz: ~11 Hz resolution (5.4 Hz bins with 2× padding), 46 ms between frames."""
+ZERO_PAD = 2
+FLOOR_BINS = 63
+"""Width of the running median that sets the local noise floor (≈ 340 Hz at 44.1 kHz)."""
+EXCLUDE_BINS = 6
+"""Bins either side of a line that belong to it (Hann main lobe is ±4 bins at 2× padding)."""
+JUMP_PENALTY_DB = 1.0
+MAX_STEP_BINS = 4
+JUMP_COST_DB = 14.0
+"""Any jump wider than MAX_STEP_BINS costs this once: a tone ≥ STRONG_DB repays it in one frame, noise does not."""
+LAG_FRAMES = 20
+STRONG_DB = 15.0
+"""White noise: P(excess > 15 dB) = exp(−ln2·31.6) ≈ 3e-10 per bin, < 1e-7 per frame over ~280 bins."""
+WEAK_DB = 8.0
+MIN_RUN = 5
+STABLE_BINS = 2
+COMB_SPACINGS_HZ = (50.0, 60.0, 100.0, 120.0)
+COMB_LEVEL_DB = 10.0
+COMB_GRID_FRACTION = 0.6
+COMB_ZONE_BINS = 3
+HARMONIC_SPACING_HZ = (80.0, 400.0)
+HARMONIC_LINE_DB = 8.0
+"""Speech pitch range: a line with lines of similar level at ±Δ and ±2Δ for Δ in this range is a harmonic."""
+LINE_DB = 6.0
+"""A local maximum this far over the floor counts as a line in the comb and second-source tests."""
+STEP_HZ = 12.0
+"""Frame-to-frame change that ends a steady segment (a ±20 Hz wobble over 2.5 s moves ≤ 2.5 Hz per frame; a
+2→12 N press ramped in 0.2 s moves ~60 Hz per frame)."""
+MIN_SEGMENT_FRAMES = 3
+MAX_GAP_FRAMES = 1
+MODE_JUMP_RATIO = 1.11
+JUMP_GAP_FRAMES = 8
+"""A jump across at most this many frames (~0.37 s) with no voiced frame between the two levels is abrupt."""
+SECOND_SOURCE_FRACTION = 0.25
+EDGE_BINS = 2
+PLOT_COLUMNS = 1200
+
+
+@dataclass(frozen=True)
+class Segment:
+    """A steady stretch of the tone: start and end (s), frames, mean/median/sd of frequency (Hz), and a flag
+    ('' or why its frames are not the taxel's load-bearing tone)."""
+
+    start_s: float
+    end_s: float
+    frames: int
+    mean_hz: float
+    median_hz: float
+    std_hz: float
+    flag: str = ""
+
+    def to_dict(self) -> dict:
+        return {"start_s": self.start_s, "end_s": self.end_s, "frames": self.frames, "mean_hz": self.mean_hz,
+                "median_hz": self.median_hz, "std_hz": self.std_hz, "flag": self.flag}
+
+
+@dataclass(frozen=True)
+class Source:
+    """Another line in the band: median frequency (Hz), median level relative to the tracked tone (dB) and the
+    fraction of voiced frames it was present in."""
+
+    frequency_hz: float
+    relative_db: float
+    fraction: float
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """Result of :func:`analyze`: statistics over voiced frames, the per-frame track, segments and warnings."""
+
+    mean_hz: float
+    median_hz: float
+    std_hz: float
+    snr_db: float
+    prominence_db: float
+    tone_fraction: float
+    band_hz: tuple[float, float]
+    sample_rate_hz: float
+    duration_s: float
+    times_s: np.ndarray = field(repr=False)
+    track_hz: np.ndarray = field(repr=False)
+    frame_snr_db: np.ndarray = field(repr=False)
+    voiced: np.ndarray = field(repr=False)
+    """True where the tone is present and is the taxel's (not a flagged mode jump)."""
+    segments: tuple[Segment, ...] = ()
+    sources: tuple[Source, ...] = ()
+    plot_times_s: np.ndarray = field(repr=False, default=None)
+    plot_freqs_hz: np.ndarray = field(repr=False, default=None)
+    plot_db: np.ndarray = field(repr=False, default=None)  # frequency × column, max-pooled in time
+    warnings: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict:
+        return {"mean_hz": self.mean_hz, "median_hz": self.median_hz, "std_hz": self.std_hz,
+                "snr_db": self.snr_db, "prominence_db": self.prominence_db, "tone_fraction": self.tone_fraction,
+                "band_hz": list(self.band_hz), "sample_rate_hz": self.sample_rate_hz,
+                "duration_s": self.duration_s, "frames": int(len(self.track_hz)),
+                "voiced_frames": int(np.sum(self.voiced)), "segments": [s.to_dict() for s in self.segments],
+                "other_sources": [{"frequency_hz": s.frequency_hz, "relative_db": s.relative_db,
+                                   "fraction": s.fraction} for s in self.sources],
+                "warnings": list(self.warnings)}
+
+
+def window_samples(fs: float) -> int:
+    """Window length (samples): the power of two nearest WINDOW_S."""
+    return max(64, int(2 ** round(np.log2(WINDOW_S * fs))))
+
+
+class Framer:
+    """Blocks of samples in, Hann-windowed power spectra (frames × frequency, one-sided PSD) out.
+
+    Frame k covers samples [k·hop, k·hop + n); its time is its centre. Only frames lying wholly inside the input
+    are produced. Keeps at most one window of samples between calls.
+    """
+
+    def __init__(self, fs: float, n: int | None = None):
+        self.fs = float(fs)
+        self.n = n or window_samples(fs)
+        self.hop = self.n // 2
+        self.mfft = ZERO_PAD * self.n
+        self.window = np.hanning(self.n + 1)[:-1]
+        self.scale = 2.0 / (self.fs * np.sum(self.window**2))
+        self.freqs = np.fft.rfftfreq(self.mfft, 1.0 / self.fs)
+        self._carry = np.zeros(0)
+        self._next = 0  # index of the next frame
+
+    def feed(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(frame times s, power frames × bins) for every frame completed by ``x``."""
+        buf = np.concatenate([self._carry, np.asarray(x, dtype=float)])
+        count = 0 if len(buf) < self.n else (len(buf) - self.n) // self.hop + 1
+        if count == 0:
+            self._carry = buf
+            return np.zeros(0), np.zeros((0, len(self.freqs)))
+        idx = np.arange(count)[:, None] * self.hop + np.arange(self.n)[None, :]
+        power = np.abs(np.fft.rfft(buf[idx] * self.window, n=self.mfft, axis=1)) ** 2 * self.scale
+        times = ((self._next + np.arange(count)) * self.hop + self.n / 2) / self.fs
+        self._next += count
+        self._carry = buf[count * self.hop:]
+        return times, power
+
+
+class BandTracker:
+    """One taxel's tone in one band, frame by frame: floor, comb removal, ridge, voicing, segments.
+
+    ``push(times, power)`` takes frames from a :class:`Framer`; ``finish()`` returns the :class:`Analysis`.
+    The arrays kept grow by five numbers per frame (~0.1 MB per minute of audio); the plot is max-pooled to at
+    most 2·PLOT_COLUMNS columns. ``on_frame`` (optional) is called with (time s, frequency Hz or NaN, excess dB)
+    as each frame's voicing becomes final, for live output.
+    """
+
+    def __init__(self, freqs: np.ndarray, fs: float, band_hz: tuple[float, float], on_frame=None):
+        nyquist = fs / 2
+        lo, hi = max(0.0, band_hz[0]), min(band_hz[1], nyquist)
+        if not lo < hi:
+            raise ValueError(f"band {band_hz[0]:g}-{band_hz[1]:g} Hz invalid for a {fs:g} Hz recording "
+                             f"(must lie below {nyquist:g} Hz)")
+        self.fs, self.band = fs, (lo, hi)
+        self.df = float(freqs[1] - freqs[0])
+        self.in_band = np.flatnonzero((freqs >= lo) & (freqs <= hi))
+        if len(self.in_band) < 2 * EXCLUDE_BINS + 3:
+            raise ValueError(f"band {lo:g}-{hi:g} Hz is narrower than the analysis needs "
+                             f"({(2 * EXCLUDE_BINS + 3) * self.df:.0f} Hz)")
+        margin = max(FLOOR_BINS // 2, int(np.ceil(2 * max(COMB_SPACINGS_HZ) / self.df)) + 2)
+        self.slab = np.arange(max(0, self.in_band[0] - margin), min(len(freqs), self.in_band[-1] + margin + 1))
+        self.offset = int(self.in_band[0] - self.slab[0])
+        self.freqs = freqs
+        self.on_frame = on_frame
+        nb = len(self.in_band)
+        self._score = np.zeros(nb)
+        self._back: list[np.ndarray] = []
+        self._pending: list[_Frame] = []  # frames whose bin is not yet decided (≤ LAG_FRAMES)
+        self._pending_rows: list[tuple] = []
+        self._run: list[int] = []  # indices of the current candidate run
+        self._first = True
+        self.times, self.track, self.excess, self.state, self.other_bin, self.other_excess = [], [], [], [], [], []
+        self.other_level = []
+        self._voice_done = 0  # frames whose voicing is final
+        self._plot_cols: list[np.ndarray] = []
+        self._plot_times: list[float] = []
+        self._pool = 1
+        self._pool_acc: list[np.ndarray] = []
+        self._steps = np.arange(-MAX_STEP_BINS, MAX_STEP_BINS + 1)
+        self._step_cost = JUMP_PENALTY_DB * self._steps.astype(float) ** 2
+        self.band_peak_power = np.zeros(nb)
+
+    # --- per block --------------------------------------------------------------------------------------------
+    def push(self, times: np.ndarray, power: np.ndarray) -> None:
+        if len(times) == 0:
+            return
+        from scipy.ndimage import maximum_filter1d, median_filter
+
+        tiny = np.finfo(float).tiny
+        slab = power[:, self.slab]
+        floor = median_filter(slab, size=(1, FLOOR_BINS), mode="nearest")
+        excess_slab = 10 * np.log10((slab + tiny) / (floor + tiny))
+        log_slab = 10 * np.log10(slab + tiny)
+        nb = len(self.in_band)
+        band = slice(self.offset, self.offset + nb)
+        # lines: local maxima LINE_DB over the floor
+        is_max = (excess_slab >= maximum_filter1d(excess_slab, 3, axis=1)) & (excess_slab >= LINE_DB)
+        lines = np.where(is_max, excess_slab, -np.inf)
+        comb_zone = maximum_filter1d(self._mains_comb(lines).astype(np.uint8), 2 * COMB_ZONE_BINS + 1,
+                                     axis=1).astype(bool)
+        emit = np.where(comb_zone[:, band], 0.0, np.clip(excess_slab[:, band], 0.0, None))
+        band_lines = np.where(comb_zone[:, band], -np.inf, lines[:, band])
+        self.band_peak_power += slab[:, band].sum(axis=0)
+        self._plot(times, log_slab[:, band])
+        for i in range(len(times)):
+            self._step(float(times[i]), emit[i], log_slab[i, band], excess_slab[i, band], band_lines[i],
+                       lines[i])
+
+    def _mains_comb(self, lines: np.ndarray) -> np.ndarray:
+        """Lines (frames × slab bins) that sit on a mains grid m·S (S = 50, 60, 100, 120 Hz) which hosts lines at
+        ≥ COMB_GRID_FRACTION of its places in the frame, unless COMB_LEVEL_DB above the grid's median line."""
+        from scipy.ndimage import maximum_filter1d
+
+        near = maximum_filter1d(lines, 3, axis=1)
+        f0 = self.freqs[self.slab[0]]
+        members = np.zeros(lines.shape, dtype=bool)
+        for spacing in COMB_SPACINGS_HZ:
+            m = np.arange(np.ceil(f0 / spacing), np.floor(self.freqs[self.slab[-1]] / spacing) + 1)
+            grid = np.round((m * spacing - f0) / self.df).astype(int)
+            grid = grid[(grid >= 1) & (grid < lines.shape[1] - 1)]
+            if len(grid) < 8:
+                continue
+            hosted = near[:, grid]
+            ok = np.isfinite(hosted)
+            comb = np.mean(ok, axis=1) >= COMB_GRID_FRACTION
+            if not np.any(comb):
+                continue
+            level = np.nanmedian(np.where(ok, hosted, np.nan)[comb], axis=1)
+            on_grid = np.zeros(lines.shape[1], dtype=bool)
+            on_grid[np.concatenate([grid - 1, grid, grid + 1])] = True
+            members[comb] |= on_grid[None, :] & np.isfinite(lines[comb]) & (lines[comb] < level[:, None] + COMB_LEVEL_DB)
+        return members
+
+    def _plot(self, times, log_band):
+        for t, row in zip(times, log_band):
+            self._pool_acc.append(row.astype(np.float32))
+            if len(self._pool_acc) == self._pool:
+                self._plot_cols.append(np.max(self._pool_acc, axis=0))
+                self._plot_times.append(t)
+                self._pool_acc = []
+                if len(self._plot_cols) >= 2 * PLOT_COLUMNS:
+                    self._plot_cols = [np.maximum(a, b) for a, b in zip(self._plot_cols[::2], self._plot_cols[1::2])]
+                    self._plot_times = self._plot_times[1::2]
+                    self._pool *= 2
+
+    def _step(self, time, emit, log_row, excess_row, line_row, slab_lines):
+        nb = len(emit)
+        if self._first:
+            self._score = emit.copy()
+            self._back.append(np.arange(nb))
+            self._first = False
+        else:
+            idx = np.arange(nb)
+            src = idx[None, :] - self._steps[:, None]
+            valid = (src >= 0) & (src < nb)
+            cand = np.where(valid, self._score[np.clip(src, 0, nb - 1)] - self._step_cost[:, None], -np.inf)
+            best = np.argmax(cand, axis=0)
+            local = cand[best, idx]
+            far = float(np.max(self._score)) - JUMP_COST_DB
+            jump_from = int(np.argmax(self._score))
+            back = np.where(local >= far, src[best, idx], jump_from)
+            self._score = np.maximum(local, far) + emit
+            self._score -= self._score.max()
+            self._back.append(back)
+        self._pending_rows.append((time, log_row, excess_row, line_row, slab_lines))
+        if len(self._pending_rows) > LAG_FRAMES:
+            state = int(np.argmax(self._score))
+            for back in reversed(self._back[1:]):
+                state = int(back[state])
+            self._decide(state)
+
+    def _decide(self, state):
+        """The oldest pending frame's ridge bin is ``state``: refine it and pass it to voicing."""
+        time, log_row, excess_row, line_row, slab_lines = self._pending_rows.pop(0)
+        self._back.pop(0)
+        nb = len(log_row)
+        lo, hi = max(0, state - 1), min(nb, state + 2)
+        peak = int(np.clip(lo + np.argmax(log_row[lo:hi]), 1, nb - 2))
+        l, m, r = log_row[peak - 1], log_row[peak], log_row[peak + 1]
+        denom = l - 2 * m + r
+        delta = float(np.clip(0.5 * (l - r) / denom, -0.5, 0.5)) if denom < 0 else 0.0
+        freq = float(self.freqs[self.in_band[0]] + (peak + delta) * self.df)
+        masked = line_row.copy()
+        masked[max(0, peak - EXCLUDE_BINS): peak + EXCLUDE_BINS + 1] = -np.inf
+        other = int(np.argmax(masked))
+        self.times.append(time)
+        self.track.append(freq)
+        self.excess.append(float(excess_row[peak]))
+        self.state.append(0)
+        self.other_bin.append(other)
+        self.other_excess.append(float(masked[other]))
+        self.other_level.append(float(log_row[other] - log_row[peak]) if np.isfinite(masked[other]) else -np.inf)
+        harmonic = _in_harmonic_comb(slab_lines, peak + self.offset, self.df)
+        self._voice(len(self.track) - 1, harmonic)
+
+    def _voice(self, i, harmonic):
+        """Voicing state machine: candidate runs qualify by strength or by length and stability; a frame whose
+        line is one of a harmonic comb is no candidate."""
+        e = -np.inf if harmonic else self.excess[i]
+        stable = bool(self._run) and abs(self._bin_of(i) - self._bin_of(self._run[-1])) <= STABLE_BINS
+        if e >= WEAK_DB and (not self._run or stable):
+            self._run.append(i)
+        else:
+            self._close_run()
+            if e >= WEAK_DB:
+                self._run = [i]
+        if self._run and (len(self._run) >= MIN_RUN or max(self.excess[j] for j in self._run) >= STRONG_DB):
+            for j in self._run:
+                self.state[j] = 1
+        if not self._run:
+            self._emit_until(i + 1)
+        elif self.state[self._run[0]] == 1:
+            self._emit_until(i + 1)
+        else:
+            self._emit_until(self._run[0])
+
+    def _bin_of(self, i):
+        return (self.track[i] - self.freqs[self.in_band[0]]) / self.df
+
+    def _close_run(self):
+        self._run = []
+
+    def _emit_until(self, stop):
+        for j in range(self._voice_done, stop):
+            if self.on_frame is not None:
+                self.on_frame(self.times[j], self.track[j] if self.state[j] else float("nan"), self.excess[j])
+        self._voice_done = max(self._voice_done, stop)
+
+    # --- end of input ---------------------------------------------------------------------------------------
+    def finish(self, duration_s: float, full_mean_power: np.ndarray | None = None) -> Analysis:
+        while self._pending_rows:
+            state = int(np.argmax(self._score))
+            for back in reversed(self._back[1:]):
+                state = int(back[state])
+            self._decide(state)
+        self._close_run()
+        self._emit_until(len(self.track))
+        if self._pool_acc:
+            self._plot_cols.append(np.max(self._pool_acc, axis=0))
+            self._plot_times.append(self.times[-1] if self.times else 0.0)
+        times, track = np.array(self.times), np.array(self.track)
+        excess, state = np.array(self.excess), np.array(self.state, dtype=int)
+        lo, hi = self.band
+        loudest = ""
+        if full_mean_power is not None and len(times):
+            loudest = _strongest_outside(self.freqs, full_mean_power, lo, hi,
+                                         float(self.band_peak_power.max() / len(times)))
+        hint = f"; {loudest}" if loudest else ""
+        if len(track) == 0:
+            raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz: the recording is shorter than one "
+                            f"{WINDOW_S * 1e3:.0f} ms analysis window")
+        if not np.any(state == 1):
+            raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz: no frame has a line >= {STRONG_DB:g} dB over the "
+                            f"local noise floor, nor >= {WEAK_DB:g} dB steady for {MIN_RUN} frames (best frame "
+                            f"{np.max(excess):.1f} dB){hint}")
+        segments = _segments(times, track, state, self.df)
+        flagged = [s for s in segments if s.flag]
+        for s in flagged:
+            state[(times >= s.start_s) & (times <= s.end_s) & (state == 1)] = 2
+        voiced = state == 1
+        if not np.any(voiced):
+            raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz that can be the taxel's: every voiced frame is in a "
+                            f"flagged segment ({flagged[0].flag}){hint}")
+        nb = len(self.in_band)
+        path = (track[voiced] - self.freqs[self.in_band[0]]) / self.df
+        edge = np.mean((path <= EDGE_BINS) | (path >= nb - 1 - EDGE_BINS))
+        if edge > 0.5:
+            raise LoopError(f"the ridge hugs the band edge ({100 * edge:.0f} % of voiced frames within {EDGE_BINS} "
+                            f"bins of {lo:.0f} or {hi:.0f} Hz): the tone is probably outside the band; widen "
+                            f"it{hint}")
+        other_excess, other_level = np.array(self.other_excess), np.array(self.other_level)
+        sources = _second_sources(np.array(self.other_bin)[voiced], other_excess[voiced], other_level[voiced],
+                                  self.freqs[self.in_band])
+        warnings = []
+        if loudest:
+            warnings.append(f"{loudest} was ignored: hum, a harmonic or another source")
+        for s in sources:
+            which = "stronger than" if s.relative_db > 0 else "weaker than"
+            warnings.append(f"a second tone near {s.frequency_hz:.0f} Hz in {100 * s.fraction:.0f} % of voiced "
+                            f"frames, {abs(s.relative_db):.1f} dB {which} the tracked one: another taxel or an "
+                            "overtone; if it is the taxel, narrow the band with --band")
+        for s in flagged:
+            warnings.append(f"{s.start_s:.2f}-{s.end_s:.2f} s at {s.mean_hz:.0f} Hz: {s.flag}; left out")
+        prom = np.where(np.isfinite(other_level[voiced]), -other_level[voiced], excess[voiced])
+        return Analysis(mean_hz=float(np.mean(track[voiced])), median_hz=float(np.median(track[voiced])),
+                        std_hz=float(np.std(track[voiced])), snr_db=float(np.median(excess[voiced])),
+                        prominence_db=float(np.median(prom)), tone_fraction=float(np.mean(voiced)),
+                        band_hz=(lo, hi), sample_rate_hz=self.fs, duration_s=duration_s, times_s=times,
+                        track_hz=track, frame_snr_db=excess, voiced=voiced, segments=tuple(segments),
+                        sources=tuple(sources), plot_times_s=np.array(self._plot_times),
+                        plot_freqs_hz=self.freqs[self.in_band], plot_db=np.array(self._plot_cols).T,
+                        warnings=tuple(warnings))
+
+
+def _segments(times, track, state, df) -> list[Segment]:
+    """Steady segments of voiced frames. A segment reached by an abrupt jump (no ramp frames) of more than
+    MODE_JUMP_RATIO whose mean also lies that far from the median of all voiced frames is flagged as a mode
+    jump."""
+    runs, cur = [], []
+    for i in np.flatnonzero(state >= 1):
+        if cur and (i - cur[-1] > MAX_GAP_FRAMES + 1 or abs(track[i] - track[cur[-1]]) > STEP_HZ):
+            runs.append(cur)
+            cur = []
+        cur.append(int(i))
+    if cur:
+        runs.append(cur)
+    reference = float(np.median(track[state >= 1]))
+    out, last = [], None
+    for run in runs:
+        if len(run) < MIN_SEGMENT_FRAMES:
+            continue
+        f = track[run]
+        mean = float(np.mean(f))
+        flag = ""
+        between = track[last[1] + 1:run[0]][state[last[1] + 1:run[0]] >= 1] if last is not None else []
+        abrupt = (last is not None and run[0] - last[1] <= JUMP_GAP_FRAMES
+                  and not np.any((between - last[0]) * (between - mean) < 0))  # no ramp frame in between
+        ratio = mean / reference
+        if abrupt and max(ratio, 1 / ratio) > MODE_JUMP_RATIO and max(mean / last[0], last[0] / mean) > MODE_JUMP_RATIO:
+            flag = (f"abrupt jump x{mean / last[0]:.3f} from {last[0]:.0f} Hz, x{ratio:.3f} from the recording's "
+                    f"median, more than a press can give (Eq. 5: x{MODE_JUMP_RATIO:g} over 0-25 N): a mode jump "
+                    "(overblowing)")
+        last = (mean, run[-1])
+        out.append(Segment(float(times[run[0]]), float(times[run[-1]]), len(run), mean, float(np.median(f)),
+                           float(np.std(f)), flag))
+    return out
+
+
+def _in_harmonic_comb(lines: np.ndarray, p: int, df: float) -> bool:
+    """True when the line at bin ``p`` has lines (within ±2 bins, ≥ HARMONIC_LINE_DB and ≥ its level −
+    COMB_LEVEL_DB) at 3 of ±Δ, ±2Δ for some Δ in HARMONIC_SPACING_HZ: one harmonic of a voice (or of any periodic
+    sound), not a taxel. White noise: ~1e-5 of frames per Δ trips it."""
+    level = lines[p]
+    if not np.isfinite(level):
+        return False
+    need = max(HARMONIC_LINE_DB, level - COMB_LEVEL_DB)
+    strong = np.concatenate([[False, False], lines >= need, [False, False]])
+    near = strong[:-4] | strong[1:-3] | strong[2:-2] | strong[3:-1] | strong[4:]  # a line within ±2 bins
+    n = len(lines)
+    d = np.arange(int(HARMONIC_SPACING_HZ[0] / df), int(HARMONIC_SPACING_HZ[1] / df) + 1)
+    hits = sum(near[np.clip(p + k * d, 0, n - 1)] & (p + k * d >= 0) & (p + k * d < n) for k in (-2, -1, 1, 2))
+    return bool(np.any(hits >= 3))
+
+
+def _second_sources(other_bin, other_excess, other_level, band_freqs) -> list[Source]:
+    """A second line present (≥ WEAK_DB over its floor) in ≥ SECOND_SOURCE_FRACTION of voiced frames, clustered
+    in frequency; its level relative to the tracked line (dB of power)."""
+    if len(other_bin) == 0:
+        return []
+    present = other_excess >= WEAK_DB
+    if np.mean(present) < SECOND_SOURCE_FRACTION:
+        return []
+    bins = other_bin[present]
+    centre = np.median(bins)
+    close = np.abs(bins - centre) <= 3 * STABLE_BINS
+    if np.sum(close) < SECOND_SOURCE_FRACTION * len(other_bin):
+        return []
+    rel = float(np.median(other_level[present][close]))
+    return [Source(float(band_freqs[int(round(centre))]), rel, float(np.sum(close) / len(other_bin)))]
+
+
+def _strongest_outside(f, mean_spectrum, lo, hi, in_band_peak) -> str:
+    """'a stronger tone near … Hz outside the band (… dB above …)' if one exists above 20 Hz, else ''."""
+    df = f[1] - f[0]
+    outside = ((f < lo - 2 * df) | (f > hi + 2 * df)) & (f > 20.0)  # below 20 Hz: drift, not a tone
+    if not np.any(outside):
+        return ""
+    i = int(np.argmax(np.where(outside, mean_spectrum, 0.0)))
+    if mean_spectrum[i] <= in_band_peak:
+        return ""
+    i = int(np.clip(i, 1, len(f) - 2))
+    a, b, c = 10 * np.log10(mean_spectrum[i - 1:i + 2] + np.finfo(float).tiny)
+    delta = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c < 0 else 0.0
+    where = f[i] + float(np.clip(delta, -0.5, 0.5)) * df
+    return (f"a stronger tone near {where:.0f} Hz outside the band "
+            f"({10 * np.log10(mean_spectrum[i] / in_band_peak):.1f} dB above the in-band peak)")
+
+
+def band_from_prediction(band_hz: tuple[float, float]) -> tuple[float, float]:
+    """Analysis band for a taxel: its predicted unloaded band, −10 % / +25 % (load raises f: +11 % at 25 N on
+    the paper's Eq. 5 fit)."""
+    return band_hz[0] * 0.9, band_hz[1] * 1.25
+
+
+def analyze_stream(blocks, fs: float, bands, on_frame=None) -> list[Analysis]:
+    """One :class:`Analysis` per band (Hz) from an iterable of sample blocks at ``fs`` (Hz), in one pass.
+
+    Several bands are the plug-in point for a board of taxels: each band is tracked on its own. ``on_frame`` is
+    called as (band index, time s, frequency Hz or NaN, excess dB) as frames become final.
+    """
+    framer = Framer(fs)
+    trackers = [BandTracker(framer.freqs, fs, band,
+                            None if on_frame is None else (lambda *a, k=k: on_frame(k, *a)))
+                for k, band in enumerate(bands)]
+    total = np.zeros(len(framer.freqs))
+    samples = 0
+    for block in blocks:
+        samples += len(block)
+        times, power = framer.feed(block)
+        if len(times):
+            total += power.sum(axis=0)
+            for tr in trackers:
+                tr.push(times, power)
+    frames = max(1, framer._next)
+    return [tr.finish(samples / fs, total / frames) for tr in trackers]
+
+
+def analyze(x: np.ndarray, fs: float, band_hz: tuple[float, float]) -> Analysis:
+    """The tone's frequency track inside ``band_hz`` (Hz) of samples ``x`` at ``fs`` (Hz).
+
+    Raises LoopError (with the reason) when no frame holds the tone or when the ridge hugs a band edge.
+    """
+    step = 1 << 20
+    return analyze_stream((x[i:i + step] for i in range(0, max(len(x), 1), step)), fs, [band_hz])[0]
+
+
+def write_track_csv(analysis: Analysis, path) -> None:
+    """Per-frame time (s), frequency (Hz, empty where unvoiced), ridge excess over the floor (dB) and voicing."""
+    rows = ["time_s,frequency_hz,snr_db,voiced"] + [
+        f"{t:.6f},{f'{f:.4f}' if v else ''},{s:.2f},{int(v)}"
+        for t, f, s, v in zip(analysis.times_s, analysis.track_hz, analysis.frame_snr_db, analysis.voiced)]
+    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+
+
+def write_segments_csv(analysis: Analysis, path, forces=None) -> None:
+    """Per segment: start, end (s), frames, mean/median/sd frequency (Hz), flag; and force with its 95 % interval
+    (N) when ``forces`` (one (force, low, high) per segment) is given."""
+    head = "start_s,end_s,frames,mean_hz,median_hz,std_hz"
+    head += ",force_n,force_low_n,force_high_n" if forces is not None else ""
+    rows = [head + ",flag"]
+    for i, s in enumerate(analysis.segments):
+        row = f"{s.start_s:.3f},{s.end_s:.3f},{s.frames},{s.mean_hz:.3f},{s.median_hz:.3f},{s.std_hz:.3f}"
+        if forces is not None:
+            row += "," + ",".join("" if not np.isfinite(v) else f"{v:.4f}" for v in forces[i])
+        rows.append(row + "," + s.flag.replace(",", ";"))
+    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+
+
+def plot(analysis: Analysis, path, forces=None) -> None:
+    """Spectrogram of the band (dB, max-pooled in time) with the voiced track and segments; with ``forces``
+    (per frame: force, low, high in N) a second panel of force against time. PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = 2 if forces is not None else 1
+    fig, axes = plt.subplots(rows, 1, figsize=(8, 3.2 * rows + 0.8), sharex=True, squeeze=False)
+    ax = axes[0, 0]
+    db = analysis.plot_db
+    ax.pcolormesh(analysis.plot_times_s, analysis.plot_freqs_hz, db, shading="nearest", cmap="magma",
+                  vmin=np.percentile(db, 5), vmax=db.max())
+    ax.plot(analysis.times_s, np.where(analysis.voiced, analysis.track_hz, np.nan), color="cyan", lw=1,
+            label="voiced track")
+    for s in analysis.segments:
+        ax.hlines(s.mean_hz, s.start_s, s.end_s, color="red" if s.flag else "white", lw=2)
+    ax.set(ylabel="frequency [Hz]",
+           title=f"mean {analysis.mean_hz:.2f} Hz over {100 * analysis.tone_fraction:.0f} % of frames (voiced), "
+                 f"{len(analysis.segments)} segments")
+    ax.legend(loc="upper right", fontsize=8)
+    if forces is not None:
+        force, low, high = forces
+        bx = axes[1, 0]
+        bx.fill_between(analysis.times_s, low, high, alpha=0.3, label="95 % interval")
+        bx.plot(analysis.times_s, force, "k.", ms=2, label="force per voiced frame")
+        bx.set(ylabel="force [N]")
+        bx.legend(loc="upper right", fontsize=8)
+    axes[-1, 0].set(xlabel="time [s]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)

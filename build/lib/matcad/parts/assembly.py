@@ -1,0 +1,68 @@
+"""Every part in its assembled place (assembly frame: plate underside z = 0, neck axis = z) and a section.
+
+Stack, bottom to top: needle mount, spacers (gap = spacer.height), neck plate (0..l), locator guide around
+the cap's flange, the cap on the plate, the clamp guide resting on the flange (unclamped: the flange's
+squeeze shows as a gap that the bolts close).
+"""
+
+from build123d import Compound, ExportSVG, Plane, Pos, Rot
+
+from matcad.parts.end_cap import end_cap
+from matcad.parts.features import cap_flange_thickness_mm, plate_bolt_positions_mm
+from matcad.parts.guide import guide
+from matcad.parts.neck_plate import neck_plate
+from matcad.parts.needle_mount import needle, needle_mount
+from matcad.parts.solid import flat_solid
+from matcad.parts.spacer import spacer
+from matcad.render.section import annotate_section
+
+SECTION_COLOURS = {
+    "neck_plate": "#9cc8f0", "guide_locator": "#c4e0fa", "guide_clamp": "#c4e0fa", "end_cap": "#f0a050",
+    "needle_mount": "#b4b4b4", "needle": "#404040", "spacer": "#d8d0f8",
+}
+
+
+def assembled_parts(spec) -> dict[str, object]:
+    """Name → solid in the assembly frame (mm). Spacers are numbered when laser-cut."""
+    plate_t = spec.neck.length
+    parts = {
+        "neck_plate": flat_solid(neck_plate(spec)),
+        "guide_locator": flat_solid(guide(spec, "locator"), plate_t),
+        "guide_clamp": flat_solid(guide(spec, "clamp"), plate_t + cap_flange_thickness_mm(spec)),
+        "end_cap": Pos(0, 0, plate_t) * end_cap(spec),
+        "needle_mount": needle_mount(spec),
+        "needle": needle(spec),
+    }
+    if spec.spacer.style == "laser":
+        one = flat_solid(spacer(spec), -spec.spacer.height)
+        for i, (x, y) in enumerate(plate_bolt_positions_mm(spec), 1):
+            parts[f"spacer_{i}"] = Pos(x, y, 0) * one
+    return parts
+
+
+def assembly(spec, parts=None) -> Compound:
+    """All parts (``assembled_parts`` unless given) as one labelled compound (for assembly.step)."""
+    children = []
+    for name, solid in (parts or assembled_parts(spec)).items():
+        solid.label = name
+        children.append(solid)
+    return Compound(label=spec.name, children=children)
+
+
+def write_section_svg(spec, path, parts=None) -> None:
+    """Section of the assembly through the neck axis in the XZ plane (needle plane), to scale in mm, with part
+    labels and the design's dimensions (:func:`matcad.render.section.annotate_section`)."""
+    parts = parts or assembled_parts(spec)
+    svg = ExportSVG(margin=2.0, line_weight=0.05)
+    layers = set()
+    for name, solid in parts.items():
+        cut = solid & Plane.XZ
+        if not cut or not cut.faces():
+            continue
+        layer = name.rsplit("_", 1)[0] if name.startswith("spacer_") else name
+        if layer not in layers:
+            svg.add_layer(layer, fill_color=SECTION_COLOURS[layer], line_color="#000000")
+            layers.add(layer)
+        svg.add_shape(Rot(-90, 0, 0) * cut, layer=layer)  # XZ plane → drawing plane, z up
+    svg.write(str(path))
+    annotate_section(spec, path)

@@ -1,0 +1,31 @@
+"""The cast silicone end cap (paper: Dragon Skin 30): cavity D x L open toward the neck, a body, a base flange.
+
+Own frame: base on z = 0 (it sits on the neck plate), axis along +z, cavity open at z = 0.
+"""
+
+import math
+
+from matcad.parts.features import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
+from matcad.parts.solid import cylinder_up, frustum_up
+
+
+def cavity_tip_radius_mm(spec) -> float:
+    """Cavity radius at its closed end: D/2 narrowed by the core pin's draft over L (mm)."""
+    return spec.cavity.diameter / 2 - spec.cavity.length * math.tan(math.radians(spec.mold.draft_deg))
+
+
+def cap_envelope(spec):
+    """The cap's outer shape (flange + body), cavity not removed (mm)."""
+    flange = cylinder_up(cap_flange_diameter_mm(spec) / 2, cap_flange_thickness_mm(spec))
+    body = cylinder_up(spec.end_cap.outer_diameter / 2, cap_height_mm(spec))
+    return flange + body
+
+
+def core_pin(spec):
+    """The cavity's shape: a frustum from D at z = 0 to the drafted tip at z = L (mm)."""
+    return frustum_up(spec.cavity.diameter / 2, cavity_tip_radius_mm(spec), spec.cavity.length)
+
+
+def end_cap(spec):
+    """The silicone end cap solid; its volume is the cast volume (mm³)."""
+    return cap_envelope(spec) - core_pin(spec)

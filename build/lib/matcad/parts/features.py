@@ -1,0 +1,129 @@
+"""Shared features: fit classes per process, bolt and dowel holes, stock sheets. Lengths in mm.
+
+One table each, used by every part, so a plate hole and the mount hole under it can never disagree.
+"""
+
+from __future__ import annotations
+
+ISO_273_CLEARANCE_MM = {
+    "M2": {"close": 2.2, "normal": 2.4, "loose": 2.6},
+    "M2.5": {"close": 2.7, "normal": 2.9, "loose": 3.1},
+    "M3": {"close": 3.2, "normal": 3.4, "loose": 3.6},
+}
+"""ISO 273 bolt clearance hole diameters (mm)."""
+
+SELF_TAP_PILOT_MM = {"M2": 1.6, "M2.5": 2.05, "M3": 2.5}
+"""Pilot hole for a machine screw cutting its own thread in a printed part (ISO tap-drill size, mm)."""
+
+PIN_FIT_ALLOWANCE_MM = {
+    "laser": {"clearance": 0.15, "slip": 0.05, "press": 0.0},
+    "fdm": {"clearance": 0.4, "slip": 0.2, "press": 0.0},
+    "sla": {"clearance": 0.2, "slip": 0.1, "press": -0.05},
+}
+"""Finished hole diameter minus pin diameter (mm) by process and fit. FDM holes print ~0.1-0.2 mm undersize,
+so its nominal-size hole is already a press fit. A laser "press" hole is drawn at pin size, but laser-cut
+acrylic holds only ±0.1 mm (docs/physics.md): the design rules reject it. Laser values are for the hole as cut after
+kerf compensation."""
+
+STOCK_ACRYLIC_MM = (1.0, 1.5, 1.59, 2.0, 2.5, 3.0, 3.18, 4.0, 4.76, 5.0, 6.0, 6.35, 8.0, 9.53, 10.0, 12.0,
+                    12.7)
+"""Common cast/extruded acrylic sheet thicknesses: metric and 1/16-inch steps (mm)."""
+
+
+def pin_hole_diameter_mm(pin_diameter_mm: float, process: str, fit: str) -> float:
+    """Finished hole diameter (mm) for a pin (dowel, needle) of the given diameter, process and fit."""
+    return pin_diameter_mm + PIN_FIT_ALLOWANCE_MM[process][fit]
+
+
+def bolt_clearance_mm(bolt: str, fit: str) -> float:
+    """ISO 273 clearance hole diameter (mm)."""
+    return ISO_273_CLEARANCE_MM[bolt][fit]
+
+
+def bolt_nominal_mm(bolt: str) -> float:
+    """Nominal major diameter of a metric bolt, e.g. 'M2.5' → 2.5 (mm)."""
+    return float(bolt[1:])
+
+
+def is_stock_sheet(thickness_mm: float, tol_mm: float = 0.005) -> bool:
+    """Whether a sheet thickness is a common stock acrylic size (mm)."""
+    return any(abs(thickness_mm - t) <= tol_mm for t in STOCK_ACRYLIC_MM)
+
+
+def laser_stack_holes(spec) -> tuple:
+    """Dowel and bolt holes shared by every laser-cut layer of the stack (plate, guides)."""
+    from matcad.parts.flat import Hole
+
+    fit = spec.fasteners.dowel_fit_laser
+    dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, "laser", fit)
+    bolt = bolt_clearance_mm(spec.fasteners.bolt, spec.fasteners.bolt_fit)
+    return (tuple(Hole(x, y, dowel, "dowel", fit) for x, y in plate_dowel_positions_mm(spec))
+            + tuple(Hole(x, y, bolt, "bolt", spec.fasteners.bolt_fit) for x, y in plate_bolt_positions_mm(spec)))
+
+
+def plate_bolt_positions_mm(spec) -> list[tuple[float, float]]:
+    """Bolt centres (x, y) at the four plate corners, inset ``plate.bolt_inset`` + bolt radius (mm)."""
+    inset = spec.plate.bolt_inset + bolt_nominal_mm(spec.fasteners.bolt) / 2
+    x, y = spec.plate.width / 2 - inset, spec.plate.depth / 2 - inset
+    return [(-x, -y), (x, -y), (x, y), (-x, y)]
+
+
+def plate_dowel_positions_mm(spec) -> list[tuple[float, float]]:
+    """Dowel centres (x, y): mid-edge on ±y, offset in x so the stack only assembles one way (mm)."""
+    inset = spec.plate.bolt_inset + spec.fasteners.dowel_diameter / 2
+    y = spec.plate.depth / 2 - inset
+    return [(spec.plate.width * 0.1, y), (-spec.plate.width * 0.1, -y)]
+
+
+def cap_flange_diameter_mm(spec) -> float:
+    """Diameter of the end cap's base flange, which the locator guide surrounds (mm)."""
+    return spec.end_cap.outer_diameter + 2 * spec.end_cap.flange_width
+
+
+def cap_flange_thickness_mm(spec) -> float:
+    """Flange thickness: the guide thickness plus the clamp squeeze (mm)."""
+    return spec.guide.thickness + spec.end_cap.flange_squeeze
+
+
+def cap_volume_mm3(spec) -> float:
+    """Cast silicone volume of one end cap: flange + body − drafted cavity (mm³)."""
+    import math
+
+    from matcad.acoustics.geometry import drafted_cavity_volume_mm3
+
+    flange_d, tf = cap_flange_diameter_mm(spec), cap_flange_thickness_mm(spec)
+    envelope = math.pi / 4 * (flange_d**2 * tf + spec.end_cap.outer_diameter**2 * (cap_height_mm(spec) - tf))
+    return envelope - float(drafted_cavity_volume_mm3(spec.cavity.diameter, spec.cavity.length,
+                                                      spec.mold.draft_deg))
+
+
+def cap_height_mm(spec) -> float:
+    """End cap height from its base (on the plate) to its top: L + top thickness (mm)."""
+    return spec.cavity.length + spec.end_cap.top_thickness
+
+
+def needle_axis_mm(spec) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """The needle's axis in the assembly frame (plate underside z = 0, neck axis = z axis, mm).
+
+    The axis lies in the XZ plane at ``needle.theta_deg`` to the plate surface, pointing up toward +x. It meets
+    the plane of the plate's underside (the neck's mouth) at (−d/2 − y, 0, 0): ``needle.y`` is the distance,
+    measured in that plane, from that point to the nearest edge of the neck opening (−d/2, 0, 0) — the
+    paper's "distance between air supply and nearest edge of cavity opening" (Fig. 2).
+    Returns (point on the mouth plane, unit direction).
+    """
+    import math
+
+    t = math.radians(spec.needle.theta_deg)
+    return (-spec.neck.diameter / 2 - spec.needle.y, 0.0, 0.0), (math.cos(t), 0.0, math.sin(t))
+
+
+def needle_tip_mm(spec) -> tuple[float, float, float]:
+    """Centre of the needle's end face: back along the axis until the face's highest point sits
+    ``needle.tip_clearance`` below the plate underside (mm)."""
+    import math
+
+    (px, py, pz), (ux, uy, uz) = needle_axis_mm(spec)
+    t = math.radians(spec.needle.theta_deg)
+    drop = spec.needle.tip_clearance + spec.needle.outer_diameter / 2 * math.cos(t)
+    s = drop / max(math.sin(t), 1e-12)
+    return (px - s * ux, py - s * uy, pz - s * uz)

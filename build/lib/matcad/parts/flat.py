@@ -1,0 +1,118 @@
+"""Flat (laser-cut) parts as data, and the one place where kerf is applied. Lengths in mm.
+
+A :class:`Flat` holds design intent: the finished outline and finished hole diameters. :func:`cut_plan`
+turns it into what the laser must follow — outlines grow and holes shrink by kerf/2 — and records the
+compensation per feature, so exporters draw it and the report declares it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+REFERENCE_SQUARE_MM = 10.0
+
+
+@dataclass(frozen=True)
+class Hole:
+    """A round hole: centre (x, y), finished diameter, what it is for and what it must fit (mm)."""
+
+    x: float
+    y: float
+    diameter: float
+    purpose: str  # neck | neck_pilot | dowel | bolt | cap
+    fit: str = ""
+
+
+@dataclass(frozen=True)
+class Engraving:
+    """Text to engrave: baseline start (x, y) and cap height (mm)."""
+
+    x: float
+    y: float
+    height: float
+    text: str
+
+
+@dataclass(frozen=True)
+class Flat:
+    """A laser-cut part: rectangular outline centred on the origin, holes, engraved text (mm)."""
+
+    name: str
+    thickness: float
+    thickness_measured: bool
+    width: float
+    depth: float
+    holes: tuple[Hole, ...]
+    engrave: tuple[Engraving, ...] = ()
+    quantity: int = 1
+    corner_radius: float = 0.5
+
+    @property
+    def area_mm2(self) -> float:
+        return self.width * self.depth
+
+
+@dataclass(frozen=True)
+class CutCircle:
+    x: float
+    y: float
+    diameter: float
+    finished_diameter: float
+    compensation: float
+    purpose: str
+
+
+@dataclass(frozen=True)
+class CutPlan:
+    """What the laser follows: outline(s), inner circles, engraving, reference, with compensation declared."""
+
+    flat: Flat
+    kerf: float
+    outlines: tuple[tuple[float, float, float, float, float], ...]  # x0, y0, x1, y1, corner radius
+    circles: tuple[CutCircle, ...]
+    texts: tuple[Engraving, ...] = ()
+    reference_square: tuple[float, float, float] | None = None  # x0, y0, side
+    extents: tuple[float, float, float, float] = field(default=(0, 0, 0, 0))
+
+
+class DrawnSizeError(ValueError):
+    """A feature whose drawn (kerf-compensated) size is not a real size: nothing can be drawn or cut."""
+
+
+def drawn_diameter_mm(finished_mm: float, kerf_mm: float) -> float:
+    """Diameter the laser must follow for a hole of ``finished_mm``: the finished size minus the full kerf
+    (the beam removes kerf/2 on each side of the line), mm."""
+    return finished_mm - kerf_mm
+
+
+def drawn_holes(flat: Flat, kerf: float) -> list[tuple[Hole, float]]:
+    """Every hole of ``flat`` with the diameter it is drawn at (mm), smallest first."""
+    return sorted(((h, drawn_diameter_mm(h.diameter, kerf)) for h in flat.holes), key=lambda hd: hd[1])
+
+
+def cut_plan(flat: Flat, kerf: float, reference_square: bool, spacing: float = 3.0) -> CutPlan:
+    """Apply kerf compensation (outline +kerf/2, holes −kerf/2) and lay out ``quantity`` copies in a row.
+
+    Raises :class:`DrawnSizeError` when a hole would be drawn at a diameter ≤ 0 (a hole smaller than the kerf):
+    the design rule ``laser.drawn_size`` reports the same thing, naming the spec field, before any build.
+    """
+    for hole, drawn in drawn_holes(flat, kerf):
+        if drawn <= 0:
+            raise DrawnSizeError(f"{flat.name}: {hole.purpose} hole of {hole.diameter:g} mm would be drawn at "
+                                 f"{drawn:g} mm after the {kerf:g} mm kerf; it must be drawn > 0 mm")
+    half = kerf / 2
+    outlines, circles = [], []
+    for i in range(flat.quantity):
+        dx = i * (flat.width + kerf + spacing)
+        outlines.append((dx - flat.width / 2 - half, -flat.depth / 2 - half,
+                         dx + flat.width / 2 + half, flat.depth / 2 + half, flat.corner_radius + half))
+        circles += [CutCircle(dx + h.x, h.y, drawn_diameter_mm(h.diameter, kerf), h.diameter, -kerf, h.purpose)
+                    for h in flat.holes]
+    x_max = outlines[-1][2]
+    square = None
+    if reference_square:
+        square = (x_max + spacing, -flat.depth / 2, REFERENCE_SQUARE_MM)
+        x_max = square[0] + REFERENCE_SQUARE_MM
+    y_max = max(flat.depth / 2 + half, -flat.depth / 2 + REFERENCE_SQUARE_MM if square else 0)
+    extents = (outlines[0][0], -flat.depth / 2 - half, x_max, y_max)
+    return CutPlan(flat, kerf, tuple(outlines), tuple(circles), flat.engrave, square, extents)

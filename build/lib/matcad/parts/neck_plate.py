@@ -1,0 +1,19 @@
+"""The acrylic neck plate: its thickness is the neck length l, its centre hole the neck d (paper Fig. 2)."""
+
+from matcad.parts.features import laser_stack_holes
+from matcad.parts.flat import Engraving, Flat, Hole
+
+
+def neck_plate(spec) -> Flat:
+    """Neck plate: outline plate.width x plate.depth, neck hole (or undersize pilot), dowel and bolt holes (mm)."""
+    if spec.plate.neck_pilot:
+        neck = Hole(0.0, 0.0, spec.neck.diameter - spec.plate.pilot_undersize, "neck_pilot")
+    else:
+        neck = Hole(0.0, 0.0, spec.neck.diameter, "neck")
+    label = ()
+    if spec.plate.label:
+        height = min(2.0, spec.plate.depth / 12)
+        label = (Engraving(-spec.plate.width / 4, -spec.plate.depth / 4 - height / 2, height, spec.plate.label),)
+    return Flat(name="neck_plate", thickness=spec.neck.length, thickness_measured=spec.plate.thickness_measured,
+                width=spec.plate.width, depth=spec.plate.depth, holes=(neck, *laser_stack_holes(spec)),
+                engrave=label)

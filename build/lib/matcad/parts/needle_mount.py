@@ -1,0 +1,54 @@
+"""Printed air-supply mount: holds the needle at θ and y under the neck (paper Fig. 2), below a spacer gap.
+
+Assembly frame (shared with every part): plate underside z = 0, neck axis = z axis. The mount's top face is
+at z = −spacer.height and it is ``mount.thickness`` thick. Bolts from the stack thread into self-tapping
+pilots; dowels press into it; with ``spacer.style = "standoff"`` the spacers are printed on it.
+"""
+
+import math
+
+from build123d import Align, Box, Cylinder, Location, Pos, Rot
+
+from matcad.parts.features import (SELF_TAP_PILOT_MM, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
+                                   plate_bolt_positions_mm, plate_dowel_positions_mm)
+from matcad.parts.solid import TOP, cylinder_up
+
+
+def needle_bore_diameter_mm(spec) -> float:
+    """Bore diameter for the needle: outer diameter plus the printer's allowance for needle.fit (mm)."""
+    return pin_hole_diameter_mm(spec.needle.outer_diameter, spec.machine.printer, spec.needle.fit)
+
+
+def _on_needle_axis(spec, start, radius: float, length: float):
+    """Cylinder of ``radius`` on the needle axis, from point ``start`` on it back ``length`` mm (mm)."""
+    tilt = 90.0 - spec.needle.theta_deg  # rotating +z about y by (90 − θ) gives (cos θ, 0, sin θ)
+    return Location(start) * Rot(0, tilt, 0) * Cylinder(radius, length, align=(Align.CENTER, Align.CENTER,
+                                                                               Align.MAX))
+
+
+def needle(spec):
+    """The needle itself, ``needle.length`` long, ending at its tip (for collision checks and assembly)."""
+    return _on_needle_axis(spec, needle_tip_mm(spec), spec.needle.outer_diameter / 2, spec.needle.length)
+
+
+def needle_mount(spec):
+    """The mount solid in the assembly frame (mm)."""
+    gap, thick = spec.spacer.height, spec.mount.thickness
+    top = -gap
+    body = Pos(0, 0, top) * Box(spec.plate.width, spec.plate.depth, thick, align=TOP)
+    if spec.spacer.style == "standoff":
+        for x, y in plate_bolt_positions_mm(spec):
+            body += cylinder_up(spec.spacer.size / 2, gap, x, y, top)
+    pilot = SELF_TAP_PILOT_MM[spec.fasteners.bolt] / 2
+    dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
+                                 spec.fasteners.dowel_fit_printed) / 2
+    # the bore runs along the whole axis, from the plate-underside plane back through the block: wherever
+    # the tip stands, the jet's path to the neck is open
+    mouth_point, _ = needle_axis_mm(spec)
+    reach = (thick + gap + spec.plate.width + spec.plate.depth) / max(math.sin(math.radians(
+        spec.needle.theta_deg)), 1e-3)
+    holes = ([cylinder_up(pilot, thick + gap, x, y, top - thick) for x, y in plate_bolt_positions_mm(spec)]
+             + [cylinder_up(dowel, thick, x, y, top - thick) for x, y in plate_dowel_positions_mm(spec)]
+             + [_on_needle_axis(spec, mouth_point, needle_bore_diameter_mm(spec) / 2, reach)])
+    return body.cut(*holes)
+

@@ -1,0 +1,24 @@
+"""build123d helpers shared by the 3-D parts: aligned primitives and a flat part as a solid (mm)."""
+
+from build123d import Align, Box, Cone, Cylinder, Pos
+
+BOTTOM = (Align.CENTER, Align.CENTER, Align.MIN)
+TOP = (Align.CENTER, Align.CENTER, Align.MAX)
+
+
+def cylinder_up(radius: float, height: float, x: float = 0.0, y: float = 0.0, z: float = 0.0):
+    """Cylinder along +z with its base centred at (x, y, z) (mm)."""
+    return Pos(x, y, z) * Cylinder(radius, height, align=BOTTOM)
+
+
+def frustum_up(bottom_radius: float, top_radius: float, height: float, x=0.0, y=0.0, z=0.0):
+    """Truncated cone along +z with its base at (x, y, z); a cylinder when the radii are equal (mm)."""
+    if abs(bottom_radius - top_radius) < 1e-9:
+        return cylinder_up(bottom_radius, height, x, y, z)
+    return Pos(x, y, z) * Cone(bottom_radius, top_radius, height, align=BOTTOM)
+
+
+def flat_solid(flat, z0: float = 0.0):
+    """A laser part (design intent, finished sizes) as a solid from z0 to z0 + thickness (mm)."""
+    body = Pos(0, 0, z0) * Box(flat.width, flat.depth, flat.thickness, align=BOTTOM)
+    return body.cut(*(cylinder_up(h.diameter / 2, flat.thickness, h.x, h.y, z0) for h in flat.holes))

@@ -1,0 +1,60 @@
+"""Plausibility notes: values that validate but are probably a unit slip, each with the value it probably meant.
+
+Validation (:mod:`matcad.spec`) refuses what is not physical; these notes catch what is physical but unlikely
+for a milli-scale taxel: a shear modulus entered in kPa, a temperature in kelvin, an angle in radians, a spec
+in metres, a sample rate in kHz, a calibration CSV in kHz. They never change a value; the CLI prints them and
+the design page shows them with the prediction.
+"""
+
+from __future__ import annotations
+
+import math
+
+SILICONE_G_MAX_MPA = 50.0
+"""Cast silicones are 0.05-5 MPa in shear; above 50 MPa the value was almost surely typed in kPa."""
+AIR_TEMPERATURE_MAX_C = 150.0
+"""A taxel in air hotter than 150 °C is unlikely; 250-400 reads as kelvin."""
+THETA_RADIANS_MAX = math.pi / 2
+"""A needle angle ≤ π/2 "degrees" is more likely radians (the paper's 75° is 1.31 rad)."""
+METRES_MAX = 0.05
+"""Every main dimension below 0.05 "mm" reads as a spec written in metres."""
+SAMPLE_RATE_KHZ_MAX = 400.0
+FREQUENCY_KHZ_MAX = 100.0
+"""Taxel tones are kHz; frequencies all below 100 "Hz" read as kHz."""
+
+
+def spec_notes(spec, data: dict | None = None) -> list[str]:
+    """Likely unit slips in the validated ``spec`` and, given its raw TOML ``data``, defaults worth knowing."""
+    notes = []
+    g_lo, g_hi = spec.wall.shear_modulus_mpa
+    if spec.wall.model == "silicone" and g_hi > SILICONE_G_MAX_MPA:
+        notes.append(f"wall.shear_modulus_mpa = [{g_lo:g}, {g_hi:g}] MPa is stiffer than acrylic; cast silicone is "
+                     f"0.05-5 MPa: kPa entered? did you mean [{g_lo / 1000:g}, {g_hi / 1000:g}]?")
+    t = spec.air.temperature_c
+    if t > AIR_TEMPERATURE_MAX_C:
+        notes.append(f"air.temperature_c = {t:g} °C: kelvin entered? did you mean {t - 273.15:.4g} (°C)?")
+    theta = spec.needle.theta_deg
+    if 0 < theta <= THETA_RADIANS_MAX:
+        notes.append(f"needle.theta_deg = {theta:g}°: radians entered? did you mean {math.degrees(theta):.4g} (deg)?")
+    dims = {"cavity.diameter": spec.cavity.diameter, "cavity.length": spec.cavity.length,
+            "neck.diameter": spec.neck.diameter, "neck.length": spec.neck.length}
+    if all(v < METRES_MAX for v in dims.values()):
+        meant = ", ".join(f"{k} = {v * 1000:g}" for k, v in dims.items())
+        notes.append(f"every main dimension is below {METRES_MAX:g} mm: a spec in metres? lengths are mm; did you "
+                     f"mean {meant}?")
+    rate = spec.microphone.sample_rate_hz
+    if rate < SAMPLE_RATE_KHZ_MAX:
+        notes.append(f"microphone.sample_rate_hz = {rate:g} Hz: kHz entered? did you mean {rate * 1000:g} (Hz)?")
+    if data is not None and "wall" not in data:
+        notes.append("no [wall] table: the walls default to rigid (wall.model = 'rigid'); a cast silicone cap is "
+                     "compliant and sings lower — set [wall] model = 'silicone' to include it")
+    return notes
+
+
+def frequency_notes(frequencies_hz, what: str = "frequency_hz") -> list[str]:
+    """A note when every frequency is below :data:`FREQUENCY_KHZ_MAX` Hz (a column in kHz, probably)."""
+    values = [float(f) for f in frequencies_hz]
+    if values and max(values) < FREQUENCY_KHZ_MAX:
+        return [f"{what}: every value is below {FREQUENCY_KHZ_MAX:g} Hz (max {max(values):g}): kHz entered? did you "
+                f"mean {max(values) * 1000:g} Hz for the largest?"]
+    return []

@@ -1,0 +1,59 @@
+"""Every picture of one build, written into its folder: a preview per part, the band and load plots.
+
+Returns the figure list the report embeds (file, caption, the part it shows). Laser parts are drawn from their
+cut plans and printed parts from the STL just written, so the laser-only path loads neither the CAD kernel
+nor a mesh library.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+LOAD_POINTS = 41
+LOAD_FORCE_MAX_N = 20.0
+"""Load curve drawn up to the calibration's measured range, else this (the paper loads to ~20 N), and never
+past Eq. 5's V_eff minimum."""
+
+
+def load_forces_n(spec) -> np.ndarray:
+    """Forces (N) at which to draw Eq. 5 for ``spec``'s calibration; empty without one."""
+    from matcad.acoustics.load import force_at_volume_minimum_n
+    from matcad.acoustics.predict import spec_calibration
+
+    cal = spec_calibration(spec)
+    if cal is None:
+        return np.array([])
+    lo, hi = spec.calibration.force_range_n or (0.0, LOAD_FORCE_MAX_N)
+    hi = min(hi, force_at_volume_minimum_n(cal))
+    return np.linspace(max(lo, 0.0), hi, LOAD_POINTS) if hi > max(lo, 0.0) else np.array([])
+
+
+def render_figures(spec, prediction, folder: Path, meshes: dict) -> list[dict]:
+    """Write every preview and plot for ``spec`` into ``folder``; ``meshes`` names the STLs written (file →
+    checks). Returns [{part, file, caption}] in report order: section, plots, laser parts, printed parts."""
+    from matcad.acoustics.predict import predict
+    from matcad.parts.catalogue import laser_parts
+    from matcad.parts.flat import cut_plan
+    from matcad.render.plots import BAND_PNG, LOAD_PNG, band_plot, load_plot
+    from matcad.render.previews import flat_preview, preview_name, printed_preview
+
+    figures = []
+    if (folder / "section.svg").is_file():
+        figures.append({"part": "assembly", "file": "section.svg",
+                        "caption": "section through the neck and needle axes, dimensioned (mm)"})
+    p = prediction.to_dict()
+    figures.append(band_plot(p, folder / BAND_PNG))
+    forces = load_forces_n(spec)
+    if len(forces):
+        figure = load_plot(predict(spec, forces_n=forces).to_dict(), folder / LOAD_PNG)
+        if figure:
+            figures.append(figure)
+    for flat in laser_parts(spec):
+        plan = cut_plan(flat, spec.machine.laser_kerf, spec.outputs.reference_square)
+        figures.append(flat_preview(plan, folder / preview_name(flat.name)))
+    for stl in sorted(meshes):
+        name = Path(stl).stem
+        figures.append(printed_preview(name, folder / stl, folder / preview_name(name)))
+    return figures

@@ -1,0 +1,55 @@
+"""Plots of the prediction (PNG): the band and its uncertainty budget, and the load curve f(F).
+
+Both read the plain report data (``Prediction.to_dict()``), so they draw whatever the prediction carries.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from matcad.render.figure import figure
+
+BAND_PNG = "plot_band.png"
+LOAD_PNG = "plot_load.png"
+
+
+def band_plot(p: dict, path: Path) -> dict:
+    """Every model's f0, the chosen band, and each budget line's shift (Hz) as a bar from f0."""
+    lines = p["budget"]
+    f0, (lo, hi) = p["f0_hz"], p["band_hz"]
+    with figure(path, 7.2, 1.2 + 0.32 * (len(lines) + len(p["models"]) + 1)) as fig:
+        ax = fig.add_subplot(1, 1, 1)
+        labels, y = [], 0
+        for b in reversed(lines):
+            ax.barh(y, b["high_hz"] - b["low_hz"], left=f0 + b["low_hz"], color="#8fb8e0", height=0.6)
+            labels.append(b["source"])
+            y += 1
+        ax.barh(y, hi - lo, left=lo, color="#e08a3c", height=0.7)
+        labels.append("band (root-sum-square)")
+        y += 1
+        for name, m in p["models"].items():
+            ax.plot([m["f0_hz"]], [y], marker="o" if m["valid"] else "x", color="black")
+            labels.append(f"{name}{' (chosen)' if name == p['model'] else ''}{'' if m['valid'] else ' (invalid)'}")
+            y += 1
+        ax.axvline(f0, color="#333333", linewidth=0.8, linestyle=":")
+        ax.set_yticks(range(len(labels)), labels, fontsize=8)
+        ax.set_xlabel("frequency [Hz]")
+        ax.set_title(f"f0 = {f0:.0f} Hz ({p['model']}), band {lo:.0f}–{hi:.0f} Hz", fontsize=10)
+        ax.grid(axis="x", alpha=0.3)
+    return {"part": "prediction", "file": path.name, "caption": "models, band and uncertainty budget"}
+
+
+def load_plot(p: dict, path: Path) -> dict | None:
+    """Paper Eq. 5 f(F) from the prediction's load curve (N, Hz); None when it has no point with a value."""
+    points = [(pt["force_n"], pt["f_hz"]) for pt in p.get("load_curve", ()) if pt["f_hz"] is not None]
+    if not points:
+        return None
+    force, freq = zip(*points)
+    with figure(path, 6.0, 3.4) as fig:
+        ax = fig.add_subplot(1, 1, 1)
+        ax.plot(force, freq, color="#c05010", marker=".")
+        ax.set_xlabel("normal force F [N]")
+        ax.set_ylabel("f [Hz]")
+        ax.set_title(f"load curve f(F), paper Eq. 5, calibration {p.get('calibration')}", fontsize=9)
+        ax.grid(alpha=0.3)
+    return {"part": "prediction", "file": path.name, "caption": "load curve f(F) (paper Eq. 5)"}

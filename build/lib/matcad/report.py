@@ -1,0 +1,172 @@
+"""report.json and report.md: resolved spec, as-built geometry, prediction, findings, BOM, file manifest."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections import defaultdict
+from pathlib import Path
+
+from matcad import __version__
+from matcad.acoustics.geometry import drafted_cavity_volume_mm3, drafted_tip_diameter_mm
+from matcad.parts.catalogue import laser_parts
+from matcad.parts.features import (bolt_nominal_mm, cap_flange_thickness_mm, cap_volume_mm3,
+                                   plate_bolt_positions_mm, plate_dowel_positions_mm)
+from matcad.spec import to_dict
+
+REPORT_FILES = ("report.json", "report.md", "report.html")
+THREAD_ENGAGEMENT_PER_D = 2.0
+"""Self-tapping screws into printed plastic want ~2 x diameter of engagement."""
+
+
+def as_built(spec) -> dict:
+    """Geometry as it will be made: drafted cavity, neck as cut and as finished (mm, mm³)."""
+    cav = spec.cavity
+    pilot = spec.plate.neck_pilot
+    return {
+        "cavity_diameter_mm": cav.diameter, "cavity_length_mm": cav.length, "draft_deg": spec.mold.draft_deg,
+        "cavity_tip_diameter_mm": float(drafted_tip_diameter_mm(cav.diameter, cav.length, spec.mold.draft_deg)),
+        "cavity_volume_mm3": float(drafted_cavity_volume_mm3(cav.diameter, cav.length, spec.mold.draft_deg)),
+        "draft_volume_change_pct": 100 * float(drafted_cavity_volume_mm3(cav.diameter, cav.length, spec.mold.draft_deg)
+                                               / drafted_cavity_volume_mm3(cav.diameter, cav.length, 0.0) - 1),
+        "neck_diameter_as_cut_mm": spec.neck.diameter - spec.plate.pilot_undersize if pilot else spec.neck.diameter,
+        "neck_diameter_finished_mm": spec.neck.diameter,
+        "neck_finish": "drill pilot to size" if pilot else "as cut (kerf compensated)",
+        "neck_length_mm": spec.neck.length, "neck_length_measured": spec.plate.thickness_measured,
+        "laser_kerf_mm": spec.machine.laser_kerf,
+        "cap_volume_mm3": cap_volume_mm3(spec),
+    }
+
+
+def bill_of_materials(spec) -> dict:
+    """Sheets, silicone, pins, bolts and needle needed for one taxel (plus the mold's batch)."""
+    sheets = defaultdict(lambda: {"parts": [], "area_mm2": 0.0, "measured": False})
+    for flat in laser_parts(spec):
+        s = sheets[flat.thickness]
+        s["parts"].append(f"{flat.quantity} x {flat.name}")
+        s["area_mm2"] += flat.area_mm2 * flat.quantity
+        s["measured"] = s["measured"] or flat.thickness_measured
+    cap = cap_volume_mm3(spec)
+    batch_ml = cap * spec.mold.count * spec.silicone.waste_factor / 1000
+    stack = spec.neck.length + cap_flange_thickness_mm(spec) + spec.guide.thickness + spec.spacer.height
+    bolt_d = bolt_nominal_mm(spec.fasteners.bolt)
+    engage = min(THREAD_ENGAGEMENT_PER_D * bolt_d, spec.mount.thickness)
+    return {
+        "sheets": [{"thickness_mm": t, **v} for t, v in sorted(sheets.items())],
+        "silicone": {"cap_volume_mm3": cap, "cap_mass_g": cap / 1000 * spec.silicone.density_g_cm3,
+                     "caps_per_pour": spec.mold.count, "batch_ml": batch_ml,
+                     "batch_mass_g": batch_ml * spec.silicone.density_g_cm3,
+                     "density_g_cm3": spec.silicone.density_g_cm3},
+        "dowels": {"count": len(plate_dowel_positions_mm(spec)), "diameter_mm": spec.fasteners.dowel_diameter,
+                   "min_length_mm": stack + engage},
+        "bolts": {"count": len(plate_bolt_positions_mm(spec)), "size": spec.fasteners.bolt,
+                  "min_length_mm": stack + engage, "note": "self-tapping into the printed mount"},
+        "spacers": ({"count": len(plate_bolt_positions_mm(spec)), "style": "laser",
+                     "note": f"{spec.spacer.size:g} mm squares cut from {spec.spacer.height:g} mm sheet"}
+                    if spec.spacer.style == "laser" else
+                    {"count": len(plate_bolt_positions_mm(spec)), "style": "standoff",
+                     "note": f"printed on the needle mount, {spec.spacer.height:g} mm tall"}),
+        "needle": {"count": 1, "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
+                   "y_mm": spec.needle.y},
+    }
+
+
+def manifest(folder: Path) -> list[dict]:
+    """Every output file (except the reports themselves) with its size and sha256."""
+    rows = []
+    for path in sorted(folder.iterdir()):
+        if path.name in REPORT_FILES:
+            continue
+        data = path.read_bytes()
+        rows.append({"file": path.name, "bytes": len(data), "sha256": hashlib.sha256(data).hexdigest()})
+    return rows
+
+
+def make_report(spec, prediction, findings, holes, meshes, folder: Path) -> dict:
+    return {
+        "matcad_version": __version__,
+        "name": spec.name,
+        "spec": to_dict(spec),
+        "as_built": as_built(spec) | {"laser_holes": holes},
+        "prediction": prediction.to_dict(),
+        "findings": [f.to_dict() for f in findings],
+        "verdict": "fail" if any(f.level == "error" for f in findings) else "pass",
+        "bom": bill_of_materials(spec),
+        "meshes": meshes,
+        "files": manifest(folder),
+    }
+
+
+def _cell(text) -> str:
+    """Free text made safe for a Markdown table cell."""
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _part_link(finding: dict, r: dict) -> str:
+    """The part a finding concerns, linked to its preview in the report ('–' when it names none)."""
+    from matcad.report_page import finding_part, part_anchor
+
+    part = finding_part(finding, r)
+    return f"[{part}](#{part_anchor(part)})" if part else "–"
+
+
+def _markdown(r: dict) -> str:
+    p, ab, bom = r["prediction"], r["as_built"], r["bom"]
+    lines = [f"# {r['name']} — matcad {r['matcad_version']} build report", "",
+             f"**Verdict: {r['verdict']}** · f0 = {p['f0_hz']:.0f} Hz ({p['model']}), band "
+             f"{p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz", "",
+             "## As built", "",
+             f"- cavity: D {ab['cavity_diameter_mm']:g} × L {ab['cavity_length_mm']:g} mm, draft "
+             f"{ab['draft_deg']:g}° (closed-end D {ab['cavity_tip_diameter_mm']:.3f} mm), volume "
+             f"{ab['cavity_volume_mm3']:.3f} mm³",
+             f"- neck: {ab['neck_diameter_finished_mm']:g} mm finished ({ab['neck_finish']}; cut at "
+             f"{ab['neck_diameter_as_cut_mm']:g} mm, kerf {ab['laser_kerf_mm']:g} mm), length "
+             f"{ab['neck_length_mm']:g} mm ({'measured' if ab['neck_length_measured'] else 'nominal'})",
+             f"- neck area {p['neck_area_mm2']:.4f} mm², A·l/V {p['neck_air_ratio']:.3f}, c "
+             f"{p['speed_of_sound_m_s']:.2f} m/s", "",
+             "## Prediction", "", "| model | f0 [Hz] | valid | failed checks |", "|---|---:|---|---|"]
+    for name, m in p["models"].items():
+        failed = ", ".join(k for k, ok in m["checks"].items() if not ok) or "–"
+        lines.append(f"| {name}{' (chosen)' if name == p['model'] else ''} | {m['f0_hz']:.1f} | "
+                     f"{'yes' if m['valid'] else 'no'} | {failed} |")
+    lines += ["", f"Band {p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz, root-sum-square in ln f of:", "",
+              "| source | tolerance | low [Hz] | high [Hz] |", "|---|---|---:|---:|"]
+    lines += [f"| {b['source']} | {_cell(b['tolerance'])} | {b['low_hz']:+.1f} | {b['high_hz']:+.1f} |"
+              for b in p["budget"]]
+    lines += ["", "## Design rules", "", "| level | rule | part | message | fix |", "|---|---|---|---|---|"]
+    lines += [f"| {f['level']} | {f['id']} | {_part_link(f, r)} | {_cell(f['message'])} | {_cell(f['fix'])} |"
+              for f in r["findings"]]
+    s = bom["silicone"]
+    lines += ["", "## Bill of materials", ""]
+    lines += [f"- acrylic {sh['thickness_mm']:g} mm{' (measured)' if sh['measured'] else ''}: "
+              f"{', '.join(sh['parts'])} — {sh['area_mm2'] / 100:.1f} cm²" for sh in bom["sheets"]]
+    lines += [f"- silicone: {s['cap_volume_mm3']:.1f} mm³ ({s['cap_mass_g']:.2f} g) per cap; mix "
+              f"{s['batch_ml']:.2f} ml = {s['batch_mass_g']:.2f} g for {s['caps_per_pour']} cap(s)",
+              f"- {bom['dowels']['count']} dowel pins Ø{bom['dowels']['diameter_mm']:g} mm, ≥ "
+              f"{bom['dowels']['min_length_mm']:.1f} mm long",
+              f"- {bom['spacers']['count']} spacers: {bom['spacers']['note']}",
+              f"- {bom['bolts']['count']} × {bom['bolts']['size']} bolts, ≥ {bom['bolts']['min_length_mm']:.1f} mm "
+              f"({bom['bolts']['note']})",
+              f"- needle Ø{bom['needle']['outer_diameter_mm']:g} mm at θ = {bom['needle']['theta_deg']:g}°, "
+              f"y = {bom['needle']['y_mm']:g} mm", "", "## Files", "", "| file | bytes | sha256 |", "|---|---:|---|"]
+    lines += [f"| {f['file']} | {f['bytes']} | `{f['sha256'][:16]}…` |" for f in r["files"]]
+    if r["meshes"]:
+        lines += ["", "## Mesh checks (STL read back)", "",
+                  "| file | watertight | is_volume | bodies | STL vs B-rep volume | print orientation (on the bed) |",
+                  "|---|---|---|---:|---:|---|"]
+        for name, m in r["meshes"].items():
+            dev = m["volume_mm3"] / m["brep_volume_mm3"] - 1
+            turn = f"turned {m['rotation_x_deg']:g}° about x; " if m["rotation_x_deg"] else "as modelled; "
+            lines.append(f"| {name} | {m['watertight']} | {m['is_volume']} | {m['bodies']} | {dev:+.4%} | "
+                         f"{_cell(turn + m['bed_face'])} |")
+    return "\n".join(lines) + "\n"
+
+
+def write_report(report: dict, folder: Path) -> None:
+    """report.json, and report.md and report.html from one Markdown rendering of the same data."""
+    from matcad.report_page import render_html, render_markdown
+
+    (folder / "report.json").write_text(json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+    text = render_markdown(report, _markdown(report))
+    (folder / "report.md").write_text(text, encoding="utf-8")
+    (folder / "report.html").write_text(render_html(text, f"{report['name']} — matcad report"), encoding="utf-8")

@@ -1,0 +1,101 @@
+"""report.md and report.html: one Markdown text rendered from the report data, and that same text as a page.
+
+The Markdown (:func:`matcad.report._markdown` plus the pictures and any report section this module does not
+know, rendered generically) is the single source; the HTML is the Markdown through markdown-it (CommonMark +
+tables) in a self-contained page — inline style, images as relative files beside it, no script, no network —
+so the two cannot drift.
+"""
+
+from __future__ import annotations
+
+import html
+
+KNOWN_KEYS = frozenset({"matcad_version", "name", "spec", "as_built", "prediction", "findings", "verdict", "bom",
+                        "meshes", "files", "figures"})
+"""Report keys rendered by :func:`matcad.report._markdown` or as pictures; every other key is rendered
+generically (a list as a numbered list, a list of tables as a table, a table as key: value lines)."""
+RULE_PARTS = {"needle.": "needle_mount", "fit.dowel_printed": "needle_mount", "mold.": "end_cap_mold_base",
+              "print.": "end_cap_mold_base", "cap.": "end_cap", "silicone.": "end_cap", "acoustic.": "prediction"}
+"""Rule id prefix → the part (picture) it concerns, for findings whose message does not start with a part."""
+STYLE = """
+body { font-family: system-ui, sans-serif; max-width: 68rem; margin: 2rem auto; padding: 0 1rem; color: #1a1a1a;
+       line-height: 1.45; }
+table { border-collapse: collapse; margin: 0.5rem 0 1rem; font-size: 0.9rem; }
+th, td { border: 1px solid #c8c8c8; padding: 0.2rem 0.5rem; vertical-align: top; }
+th { background: #eef2f7; }
+img { max-width: 100%; border: 1px solid #e0e0e0; background: white; }
+img[src$=".svg"] { width: 40rem; }
+code { font-size: 0.85rem; }
+h2 { border-bottom: 1px solid #ddd; margin-top: 2rem; }
+:target + h3 { background: #fff3c4; }
+"""
+
+
+def part_anchor(part: str) -> str:
+    """HTML id of a part's picture."""
+    return f"part-{part}"
+
+
+def finding_part(finding: dict, r: dict) -> str | None:
+    """The pictured part a finding concerns: the part its message starts with, else by its rule id."""
+    pictured = {f["part"] for f in r.get("figures", ())}
+    head = finding["message"].split(":", 1)[0].strip()
+    if head in pictured:
+        return head
+    for prefix, part in RULE_PARTS.items():
+        if finding["id"].startswith(prefix) and part in pictured:
+            return part
+    return None
+
+
+def _pictures(r: dict) -> list[str]:
+    lines, seen = ["## Pictures", ""], set()
+    for fig in r.get("figures", ()):
+        if fig["part"] not in seen:
+            seen.add(fig["part"])
+            lines += [f'<a id="{part_anchor(fig["part"])}"></a>', ""]
+        lines += [f"### {fig['caption']}", "", f"![{fig['caption']}]({fig['file']})", ""]
+    return lines if seen else []
+
+
+def _title(key: str) -> str:
+    return key.replace("_", " ").capitalize()
+
+
+def _generic(key: str, value) -> list[str]:
+    """A report section this module does not know, as Markdown."""
+    from matcad.report import _cell
+
+    lines = [f"## {_title(key)}", ""]
+    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        cols = list(dict.fromkeys(k for v in value for k in v))
+        lines += ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+        lines += ["| " + " | ".join(_cell(v.get(c, "")) for c in cols) + " |" for v in value]
+    elif isinstance(value, list):
+        lines += [f"{i}. {_cell(v)}" for i, v in enumerate(value, 1)]
+    elif isinstance(value, dict):
+        lines += [f"- {_title(k)}: {_cell(v)}" for k, v in value.items()]
+    else:
+        lines.append(_cell(value))
+    return lines + [""]
+
+
+def render_markdown(r: dict, body: str) -> str:
+    """The report as Markdown: ``body`` (the known sections) with the pictures after its title block and every
+    unknown report key appended as its own section."""
+    head, sep, rest = body.partition("\n## ")
+    lines = [head.rstrip("\n"), ""] + _pictures(r)
+    text = "\n".join(lines) + (sep.lstrip("\n") + rest if sep else "")
+    extra = [line for key, value in r.items() if key not in KNOWN_KEYS for line in _generic(key, value)]
+    return text.rstrip("\n") + "\n" + ("\n" + "\n".join(extra).rstrip("\n") + "\n" if extra else "")
+
+
+def render_html(markdown_text: str, title: str) -> str:
+    """``markdown_text`` as one self-contained HTML page (CommonMark + tables; inline HTML kept for anchors)."""
+    from markdown_it import MarkdownIt
+
+    body = MarkdownIt("commonmark", {"html": True}).enable("table").render(markdown_text)
+    return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+            "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src 'self' data: file:; "
+            "style-src 'unsafe-inline'\">\n"
+            f"<title>{html.escape(title)}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n{body}</body>\n</html>\n")
