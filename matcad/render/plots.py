@@ -40,16 +40,20 @@ def band_plot(p: dict, path: Path) -> dict:
 
 
 def load_plot(p: dict, path: Path) -> dict | None:
-    """Paper Eq. 5 f(F) from the prediction's load curve (N, Hz); None when it has no point with a value."""
-    points = [(pt["force_n"], pt["f_hz"]) for pt in p.get("load_curve", ()) if pt["f_hz"] is not None]
+    """f(F) from the prediction's load curve, one line per source (Eq. 5 calibration, cap mechanics) (N, Hz);
+    None when no point has a value."""
+    points = [pt for pt in p.get("load_curve", ()) if pt["f_hz"] is not None]
     if not points:
         return None
-    force, freq = zip(*points)
-    with figure(path, 6.0, 3.4) as fig:
+    sources = list(dict.fromkeys(pt.get("source", "Eq. 5") for pt in points))
+    with figure(path, 6.4, 3.6) as fig:
         ax = fig.add_subplot(1, 1, 1)
-        ax.plot(force, freq, color="#c05010", marker=".")
+        for source in sources:
+            mine = [pt for pt in points if pt.get("source", "Eq. 5") == source]
+            ax.plot([pt["force_n"] for pt in mine], [pt["f_hz"] for pt in mine], marker=".", label=source)
         ax.set_xlabel("normal force F [N]")
         ax.set_ylabel("f [Hz]")
-        ax.set_title(f"load curve f(F), paper Eq. 5, calibration {p.get('calibration')}", fontsize=9)
+        ax.set_title("load curve f(F)", fontsize=9)
+        ax.legend(fontsize=7)
         ax.grid(alpha=0.3)
-    return {"part": "prediction", "file": path.name, "caption": "load curve f(F) (paper Eq. 5)"}
+    return {"part": "prediction", "file": path.name, "caption": "load curve f(F): " + "; ".join(sources)}
