@@ -46,8 +46,8 @@ def spec_notes(spec, data: dict | None = None) -> list[str]:
     if rate < SAMPLE_RATE_KHZ_MAX:
         notes.append(f"microphone.sample_rate_hz = {rate:g} Hz: kHz entered? did you mean {rate * 1000:g} (Hz)?")
     if data is not None and "wall" not in data:
-        notes.append("no [wall] table: the walls default to rigid (wall.model = 'rigid'); a cast silicone cap is "
-                     "compliant and sings lower — set [wall] model = 'silicone' to include it")
+        notes.append("no [wall] table: the walls default to rigid (wall.model = 'rigid'); a cast silicone cap has "
+                     "wall modes near the tone that move it — set [wall] model = 'silicone' to include them")
     return notes
 
 
