@@ -22,11 +22,24 @@ def write_stl(shape, path: Path, tolerance_mm: float, angular_tolerance_rad: flo
 
 
 def write_step(shape, path: Path) -> None:
-    """STEP AP214 in mm."""
+    """STEP AP214 in mm, byte-for-byte reproducible: a fixed timestamp, and assembly-occurrence ids numbered per
+    file (OpenCASCADE numbers them from a process-wide counter, so a second export in one process differs)."""
+    import itertools
+    import re
+
     from build123d import Unit, export_step
 
     if not export_step(shape, str(path), unit=Unit.MM, timestamp="2000-01-01T00:00:00"):
         raise RuntimeError(f"STEP export failed for {path.name}")
+    text = path.read_text(encoding="utf-8")
+    count = itertools.count(1)
+
+    def renumber(m):
+        return f"NEXT_ASSEMBLY_USAGE_OCCURRENCE('{next(count)}'" + re.sub(r"\s*\n\s*", "", m.group(1)) + ";"
+
+    fixed = re.sub(r"NEXT_ASSEMBLY_USAGE_OCCURRENCE\('\d+'(.*?);", renumber, text, flags=re.S)
+    if fixed != text:
+        path.write_text(fixed, encoding="utf-8")
 
 
 def mesh_checks(path: Path) -> dict:
