@@ -14,22 +14,20 @@ import numpy as np
 LOAD_POINTS = 41
 LOAD_FORCE_MAX_N = 20.0
 """Load curve drawn up to the calibration's measured range, else this (the paper loads to ~20 N), and never
-past Eq. 5's V_eff minimum when a calibration is drawn."""
+past Eq. 5's V_eff minimum."""
 
 
 def load_forces_n(spec) -> np.ndarray:
-    """Forces (N) at which to draw f(F) for ``spec``: with a calibration (Eq. 5) or a cast cap (its mechanics);
-    empty for a laser-only spec without a calibration, which so never loads the mechanics solver."""
+    """Forces (N) at which the build draws Eq. 5 f(F) for ``spec``'s calibration; empty without one (the cap
+    mechanics' curve takes seconds and stays with ``matcad predict --load``)."""
     from matcad.acoustics.load import force_at_volume_minimum_n
     from matcad.acoustics.predict import spec_calibration
 
     cal = spec_calibration(spec)
-    if cal is None and not spec.outputs.end_cap_mold:
+    if cal is None:
         return np.array([])
-    measured = spec.calibration.force_range_n if spec.calibration is not None else None
-    lo, hi = measured or (0.0, LOAD_FORCE_MAX_N)
-    if cal is not None:
-        hi = min(hi, force_at_volume_minimum_n(cal))
+    lo, hi = spec.calibration.force_range_n or (0.0, LOAD_FORCE_MAX_N)
+    hi = min(hi, force_at_volume_minimum_n(cal))
     return np.linspace(max(lo, 0.0), hi, LOAD_POINTS) if hi > max(lo, 0.0) else np.array([])
 
 
