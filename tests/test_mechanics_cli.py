@@ -35,6 +35,9 @@ def test_predict_force_without_calibration_uses_the_cap_mechanics(write_spec):
     assert model["complete"] and model["sensitivity_hz_per_n_at_0"] > 0
     assert model["eq5"]["area_convention"] == "pi_d2/4" and model["eq5"]["b"] > 0
     assert len(model["curve"]) == 5
+    first, last = (model["curve"][i]["cavity_outline_mm"] for i in (0, -1))
+    assert first[0] == [1.59, 0.0] and first[-1] == [0.0, 4.76]  # wall foot on the plate ... axis under the top
+    assert last[0] == [1.59, 0.0] and last[-1][0] == 0.0 and last[-1][1] < 4.76  # the top moved down
 
 
 def test_predict_force_table_names_each_source(write_spec):

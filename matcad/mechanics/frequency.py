@@ -141,7 +141,7 @@ def at_forces(fc: ForceCurve, forces_n) -> list[tuple[float, float | None, float
 def load_points(spec, forces_n, f0_hz: float, fem_level: int | None = None) -> tuple[list[dict], dict]:
     """The cap model's answer to ``matcad predict --force``: one row per force (force_n, f_hz, displacement_mm,
     cavity_volume_mm3, reason, source) and a summary (material, contact, run, df/dF, turn force, Eq. 5 fit, the
-    whole computed curve). ``f0_hz`` is the unloaded ladder's chosen f0 (Hz); see :func:`force_curve`."""
+    whole computed curve with each state's deformed cavity outline as [r, z] mm from the wall's foot to the axis). ``f0_hz`` is the unloaded ladder's chosen f0 (Hz); see :func:`force_curve`."""
     from matcad.mechanics.solver import cap_curve
 
     curve = cap_curve(spec)
@@ -162,7 +162,9 @@ def load_points(spec, forces_n, f0_hz: float, fem_level: int | None = None) -> t
         "sensitivity_hz_per_n_at_0": fc.sensitivity_hz_per_n[0], "max_force_n": fc.states[-1].force_n,
         "turn_force_n": fc.turn_force_n, "eq5": constants(fc.eq5), "eq5_paper_convention":
             constants(fc.eq5_paper_convention), "fit_note": fc.fit_note,
-        "curve": [dataclasses.asdict(s) | {"sensitivity_hz_per_n": d, "peak_strain": p}
-                  for s, d, p in zip(fc.states, fc.sensitivity_hz_per_n, curve.column("peak_strain"))],
+        "curve": [dataclasses.asdict(s) | {"sensitivity_hz_per_n": d, "peak_strain": p,
+                                            "cavity_outline_mm": np.round(o, 5).tolist()}
+                  for s, d, p, o in zip(fc.states, fc.sensitivity_hz_per_n, curve.column("peak_strain"),
+                                        [curve.unloaded_outline] + [st.cavity_outline for st in curve.steps])],
     }
     return rows, summary
