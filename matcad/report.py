@@ -12,6 +12,7 @@ from matcad.acoustics.geometry import drafted_cavity_volume_mm3, drafted_tip_dia
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.features import (bolt_nominal_mm, cap_flange_thickness_mm, cap_volume_mm3,
                                    plate_bolt_positions_mm, plate_dowel_positions_mm)
+from matcad.parts.fabrication import fabrication
 from matcad.spec import to_dict
 
 REPORT_FILES = ("report.json", "report.md", "report.html")
@@ -46,16 +47,19 @@ def bill_of_materials(spec) -> dict:
         s["parts"].append(f"{flat.quantity} x {flat.name}")
         s["area_mm2"] += flat.area_mm2 * flat.quantity
         s["measured"] = s["measured"] or flat.thickness_measured
+    from matcad.parts.casting import MIN_BATCH_G
+
     cap = cap_volume_mm3(spec)
-    batch_ml = cap * spec.mold.count * spec.silicone.waste_factor / 1000
+    needed_g = cap * spec.mold.count * spec.silicone.waste_factor / 1000 * spec.silicone.density_g_cm3
+    batch_g = max(needed_g, MIN_BATCH_G)
     stack = spec.neck.length + cap_flange_thickness_mm(spec) + spec.guide.thickness + spec.spacer.height
     bolt_d = bolt_nominal_mm(spec.fasteners.bolt)
     engage = min(THREAD_ENGAGEMENT_PER_D * bolt_d, spec.mount.thickness)
     return {
         "sheets": [{"thickness_mm": t, **v} for t, v in sorted(sheets.items())],
         "silicone": {"cap_volume_mm3": cap, "cap_mass_g": cap / 1000 * spec.silicone.density_g_cm3,
-                     "caps_per_pour": spec.mold.count, "batch_ml": batch_ml,
-                     "batch_mass_g": batch_ml * spec.silicone.density_g_cm3,
+                     "caps_per_pour": spec.mold.count, "needed_mass_g": needed_g, "batch_mass_g": batch_g,
+                     "batch_ml": batch_g / spec.silicone.density_g_cm3,
                      "density_g_cm3": spec.silicone.density_g_cm3},
         "dowels": {"count": len(plate_dowel_positions_mm(spec)), "diameter_mm": spec.fasteners.dowel_diameter,
                    "min_length_mm": stack + engage},
@@ -69,6 +73,20 @@ def bill_of_materials(spec) -> dict:
         "needle": {"count": 1, "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
                    "y_mm": spec.needle.y},
     }
+
+
+def casting(spec) -> dict | None:
+    """The pour guide and the mold's venting (mm, g, min, h, °C), when the mold is built."""
+    if not spec.outputs.end_cap_mold:
+        return None
+    from matcad.parts.casting import casting_guide
+    from matcad.parts.mold_layout import layout
+
+    plan = layout(spec).plan
+    return casting_guide(spec).to_dict() | {"venting": {
+        "vent_reach_mm": spec.mold.vent_reach, "base_face_reach_mm": plan.reach_base_mm,
+        "pin_end_reach_mm": plan.reach_tip_mm, "base_face_vents_per_cap": len(plan.inner) + len(plan.outer),
+        "pin_vents_per_cap": 1, "vent_diameter_mm": spec.mold.vent}}
 
 
 def manifest(folder: Path) -> list[dict]:
@@ -92,6 +110,8 @@ def make_report(spec, prediction, findings, holes, meshes, folder: Path) -> dict
         "findings": [f.to_dict() for f in findings],
         "verdict": "fail" if any(f.level == "error" for f in findings) else "pass",
         "bom": bill_of_materials(spec),
+        "casting": casting(spec),
+        "fabrication": fabrication(spec),
         "meshes": meshes,
         "files": manifest(folder),
     }
@@ -108,6 +128,40 @@ def _part_link(finding: dict, r: dict) -> str:
 
     part = finding_part(finding, r)
     return f"[{part}](#{part_anchor(part)})" if part else "–"
+
+
+def _fabrication_markdown(f: dict | None) -> list[str]:
+    if not f:
+        return []
+    s = f["seal"]
+    lines = ["", "## Fabrication", "", "Caliper these sheets before cutting — the guide sheet before printing the mold:",
+             "", "| sheet [mm] | first part | tolerance [mm] | measured | why |", "|---:|---|---:|---|---|"]
+    lines += [f"| {c['sheet_mm']:g} | {c['part']} | ±{c['tolerance_mm']:.2f} | {'yes' if c['measured'] else '**no**'} | "
+              f"{_cell(c['why'])} |" for c in f["caliper"]]
+    lines += ["", f"Seal: the flange is cast {s['guide_sheet_mm']:g} + {s['flange_squeeze_mm']:g} mm thick; over the "
+              f"guide sheet's ±{s['sheet_tolerance_mm']:.2f} mm the clamp squeezes it {s['squeeze_low_mm']:+.2f} … "
+              f"{s['squeeze_high_mm']:+.2f} mm ({'measured' if s['guide_measured'] else 'nominal'} sheet)."]
+    lines += [f"{i}. {_cell(step)}" for i, step in enumerate(f.get("steps", ()), 1)]
+    return lines
+
+
+def _casting_markdown(c: dict | None) -> list[str]:
+    if not c:
+        return []
+    v = c["venting"]
+    lines = ["", "## Casting guide", "",
+             f"{c['caps']} cap(s) of {c['grade']} in a {c['mold_material']} mold: mix **{c['batch_g']:.1f} g** "
+             f"({c['mix_ratio']}) — {c['batch_reason']}. Pot life {c['pot_life_min']:g} min; cure "
+             f"{c['cure_h_room']:g} h at 23 °C or warm at most {c['max_cure_c']:g} °C.", "",
+             f"Venting: every ceiling of each cavity in pour orientation reaches an opening within "
+             f"{v['vent_reach_mm']:g} mm — base face {v['base_face_reach_mm']:.2f} mm ({v['base_face_vents_per_cap']} "
+             f"vents + the fill port), core-pin end over the membrane {v['pin_end_reach_mm']:.2f} mm (a vent along "
+             "the pin).", ""]
+    if c["inhibition"]:
+        lines += [f"**SLA cure inhibition:** {c['inhibition']}.", ""]
+    lines += [f"{i}. {step}" for i, step in enumerate(c["steps"], 1)]
+    lines += ["", "Trim:", ""] + [f"- {t}" for t in c["trim"]]
+    return lines
 
 
 def _markdown(r: dict) -> str:
@@ -143,14 +197,18 @@ def _markdown(r: dict) -> str:
     lines += [f"- acrylic {sh['thickness_mm']:g} mm{' (measured)' if sh['measured'] else ''}: "
               f"{', '.join(sh['parts'])} — {sh['area_mm2'] / 100:.1f} cm²" for sh in bom["sheets"]]
     lines += [f"- silicone: {s['cap_volume_mm3']:.1f} mm³ ({s['cap_mass_g']:.2f} g) per cap; mix "
-              f"{s['batch_ml']:.2f} ml = {s['batch_mass_g']:.2f} g for {s['caps_per_pour']} cap(s)",
+              f"{s['batch_mass_g']:.1f} g ({s['batch_ml']:.1f} ml) for {s['caps_per_pour']} cap(s), of which "
+              f"{s['needed_mass_g']:.2f} g fills caps, sprues and cup",
               f"- {bom['dowels']['count']} dowel pins Ø{bom['dowels']['diameter_mm']:g} mm, ≥ "
               f"{bom['dowels']['min_length_mm']:.1f} mm long",
               f"- {bom['spacers']['count']} spacers: {bom['spacers']['note']}",
               f"- {bom['bolts']['count']} × {bom['bolts']['size']} bolts, ≥ {bom['bolts']['min_length_mm']:.1f} mm "
               f"({bom['bolts']['note']})",
               f"- needle Ø{bom['needle']['outer_diameter_mm']:g} mm at θ = {bom['needle']['theta_deg']:g}°, "
-              f"y = {bom['needle']['y_mm']:g} mm", "", "## Files", "", "| file | bytes | sha256 |", "|---|---:|---|"]
+              f"y = {bom['needle']['y_mm']:g} mm"]
+    lines += _fabrication_markdown(r.get("fabrication"))
+    lines += _casting_markdown(r.get("casting"))
+    lines += ["", "## Files", "", "| file | bytes | sha256 |", "|---|---:|---|"]
     lines += [f"| {f['file']} | {f['bytes']} | `{f['sha256'][:16]}…` |" for f in r["files"]]
     if r["meshes"]:
         lines += ["", "## Mesh checks (STL read back)", "",

@@ -177,6 +177,8 @@ class Mold(Section):
     count: int = _param("caps per mold", default=1, kind="integer", lo=1, hi=50)
     fill_port: float = _length("fill port diameter (>= 2 mm for syringe filling)", 2.0)
     vent: float = _length("vent diameter", 1.0)
+    vent_reach: float = _length("farthest any point of a cavity ceiling in pour orientation may be from the edge "
+                                "of a vent or the fill port; vents are added until it holds", 2.0)
     bolt: str = _param("mold clamp bolt size", default="M3", kind="choice", choices=("M2", "M2.5", "M3"))
     key_height: float = _length("registration key (truncated cone) height", 2.0)
     key_diameter: float = _length("registration key base diameter", 4.0)

@@ -187,7 +187,26 @@ def test_mold_lid_exported_pins_up_with_its_outer_face_on_the_bed(built):
     mesh = trimesh.load_mesh(out / "end_cap_mold_lid.stl")
     # the lid plate (lid_thickness) is at the bottom, the core pins (cavity length) stand above it
     assert mesh.bounds[1, 2] == pytest.approx(spec.mold.lid_thickness + spec.cavity.length, abs=1e-6)
-    holes = (len(lay.fill_ports) * spec.mold.fill_port ** 2 + len(lay.vents) * spec.mold.vent ** 2
+    vents = len(lay.vents) + len(lay.pin_vents)
+    holes = (len(lay.fill_ports) * spec.mold.fill_port ** 2 + vents * spec.mold.vent ** 2
              + len(lay.bolts) * bolt_clearance_mm(spec.mold.bolt, "normal") ** 2) * np.pi / 4
     bed = _horizontal_groups(mesh)[(-1, 0.0)]
     assert bed == pytest.approx(lay.block_x * lay.block_y - holes, rel=2e-3)
+
+
+def test_seal_squeeze_read_back_from_the_cast_cap(built):
+    """The report's squeeze range is the flange measured on end_cap.stl minus the guide sheet ± its tolerance."""
+    spec, out, _ = built
+    if not spec.outputs.end_cap_mold:
+        return
+    report = json.loads((out / "report.json").read_text())
+    seal = report["fabrication"]["seal"]
+    groups = _horizontal_groups(trimesh.load_mesh(out / "end_cap.stl"))
+    flange = min(z for sign, z in groups if sign == 1)  # the flange's top: the lowest up-facing step
+    t, tol = spec.guide.thickness, seal["sheet_tolerance_mm"]
+    assert seal["squeeze_low_mm"] == pytest.approx(flange - (t + tol), abs=1e-3)
+    assert seal["squeeze_high_mm"] == pytest.approx(flange - (t - tol), abs=1e-3)
+    assert seal["squeeze_low_mm"] > 0  # the templates' measured guide sheet keeps the flange squeezed
+    md = (out / "report.md").read_text()
+    guide = next(c for c in report["fabrication"]["caliper"] if c["part"].startswith("guide"))
+    assert guide["before_mold"] and "before printing the mold" in md

@@ -46,6 +46,12 @@ class BudgetLine:
     high_hz: float
 
 
+def sheet_tolerance_mm(thickness_mm: float, measured: bool) -> float:
+    """± thickness tolerance of an acrylic sheet (mm): a calipered sheet :data:`MEASURED_SHEET_TOL_MM`, else cast
+    sheet per ISO 7823-1, ±(0.4 + 0.1 t)."""
+    return MEASURED_SHEET_TOL_MM if measured else 0.4 + 0.1 * thickness_mm
+
+
 def model_errors() -> dict:
     """Relative model errors against the converged FEM, as measured by benchmarks/error_vs_runtime.py."""
     return json.loads((Path(__file__).parent / "model_errors.json").read_text(encoding="utf-8"))
@@ -97,7 +103,7 @@ def budget(spec, res, model: str, f0_hz: float, valid: bool = True) -> list[Budg
     lines.append(BudgetLine("neck diameter", f"+-{tol:g} mm ({'drilled' if drilled else 'laser cut'})",
                             *shifts(d_variants)))
     t = spec.neck.length
-    tol = MEASURED_SHEET_TOL_MM if spec.plate.thickness_measured else 0.4 + 0.1 * t
+    tol = sheet_tolerance_mm(t, spec.plate.thickness_measured)
     what = "measured" if spec.plate.thickness_measured else "ISO 7823-1 cast sheet"
     lines.append(BudgetLine("neck length (sheet)", f"+-{tol:.3g} mm ({what})",
                             *shifts([_replace(spec, "neck", length=max(t - tol, 0.05 * t)),

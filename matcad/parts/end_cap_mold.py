@@ -7,60 +7,22 @@ orientation is as modelled, z up:
 - **lid** (z > 0): a plate carrying the core pins that form the cavities (drafted toward their tips so they
   release), with sockets over the base's truncated-cone registration keys (clearance per side from the
   printer's fit class), a fill port per cap over the body annulus, vents, and clamp bolt holes.
-The only ceiling of each mold cavity in pour orientation is the lid's underside over the flange ring, so
-that is where air collects: each cap gets vents around that ring, away from the fill port.
+Each cavity has two ceilings in pour orientation (see :mod:`matcad.parts.mold_layout`): the base face under
+the lid, vented by rings of holes planned so no point is farther than ``mold.vent_reach`` from an opening, and
+the core pin's end face over the sensing membrane, vented along the pin's axis.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
-
 from build123d import Box, Pos, Rot
 
 from matcad.parts.end_cap import cap_envelope, core_pin, end_cap
-from matcad.parts.features import bolt_clearance_mm, cap_flange_diameter_mm, cap_height_mm
+from matcad.parts.features import bolt_clearance_mm
+from matcad.parts.mold_layout import MoldLayout, layout  # noqa: F401  (the layout is part of this part's API)
 from matcad.parts.solid import BOTTOM, TOP, cylinder_up, frustum_up
 
 KEY_TOP_RATIO = 0.6
 """Key top diameter / base diameter: a truncated cone that self-centres as the lid closes."""
-VENT_ANGLES_DEG = (90.0, 180.0, 270.0)
-"""Vents around the flange ring, the fill port sitting at 0°."""
-
-
-@dataclass(frozen=True)
-class MoldLayout:
-    """Where things are in the mold frame (mm)."""
-
-    cap_x: tuple[float, ...]
-    block_x: float
-    block_y: float
-    keys: tuple[tuple[float, float], ...]
-    bolts: tuple[tuple[float, float], ...]
-    fill_ports: tuple[tuple[float, float], ...]
-    vents: tuple[tuple[float, float], ...]
-    base_height: float
-
-
-def layout(spec) -> MoldLayout:
-    """Positions of caps, keys, bolts, fill ports and vents (mm); pure arithmetic, no CAD."""
-    m = spec.mold
-    flange_d = cap_flange_diameter_mm(spec)
-    pitch = flange_d + m.wall
-    cap_x = tuple((i - (m.count - 1) / 2) * pitch for i in range(m.count))
-    feature = max(m.key_diameter + 2 * spec.machine.key_clearance, bolt_clearance_mm(m.bolt, "normal"))
-    end_zone = feature + m.wall
-    block_x = m.count * pitch + m.wall + 2 * end_zone
-    block_y = max(flange_d + 2 * m.wall, 2 * feature + 3 * m.wall)
-    xe = block_x / 2 - end_zone / 2
-    ye = block_y / 4
-    r_fill = (spec.cavity.diameter + spec.end_cap.outer_diameter) / 4
-    r_vent = (spec.end_cap.outer_diameter + flange_d) / 4
-    fill = tuple((x + r_fill, 0.0) for x in cap_x)
-    vents = tuple((x + r_vent * math.cos(math.radians(a)), r_vent * math.sin(math.radians(a)))
-                  for x in cap_x for a in VENT_ANGLES_DEG)
-    return MoldLayout(cap_x, block_x, block_y, keys=((xe, ye), (-xe, -ye)), bolts=((xe, -ye), (-xe, ye)),
-                      fill_ports=fill, vents=vents, base_height=cap_height_mm(spec) + m.floor)
 
 
 def _key(spec, grow: float, x: float, y: float):
@@ -84,7 +46,8 @@ def mold_base(spec):
 
 
 def mold_lid(spec):
-    """Lid: bottom face at z = 0, core pins hanging into the caps, key sockets, fill ports, vents, bolts (mm)."""
+    """Lid: bottom face at z = 0, core pins (each vented along its axis) hanging into the caps, key sockets, fill
+    ports, vents, bolts (mm)."""
     lay = layout(spec)
     m = spec.mold
     lid = Box(lay.block_x, lay.block_y, m.lid_thickness, align=BOTTOM)
@@ -93,7 +56,9 @@ def mold_lid(spec):
              + [(x, y, m.vent / 2) for x, y in lay.vents]
              + [(x, y, bolt_clearance_mm(m.bolt, "normal") / 2) for x, y in lay.bolts])
     return lid.cut(*[_key(spec, spec.machine.key_clearance, x, y) for x, y in lay.keys],
-                   *[cylinder_up(r, m.lid_thickness, x, y, 0.0) for x, y, r in holes])
+                   *[cylinder_up(r, m.lid_thickness, x, y, 0.0) for x, y, r in holes],
+                   *[cylinder_up(m.vent / 2, spec.cavity.length + m.lid_thickness, x, y, -spec.cavity.length)
+                     for x, y in lay.pin_vents])
 
 
 def cast_caps(spec):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.features import is_stock_sheet
 from matcad.parts.flat import Flat, drawn_holes
@@ -103,7 +104,7 @@ def stock_thickness(spec) -> list[Finding]:
                                f"{flat.name}: {flat.thickness:g} mm is not a stock acrylic thickness",
                                "use a stock sheet, or measure yours and mark it *_measured = true"))
         else:
-            tol = 0.4 + 0.1 * flat.thickness
+            tol = sheet_tolerance_mm(flat.thickness, False)
             # the plate's thickness is the neck length l, which sets f: nominal is not good enough there
             level = "warning" if flat.name == "neck_plate" else "info"
             out.append(Finding("laser.stock", level, flat.thickness, round(tol, 3),

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from matcad.parts.features import cap_volume_mm3
+from matcad.parts.casting import MIN_BATCH_G, MOLD_MATERIALS, casting_guide
+from matcad.parts.mold_layout import pin_tip_radius_mm, plan_vents
 from matcad.rules import Finding
 
 MIN_WALL_SLA_MM = 0.8
@@ -62,17 +63,31 @@ def fill_and_vents(spec) -> list[Finding]:
     ring = spec.end_cap.flange_width
     if m.vent > ring:
         out.append(Finding("mold.vents", "error", m.vent, ring,
-                           f"vents ({m.vent:g} mm) do not fit on the flange ring ({ring:g} mm), the cavity's "
-                           "only high point in pour orientation: air would be trapped",
-                           "reduce mold.vent or widen end_cap.flange_width"))
-    elif spec.machine.printer == "fdm" and m.vent < 2 * spec.machine.nozzle:
+                           f"vents ({m.vent:g} mm) do not fit on the flange ring ({ring:g} mm): the base face "
+                           "over the flange could not be vented", "reduce mold.vent or widen end_cap.flange_width"))
+        return out
+    if spec.machine.printer == "fdm" and m.vent < 2 * spec.machine.nozzle:
         out.append(Finding("mold.vents", "warning", m.vent, 2 * spec.machine.nozzle,
                            f"{m.vent:g} mm vents may print closed with a {spec.machine.nozzle:g} mm nozzle",
                            "enlarge mold.vent or drill the vents open"))
+    pin_wall = (2 * pin_tip_radius_mm(spec) - m.vent) / 2
+    if pin_wall < _min_wall_mm(spec):
+        out.append(Finding("mold.pin_vent", "error", round(pin_wall, 4), _min_wall_mm(spec),
+                           f"the vent along the core pin leaves a {pin_wall:.2f} mm wall at the pin's end",
+                           "reduce mold.vent"))
+    plan = plan_vents(spec)
+    n = len(plan.inner) + len(plan.outer)
+    reach = max(plan.reach_base_mm, plan.reach_tip_mm)
+    if not plan.feasible:
+        out.append(Finding("mold.vent_reach", "error", round(reach, 3), m.vent_reach,
+                           f"no vent layout brings every cavity ceiling within {m.vent_reach:g} mm of an opening "
+                           f"(best: {reach:.2f} mm with {n} vents per cap): bubbles would stay in the cap",
+                           "raise mold.vent_reach, or change mold.vent / mold.fill_port"))
     else:
-        out.append(Finding("mold.vents", "info", m.vent, ring,
-                           "3 vents per cap on the flange ring (the only ceiling in pour orientation), fill "
-                           "port over the body wall", ""))
+        out.append(Finding("mold.vent_reach", "info", round(reach, 3), m.vent_reach,
+                           f"per cap: {n} vents over the base face (farthest ceiling point "
+                           f"{plan.reach_base_mm:.2f} mm from an opening) and one along the core pin (its end face "
+                           f"over the membrane within {plan.reach_tip_mm:.2f} mm); fill port over the body wall", ""))
     return out
 
 
@@ -86,14 +101,20 @@ def cap_wall(spec) -> list[Finding]:
 
 
 def silicone_batch(spec) -> list[Finding]:
-    cap = cap_volume_mm3(spec)
-    cast = cap * spec.mold.count
-    batch = cast * spec.silicone.waste_factor
-    mass = batch / 1000 * spec.silicone.density_g_cm3
-    return [Finding("silicone.batch", "info", round(batch / 1000, 4), None,
-                    f"{spec.mold.count} cap(s) of {cap:.1f} mm^3 = {cast / 1000:.3f} ml cast; mix "
-                    f"{batch / 1000:.3f} ml = {mass:.2f} g (x{spec.silicone.waste_factor:g} for cups and vents), "
-                    "1A:1B by weight, degas; cure <= 45 C in PLA molds", "")]
+    guide = casting_guide(spec)
+    return [Finding("silicone.batch", "info", round(guide.batch_g, 3), MIN_BATCH_G,
+                    f"{guide.caps} cap(s) = {guide.cast_volume_ml:.3f} ml cast; mix {guide.batch_g:.1f} g of "
+                    f"{guide.grade} ({guide.mix_ratio}): {guide.batch_reason}; pot life {guide.pot_life_min:g} min, "
+                    f"cure {guide.cure_h_room:g} h at 23 C or <= {guide.max_cure_c:g} C in {guide.mold_material} molds",
+                    "")]
 
 
-RULES = (printable_walls, key_clearance, fill_and_vents, cap_wall, silicone_batch)
+def sla_inhibition(spec) -> list[Finding]:
+    if not (spec.outputs.end_cap_mold and spec.machine.printer == "sla"):
+        return []
+    return [Finding("mold.cure_inhibition", "warning", "sla", "post-cured or barrier-coated",
+                    MOLD_MATERIALS["sla"]["inhibition"], "post-cure the SLA mold fully, or barrier-coat it; "
+                    "cast a test drop")]
+
+
+RULES = (printable_walls, key_clearance, fill_and_vents, cap_wall, silicone_batch, sla_inhibition)

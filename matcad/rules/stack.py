@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
-from matcad.parts.features import needle_tip_mm
+from matcad.acoustics.uncertainty import sheet_tolerance_mm
+from matcad.parts.features import cap_flange_thickness_mm, needle_tip_mm
 from matcad.rules import Finding
 
 PAPER_THETA_DEG = (30.0, 75.0)
 PAPER_Y_MM = (0.0, 3.47)
 """The paper's tested window (Sec. II): outside it the taxel may not sound."""
+MAX_FLANGE_STRAIN = 0.3
+"""Most compression a cast silicone flange should take: elastomer seals are designed for ~10-30 % squeeze
+(O-ring practice, e.g. Parker O-Ring Handbook ORD 5700, static face seals); beyond it the silicone creeps."""
 
 
 def needle_clearance(spec) -> list[Finding]:
@@ -41,6 +45,40 @@ def needle_window(spec) -> list[Finding]:
     return out
 
 
+def squeeze_range_mm(spec) -> tuple[float, float, float]:
+    """Flange squeeze the clamp can produce over the guide sheet's tolerance: (low, high, tolerance) in mm.
+
+    The flange is cast guide.thickness + squeeze thick; the clamp bottoms out on the locator, cut from the same
+    sheet, so the real squeeze is the flange minus the real sheet (nominal ± :func:`sheet_tolerance_mm`)."""
+    tol = sheet_tolerance_mm(spec.guide.thickness, spec.guide.thickness_measured)
+    s = spec.end_cap.flange_squeeze
+    return s - tol, s + tol, tol
+
+
+def seal_squeeze(spec) -> list[Finding]:
+    """The cap's flange must stay squeezed whatever the guide sheet really is, and not be crushed."""
+    lo, hi, tol = squeeze_range_mm(spec)
+    g = spec.guide
+    flange = cap_flange_thickness_mm(spec)
+    what = "measured" if g.thickness_measured else "nominal, ISO 7823-1 cast sheet"
+    span = f"{lo:+.2f} … {hi:+.2f} mm over the guide sheet's ±{tol:.2f} mm ({g.thickness:g} mm {what})"
+    if lo <= 0:
+        fix = ("caliper the guide sheet BEFORE printing the mold, enter guide.thickness and set "
+               "guide.thickness_measured = true" if not g.thickness_measured else
+               f"raise end_cap.flange_squeeze above the {tol:g} mm measuring tolerance")
+        return [Finding("seal.squeeze", "error" if spec.outputs.end_cap_mold else "warning", round(lo, 4), "> 0",
+                        f"the {spec.end_cap.flange_squeeze:g} mm flange squeeze can be swallowed: squeeze {span}; "
+                        "with a thick sheet the clamp never touches the flange and the cavity leaks", fix)]
+    strain = hi / flange
+    if strain > MAX_FLANGE_STRAIN:
+        return [Finding("seal.squeeze", "warning", round(strain, 3), MAX_FLANGE_STRAIN,
+                        f"the flange may be crushed by {100 * strain:.0f} % (squeeze {span})",
+                        "reduce end_cap.flange_squeeze, or caliper the guide sheet")]
+    return [Finding("seal.squeeze", "info", [round(lo, 4), round(hi, 4)], "> 0",
+                    f"flange squeeze {span}: {100 * lo / flange:.1f}-{100 * strain:.1f} % of the "
+                    f"{flange:g} mm flange", "")]
+
+
 def printed_fits(spec) -> list[Finding]:
     if spec.fasteners.dowel_fit_printed == "clearance":
         return [Finding("fit.dowel_printed", "warning", "clearance", "slip | press",
@@ -48,4 +86,4 @@ def printed_fits(spec) -> list[Finding]:
     return []
 
 
-RULES = (needle_clearance, needle_window, printed_fits)
+RULES = (needle_clearance, needle_window, seal_squeeze, printed_fits)

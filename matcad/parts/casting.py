@@ -1,0 +1,109 @@
+"""How to cast the caps in the printed mold: batch, pot life, cure by mold material, release, fill order, sprues.
+
+Material numbers come from :mod:`matcad.materials` (manufacturers' data sheets); mold-material limits and the
+platinum cure-inhibition advice are shop practice with the sources named in ``docs/materials.md``. Masses in g,
+volumes in ml, temperatures in °C, times in minutes or hours as named.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+from matcad.materials import grade
+from matcad.parts.features import cap_volume_mm3
+from matcad.parts.mold_layout import layout
+
+MIN_BATCH_G = 10.0
+"""Smallest mix worth weighing: on a 0.01 g kitchen/lab scale each part of a 1:1 mix is then weighed to ±0.2 %
+(of a 10:1 mix, the 0.9 g curing agent to ±1 %), and the 1–2 g that stays on the cup and stick is a small
+fraction. A 0.5 g mix is all cup residue and cannot be ratioed reliably (off-ratio platinum silicone stays
+tacky)."""
+
+MOLD_MATERIALS = {
+    "fdm": {"label": "PLA (FDM)", "max_cure_c": 45.0,
+            "note": "PLA softens near its glass transition (~55–60 °C): a warm cure must stay ≤ 45 °C or the core "
+                    "pins droop", "inhibition": ""},
+    "sla": {"label": "SLA resin", "max_cure_c": 45.0,
+            "note": "standard SLA resins soften from ~50 °C (heat deflection 50–70 °C): stay ≤ 45 °C unless the "
+                    "resin's data sheet allows more",
+            "inhibition": "platinum-cure silicone (Dragon Skin, Ecoflex, Sylgard 184) may stay tacky against SLA "
+                          "resin: uncured photoinitiator and monomer inhibit the platinum catalyst. Wash the mold "
+                          "in IPA, post-cure it fully (UV, then ~2 h at 45 °C or the resin maker's schedule), or "
+                          "seal it with a barrier coat (clear acrylic lacquer); cast a test drop first and check "
+                          "it cures tack-free where it touched the resin"},
+}
+"""What the printed mold's material allows; keyed by ``machine.printer``."""
+
+RELEASE_AGENT = ("Mann Ease Release 200 (or another release for silicone-on-plastic), a light coat on the base, "
+                 "lid and core pins, dry 10 min; the core pins are thin: do not skip it")
+
+
+@dataclass(frozen=True)
+class CastingGuide:
+    """One pour: masses (g), times, temperatures, and the procedure as ordered steps."""
+
+    grade: str
+    mold_material: str
+    caps: int
+    cast_volume_ml: float
+    needed_g: float
+    batch_g: float
+    batch_reason: str
+    mix_ratio: str
+    pot_life_min: float
+    cure_h_room: float
+    max_cure_c: float
+    cure_note: str
+    release: str
+    inhibition: str
+    vents_per_cap: int
+    steps: tuple[str, ...]
+    trim: tuple[str, ...]
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def casting_guide(spec) -> CastingGuide:
+    """The pour for ``spec``: batch = max(cast volume × waste factor × density, :data:`MIN_BATCH_G`) (g)."""
+    g = grade(spec.silicone.grade)
+    mold = MOLD_MATERIALS[spec.machine.printer]
+    caps = spec.mold.count
+    cast_ml = cap_volume_mm3(spec) * caps / 1000
+    needed = cast_ml * spec.silicone.waste_factor * spec.silicone.density_g_cm3
+    batch = max(needed, MIN_BATCH_G)
+    reason = (f"the caps need {needed:.2f} g (x{spec.silicone.waste_factor:g} for cup, sprues and vents); mix at "
+              f"least {MIN_BATCH_G:g} g so the ratio can be weighed on a 0.01 g scale and cup residue does not eat "
+              "the batch" if needed < MIN_BATCH_G else f"the caps need {needed:.2f} g with x{spec.silicone.waste_factor:g} "
+              "for cup, sprues and vents")
+    lay = layout(spec)
+    vents = len(lay.plan.inner) + len(lay.plan.outer)
+    steps = (
+        f"Print the mold ({mold['label']}): end_cap_mold_base.stl and end_cap_mold_lid.stl, each as exported "
+        f"(flat face down, no supports). Clear every vent with a {spec.mold.vent:g} mm drill or pin.",
+        *((f"SLA: {mold['inhibition']}.",) if mold["inhibition"] else ()),
+        f"Release: {RELEASE_AGENT}.",
+        f"Close the mold: lid on the base (the keys centre it), {len(lay.bolts)} x {spec.mold.bolt} bolts with nuts, "
+        "finger-tight and even; set it level, fill ports up.",
+        f"Weigh {batch:.1f} g of {g.label} ({g.mix_ratio}), mix 3 min scraping sides and bottom, degas in vacuum "
+        f"if you can; pot life {g.pot_life_min:g} min at 23 °C.",
+        f"Fill each cap through its {spec.mold.fill_port:g} mm fill port with a syringe, slowly, one cap at a time: "
+        "first the core-pin vent must show silicone (the closed end over the membrane is full), then every one of "
+        f"the {vents} base-face vents; top the port up as the level settles.",
+        f"Cure {g.cure_h_room:g} h at room temperature (23 °C), or warm at most {mold['max_cure_c']:g} °C: "
+        f"{mold['note']}.",
+        "Demold: remove the bolts, lift the lid straight up (the core pins slide out of the cavities), then push "
+        "each cap out of the base by its flange.",
+    )
+    trim = (
+        "fill-port and base-face vent sprues: cut flush with the cap's base face (the face that seals on the "
+        "neck plate) using a fresh scalpel blade laid flat on the face; a nub there breaks the seal",
+        "core-pin vent thread: it stands on the cavity's closed end (inside the cavity, over the membrane); pull it "
+        "out with tweezers through the cavity opening or snip it flush with micro scissors: a stub changes the "
+        "cavity volume and the membrane's stiffness",
+    )
+    return CastingGuide(grade=g.label, mold_material=mold["label"], caps=caps, cast_volume_ml=cast_ml,
+                        needed_g=needed, batch_g=batch, batch_reason=reason, mix_ratio=g.mix_ratio,
+                        pot_life_min=g.pot_life_min, cure_h_room=g.cure_h_room, max_cure_c=mold["max_cure_c"],
+                        cure_note=mold["note"], release=RELEASE_AGENT, inhibition=mold["inhibition"],
+                        vents_per_cap=vents, steps=steps, trim=trim)
