@@ -45,7 +45,7 @@ def default_out_dir(spec, suffix: str = "", root: Path = Path("out")) -> Path:
 
 def write_laser_part(flat, spec, folder: Path) -> list[dict]:
     """DXF + SVG of one laser part, kerf compensated; returns each hole as cut, with its compensation."""
-    plan = cut_plan(flat, spec.machine.laser_kerf, spec.outputs.reference_square)
+    plan = cut_plan(flat, spec.outputs.reference_square)
     write_dxf(plan, folder / f"{flat.name}.dxf")
     write_svg(plan, folder / f"{flat.name}.svg")
     return [{"part": flat.name, "purpose": c.purpose, "x_mm": c.x, "y_mm": c.y, "finished_mm": c.finished_diameter,
@@ -113,15 +113,21 @@ def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
     """Write the laser and printed test coupons to ``out_dir`` (default out/<name>-coupon) with a hole table."""
     import json
 
-    from matcad.parts.coupon import laser_coupon, printed_coupon, printed_coupon_holes
+    from matcad.parts.coupon import coupon_sheets, laser_coupon, printed_coupon, printed_coupon_holes
 
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec, "-coupon")
+    coupons = [laser_coupon(spec, sheet) for sheet in coupon_sheets(spec)]
+    for flat in coupons:  # refuse before anything is written (cut_plan would, half-way through)
+        cut_plan(flat, False)
     with staged_output(target) as tmp:
-        laser = write_laser_part(laser_coupon(spec), spec, tmp)
+        laser = [hole | {"sheet_mm": flat.thickness, "kerf_mm": flat.kerf}
+                 for flat in coupons for hole in write_laser_part(flat, spec, tmp)]
         mesh = write_printed_part("coupon_printed", printed_coupon(spec), spec, tmp)
-        table = {"name": spec.name, "laser_kerf_mm": spec.machine.laser_kerf, "printer": spec.machine.printer,
-                 "laser_holes": laser, "mesh": mesh,
-                 "printed_holes": [{"purpose": h.purpose, "x_mm": h.x, "y_mm": h.y, "diameter_mm": h.diameter}
+        table = {"name": spec.name, "sheets": {f.name: {"thickness_mm": f.thickness, "kerf_mm": f.kerf}
+                                                for f in coupons},
+                 "printer": spec.machine.printer, "laser_holes": laser, "mesh": mesh,
+                 "printed_holes": [{"purpose": h.purpose, "x_mm": h.x, "y_mm": h.y, "diameter_mm": h.diameter,
+                                    "theta_deg": spec.needle.theta_deg if h.purpose == "needle" else 90.0}
                                    for h in printed_coupon_holes(spec)]}
         (tmp / "report.json").write_text(json.dumps(table, indent=2) + "\n", encoding="utf-8")
     return target, table

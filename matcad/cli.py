@@ -162,8 +162,8 @@ def cmd_coupon(args) -> int:
     if args.json:
         _print_json({"out_dir": str(target), **table})
     else:
-        print(f"coupons in {target}/: coupon_laser.dxf/.svg (neck and dowel sweeps, engraved sizes), "
-              "coupon_printed.stl/.step (needle bores and dowel holes, ascending left to right)")
+        print(f"coupons in {target}/: coupon_<sheet>.dxf/.svg, one per sheet with its kerf (engraved sizes), "
+              "coupon_printed.stl/.step (needle bores at theta and dowel holes, ascending left to right)")
     return EXIT_OK
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from matcad import __version__
 from matcad.acoustics.geometry import drafted_cavity_volume_mm3, drafted_tip_diameter_mm
 from matcad.parts.catalogue import laser_parts
-from matcad.parts.features import (bolt_nominal_mm, cap_flange_thickness_mm, cap_volume_mm3,
+from matcad.parts.features import (sheet_kerf_mm, bolt_nominal_mm, cap_flange_thickness_mm, cap_volume_mm3,
                                    plate_bolt_positions_mm, plate_dowel_positions_mm)
 from matcad.parts.fabrication import fabrication
 from matcad.spec import to_dict
@@ -34,7 +34,7 @@ def as_built(spec) -> dict:
         "neck_diameter_finished_mm": spec.neck.diameter,
         "neck_finish": "drill pilot to size" if pilot else "as cut (kerf compensated)",
         "neck_length_mm": spec.neck.length, "neck_length_measured": spec.plate.thickness_measured,
-        "laser_kerf_mm": spec.machine.laser_kerf,
+        "laser_kerf_mm": sheet_kerf_mm(spec, "plate"),
         "cap_volume_mm3": cap_volume_mm3(spec),
     }
 
@@ -141,7 +141,10 @@ def _fabrication_markdown(f: dict | None) -> list[str]:
     lines += ["", f"Seal: the flange is cast {s['guide_sheet_mm']:g} + {s['flange_squeeze_mm']:g} mm thick; over the "
               f"guide sheet's ±{s['sheet_tolerance_mm']:.2f} mm the clamp squeezes it {s['squeeze_low_mm']:+.2f} … "
               f"{s['squeeze_high_mm']:+.2f} mm ({'measured' if s['guide_measured'] else 'nominal'} sheet)."]
-    lines += [f"{i}. {_cell(step)}" for i, step in enumerate(f.get("steps", ()), 1)]
+    if f["fits"]:
+        lines += ["", "| fit | hole [mm] | part in it [mm] | clearance [mm] |", "|---|---:|---:|---:|"]
+        lines += [f"| {_cell(x['fit'])} | {x['hole_mm']:.3f} | {x['pin_mm']:.3f} | {x['clearance_mm']:+.3f} |"
+                  for x in f["fits"]]
     return lines
 
 

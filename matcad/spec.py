@@ -103,6 +103,9 @@ class Plate(Section):
                                     hi=LENGTH_MAX_MM)
     bolt_inset: float = _param("bolt and dowel centres inset from the plate edges", "mm", 2.5, lo=0.0,
                                hi=LENGTH_MAX_MM)
+    laser_kerf: float | None = _param("full kerf in the neck plate sheet; default machine.laser_kerf (kerf "
+                                      "grows with sheet thickness: measure each sheet with `matcad coupon`)",
+                                      "mm", None, lo=0.0, hi=5.0, lo_open=False)
 
 
 @dataclass(frozen=True)
@@ -112,6 +115,9 @@ class Guide(Section):
     thickness: float = _length("guide sheet thickness (paper: 1.5 mm acrylic)", 1.5)
     thickness_measured: bool = _param("true if guide.thickness is a measured value", default=False,
                                       kind="bool")
+    laser_kerf: float | None = _param("full kerf in the guide sheet; default machine.laser_kerf (kerf "
+                                      "grows with sheet thickness: measure each sheet with `matcad coupon`)",
+                                      "mm", None, lo=0.0, hi=5.0, lo_open=False)
 
 
 @dataclass(frozen=True)
@@ -125,6 +131,9 @@ class Spacer(Section):
     size: float = _length("spacer square side / standoff diameter", 5.0)
     thickness_measured: bool = _param("true if spacer.height is a measured sheet thickness", default=False,
                                       kind="bool")
+    laser_kerf: float | None = _param("full kerf in the spacer sheet; default machine.laser_kerf (kerf "
+                                      "grows with sheet thickness: measure each sheet with `matcad coupon`)",
+                                      "mm", None, lo=0.0, hi=5.0, lo_open=False)
 
 
 @dataclass(frozen=True)

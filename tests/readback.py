@@ -29,8 +29,8 @@ def assert_manifest(out: Path) -> dict:
 
 
 def assert_laser_files(spec, out: Path) -> None:
-    kerf = spec.machine.laser_kerf
     for flat in laser_parts(spec):
+        kerf = flat.kerf
         doc = ezdxf.readfile(out / f"{flat.name}.dxf")
         assert doc.header["$INSUNITS"] == 4
         assert not doc.audit().has_errors
@@ -68,3 +68,24 @@ def assert_build_folder(spec, out: Path) -> None:
     report = assert_manifest(out)
     assert_laser_files(spec, out)
     assert_meshes(report, out)
+
+
+def section_circles(mesh, z: float) -> list[tuple[float, float, float]]:
+    """Closed loops of a mesh's section at height z as circles (x, y, radius, mm): the loop's vertex centroid and
+    mean vertex distance (tessellation vertices lie on the true surface, so this is the true radius)."""
+    import numpy as np
+
+    section = mesh.section(plane_origin=[0, 0, z], plane_normal=[0, 0, 1])
+    if section is None:
+        return []
+    circles = []
+    for loop in section.discrete:
+        pts = np.asarray(loop)[:-1, :2]
+        centre = pts.mean(axis=0)
+        circles.append((float(centre[0]), float(centre[1]), float(np.linalg.norm(pts - centre, axis=1).mean())))
+    return circles
+
+
+def nearest_circle(circles, x: float, y: float) -> tuple[float, float, float]:
+    """The circle whose centre is nearest (x, y)."""
+    return min(circles, key=lambda c: (c[0] - x) ** 2 + (c[1] - y) ** 2)

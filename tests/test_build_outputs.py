@@ -51,8 +51,8 @@ def test_report_manifest_matches_files(built):
 
 def test_dxf_units_layers_holes_outlines(built):
     spec, out, _ = built
-    kerf = spec.machine.laser_kerf
     for name, flat in _laser(spec).items():
+        kerf = flat.kerf
         doc = ezdxf.readfile(out / f"{name}.dxf")
         assert doc.header["$INSUNITS"] == 4
         auditor = doc.audit()
@@ -83,7 +83,8 @@ def test_neck_hole_is_spec_minus_kerf(built):
     doc = ezdxf.readfile(out / "neck_plate.dxf")
     neck = [c for c in doc.modelspace().query("CIRCLE") if abs(c.dxf.center.x) < 1e-9 and abs(c.dxf.center.y) < 1e-9]
     cut = spec.neck.diameter - (spec.plate.pilot_undersize if spec.plate.neck_pilot else 0.0)
-    assert len(neck) == 1 and 2 * neck[0].dxf.radius == pytest.approx(cut - spec.machine.laser_kerf, abs=1e-6)
+    kerf = spec.plate.laser_kerf if spec.plate.laser_kerf is not None else spec.machine.laser_kerf
+    assert len(neck) == 1 and 2 * neck[0].dxf.radius == pytest.approx(cut - kerf, abs=1e-6)
 
 
 def test_svg_mm_size_viewbox_and_colours(built):
@@ -98,7 +99,7 @@ def test_svg_mm_size_viewbox_and_colours(built):
         assert groups["CUT_INNER"].get("stroke") == LAYERS["CUT_INNER"][1]
         radii = sorted(2 * float(c.get("r")) for c in groups["CUT_INNER"])
         flat = _laser(spec)[name]
-        assert radii == pytest.approx(sorted(hh.diameter - spec.machine.laser_kerf for hh in flat.holes)
+        assert radii == pytest.approx(sorted(hh.diameter - flat.kerf for hh in flat.holes)
                                       * flat.quantity, abs=1e-6)
 
 

@@ -1,34 +1,86 @@
-"""`matcad coupon`: the swept sizes, read back from the DXF and STL."""
+"""`matcad coupon`: one laser coupon per sheet with that sheet's kerf, the printed coupon's bores at the needle's
+real θ; every size read back from the DXF, the STEP and the STL."""
 
 import json
+import math
 
 import ezdxf
 import pytest
 import trimesh
+from build123d import GeomType, import_step
 
 from matcad import spec as spec_mod
-from matcad.parts.coupon import DOWEL_SWEEP_MM, NECK_SWEEP_MM, NEEDLE_SWEEP_MM, PRINTED_DOWEL_SWEEP_MM
+from matcad.parts.coupon import (BOLT_SWEEP_MM, DOWEL_SWEEP_MM, NECK_SWEEP_MM, NEEDLE_SWEEP_MM,
+                                 PRINTED_DOWEL_SWEEP_MM, SHEET_ROWS)
+from matcad.parts.features import bolt_clearance_mm
 from tests.conftest import PAPER, run_cli
 
+KERFS = {"plate": 0.27, "guide": 0.14, "spacer": 0.16}
 
-def test_coupon_sizes_read_back(tmp_path):
-    spec = spec_mod.load(PAPER)
-    code, out, err = run_cli("coupon", PAPER, "--out", tmp_path / "c", "--json")
+
+@pytest.fixture(scope="module")
+def coupons(tmp_path_factory):
+    root = tmp_path_factory.mktemp("coupon")
+    text = PAPER.read_text()
+    for section, kerf in KERFS.items():
+        text = text.replace(f"[{section}]\n", f"[{section}]\nlaser_kerf = {kerf}\n", 1)
+    path = root / "spec.toml"
+    path.write_text(text)
+    code, _, err = run_cli("coupon", path, "--out", root / "c", "--json")
     assert code == 0, err
-    folder = tmp_path / "c"
-    doc = ezdxf.readfile(folder / "coupon_laser.dxf")
+    return spec_mod.load(path), root / "c"
+
+
+def _finished(spec, purpose):
+    base = {"neck": (spec.neck.diameter, NECK_SWEEP_MM), "dowel": (spec.fasteners.dowel_diameter, DOWEL_SWEEP_MM),
+            "bolt": (bolt_clearance_mm(spec.fasteners.bolt, spec.fasteners.bolt_fit), BOLT_SWEEP_MM)}[purpose]
+    return [base[0] + d for d in base[1]]
+
+
+@pytest.mark.parametrize("sheet", ["plate", "guide", "spacer"])
+def test_one_laser_coupon_per_sheet_with_its_kerf_and_labels(coupons, sheet):
+    spec, folder = coupons
+    doc = ezdxf.readfile(folder / f"coupon_{sheet}.dxf")
     assert doc.header["$INSUNITS"] == 4 and not doc.audit().has_errors
-    drawn = sorted(round(2 * c.dxf.radius, 6) for c in doc.modelspace().query("CIRCLE"))
-    finished = [spec.neck.diameter + d for d in NECK_SWEEP_MM] + [spec.fasteners.dowel_diameter + d
-                                                                 for d in DOWEL_SWEEP_MM]
-    assert drawn == pytest.approx(sorted(f - spec.machine.laser_kerf for f in finished), abs=1e-6)
-    labels = {t.dxf.text for t in doc.modelspace().query("TEXT[layer=='ENGRAVE']")}
-    assert {f"{f:.2f}" for f in finished} == labels
+    finished = [f for purpose in SHEET_ROWS[sheet] for f in _finished(spec, purpose)]
+    drawn = sorted(2 * c.dxf.radius for c in doc.modelspace().query("CIRCLE"))
+    assert drawn == pytest.approx(sorted(f - KERFS[sheet] for f in finished), abs=1e-6)
+    table = json.loads((folder / "report.json").read_text())
+    assert table["sheets"][f"coupon_{sheet}"]["kerf_mm"] == KERFS[sheet]
+    thickness = {"plate": spec.neck.length, "guide": spec.guide.thickness, "spacer": spec.spacer.height}[sheet]
+    assert table["sheets"][f"coupon_{sheet}"]["thickness_mm"] == thickness
+
+
+def test_printed_coupon_bores_at_the_needle_angle(coupons):
+    spec, folder = coupons
+    solid = import_step(folder / "coupon_printed.step")
+    bores = {}
+    for f in solid.faces():
+        if f.geom_type == GeomType.CYLINDER:
+            d = f.axis_of_rotation.direction
+            bores.setdefault(round(2 * f.radius, 4), set()).add(round(math.degrees(math.asin(abs(d.Z))), 3))
+    for dx in NEEDLE_SWEEP_MM:
+        assert bores[round(spec.needle.outer_diameter + dx, 4)] == {round(spec.needle.theta_deg, 3)}
+    for dx in PRINTED_DOWEL_SWEEP_MM:
+        assert bores[round(spec.fasteners.dowel_diameter + dx, 4)] == {90.0}
     mesh = trimesh.load_mesh(folder / "coupon_printed.stl")
     assert mesh.is_watertight and mesh.is_volume
     table = json.loads((folder / "report.json").read_text())
-    bores = [h["diameter_mm"] for h in table["printed_holes"] if h["purpose"] == "needle"]
-    assert bores == pytest.approx([spec.needle.outer_diameter + d for d in NEEDLE_SWEEP_MM])
-    assert len(table["printed_holes"]) == len(NEEDLE_SWEEP_MM) + len(PRINTED_DOWEL_SWEEP_MM)
-    # the printed bar really has those holes: its volume is the bar minus the cylinders
     assert mesh.volume == pytest.approx(table["mesh"]["brep_volume_mm3"], rel=1e-3)
+    assert [h["theta_deg"] for h in table["printed_holes"] if h["purpose"] == "needle"] == \
+        [spec.needle.theta_deg] * len(NEEDLE_SWEEP_MM)
+
+
+def test_per_sheet_kerf_reaches_the_kit(coupons, tmp_path):
+    spec, _ = coupons
+    import dataclasses
+
+    from matcad.build import build
+    s = dataclasses.replace(spec, outputs=dataclasses.replace(spec.outputs, end_cap_mold=False, needle_mount=False,
+                                                              assembly=False))
+    build(s, tmp_path / "k")
+    for part, sheet in (("neck_plate", "plate"), ("guide_locator", "guide"), ("spacer", "spacer")):
+        msp = ezdxf.readfile(tmp_path / "k" / f"{part}.dxf").modelspace()
+        xs = [x for x, *_ in msp.query("LWPOLYLINE[layer=='CUT_OUTER']")[0].get_points("xyb")]
+        width = spec.spacer.size if part == "spacer" else spec.plate.width
+        assert max(xs) - min(xs) == pytest.approx(width + KERFS[sheet], abs=1e-9)

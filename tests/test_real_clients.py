@@ -18,7 +18,7 @@ import pytest
 from matcad import spec as spec_mod
 from matcad.build import build, build_coupon
 from matcad.parts.catalogue import laser_parts
-from matcad.parts.coupon import laser_coupon
+from matcad.parts.coupon import coupon_sheets, laser_coupon
 from matcad.parts.flat import cut_plan
 from tests.conftest import TEMPLATES
 
@@ -149,10 +149,11 @@ def test_librecad_renders_every_dxf_at_one_to_one(builds, tmp_path):
     checked = 0
     coupon_spec = spec_mod.load(TEMPLATES[0])
     for spec, folder in builds:
-        flats = laser_parts(spec) if spec is not None else [laser_coupon(coupon_spec)]
+        flats = laser_parts(spec) if spec is not None else [laser_coupon(coupon_spec, sheet)
+                                                             for sheet in coupon_sheets(coupon_spec)]
         spec = spec or coupon_spec
         for flat in flats:
-            plan = cut_plan(flat, spec.machine.laser_kerf, spec.outputs.reference_square)
+            plan = cut_plan(flat, spec.outputs.reference_square)
             x0, y0, x1, y1 = plan.extents
             target = tmp_path / f"{spec.name}-{flat.name}"
             target.mkdir()

@@ -1,13 +1,15 @@
 """Test coupons that sweep the sizes that matter, so users can measure their own laser and printer.
 
-Laser coupon (neck-plate sheet): a row of neck holes d − 0.2 … d + 0.2 mm and a row of dowel holes from pin
-size up, each engraved with its finished size and cut with the spec's kerf compensation. Printed coupon
-(mount process): needle bores and dowel holes swept around their fit, ascending left to right. Pick the
-size that fits and feed the difference back (machine.laser_kerf, fasteners fits).
+Laser coupons, one per sheet, each cut with that sheet's kerf: the neck plate's sheet sweeps neck holes
+d − 0.2 … d + 0.2 mm and dowel holes, the guide sheet dowel and bolt holes, the spacer sheet bolt holes; every
+hole engraved with its finished size. Printed coupon (mount process): needle bores at the needle's real angle θ
+and vertical dowel holes swept around their fit, ascending left to right. Pick the size that fits and feed the
+difference back (<sheet>.laser_kerf, fasteners fits).
 """
 
 from __future__ import annotations
 
+from matcad.parts.features import bolt_clearance_mm, sheet_kerf_mm, sheet_thickness_mm
 from matcad.parts.flat import Engraving, Flat, Hole
 
 NECK_SWEEP_MM = (-0.2, -0.15, -0.1, -0.05, 0.0, 0.05, 0.1, 0.15, 0.2)
@@ -18,25 +20,47 @@ LABEL_MM = 1.2
 MARGIN_MM = 3.0
 
 
+BOLT_SWEEP_MM = (-0.2, -0.1, 0.0, 0.1, 0.2)
+SHEET_ROWS = {"plate": ("neck", "dowel"), "guide": ("dowel", "bolt"), "spacer": ("bolt",)}
+"""Which fits each sheet's coupon sweeps: the holes that sheet really carries."""
+
+
 def _row(sizes, y, pitch, purpose, x0):
     return [Hole(x0 + i * pitch, y, size, purpose) for i, size in enumerate(sizes)]
 
 
-def laser_coupon(spec) -> Flat:
-    """Flat coupon in the neck plate's sheet: neck and dowel sweeps with engraved sizes (mm)."""
-    necks = [spec.neck.diameter + dx for dx in NECK_SWEEP_MM]
-    dowels = [spec.fasteners.dowel_diameter + dx for dx in DOWEL_SWEEP_MM]
-    pitch = max(necks[-1], dowels[-1]) + 2 * MARGIN_MM
-    width = len(necks) * pitch + MARGIN_MM
-    row_h = max(necks[-1], dowels[-1]) + LABEL_MM + 2 * MARGIN_MM
-    depth = 2 * row_h
+def _sweep(spec, purpose: str) -> list[float]:
+    if purpose == "neck":
+        return [spec.neck.diameter + dx for dx in NECK_SWEEP_MM]
+    if purpose == "dowel":
+        return [spec.fasteners.dowel_diameter + dx for dx in DOWEL_SWEEP_MM]
+    return [bolt_clearance_mm(spec.fasteners.bolt, spec.fasteners.bolt_fit) + dx for dx in BOLT_SWEEP_MM]
+
+
+def coupon_sheets(spec) -> list[str]:
+    """The sheets (keys of features.SHEETS) the kit cuts: one laser coupon each."""
+    return ["plate", "guide"] + (["spacer"] if spec.spacer.style == "laser" else [])
+
+
+def laser_coupon(spec, sheet: str = "plate") -> Flat:
+    """Flat coupon cut from ``sheet`` with that sheet's kerf: a row per fit it carries, each hole engraved with
+    its finished size (mm)."""
+    rows = [_sweep(spec, purpose) for purpose in SHEET_ROWS[sheet]]
+    biggest = max(max(r) for r in rows)
+    pitch = biggest + 2 * MARGIN_MM
+    width = max(len(r) for r in rows) * pitch + MARGIN_MM
+    row_h = biggest + LABEL_MM + 2 * MARGIN_MM
+    depth = len(rows) * row_h
     x0 = -width / 2 + MARGIN_MM / 2 + pitch / 2
-    holes = (_row(necks, row_h / 2 + LABEL_MM / 2, pitch, "neck", x0)
-             + _row(dowels, -row_h / 2 + LABEL_MM / 2, pitch, "dowel", x0))
+    holes = []
+    for i, (purpose, sizes) in enumerate(zip(SHEET_ROWS[sheet], rows)):
+        y = depth / 2 - (i + 0.5) * row_h + LABEL_MM / 2
+        holes += _row(sizes, y, pitch, purpose, x0)
     labels = tuple(Engraving(h.x - 0.9 * LABEL_MM, h.y - h.diameter / 2 - 0.5 - LABEL_MM, LABEL_MM,
                              f"{h.diameter:.2f}") for h in holes)
-    return Flat(name="coupon_laser", thickness=spec.neck.length, thickness_measured=spec.plate.thickness_measured,
-                width=width, depth=depth, holes=tuple(holes), engrave=labels)
+    thickness, measured = sheet_thickness_mm(spec, sheet)
+    return Flat(name=f"coupon_{sheet}", thickness=thickness, thickness_measured=measured,
+                kerf=sheet_kerf_mm(spec, sheet), width=width, depth=depth, holes=tuple(holes), engrave=labels)
 
 
 def printed_coupon_holes(spec) -> list[Hole]:
@@ -50,15 +74,29 @@ def printed_coupon_holes(spec) -> list[Hole]:
 
 
 def printed_coupon(spec):
-    """The printed coupon: a bar of mount thickness with the swept holes through it (mm)."""
-    from build123d import Box
+    """The printed coupon: a bar of mount thickness; needle bores at the needle's θ (as in the mount, so a bore
+    that passes here passes there: a tilted printed bore comes out smaller than a vertical one), dowel holes
+    vertical as in the mount (mm)."""
+    import math
 
-    from matcad.parts.solid import BOTTOM, cylinder_up
+    from build123d import Box, Pos
+
+    from matcad.parts.solid import BOTTOM, cylinder_up, tilted_cylinder
 
     holes = printed_coupon_holes(spec)
-    width = max(h.x for h in holes) - min(h.x for h in holes) + 2 * (max(h.diameter for h in holes) + MARGIN_MM)
+    t = spec.mount.thickness
+    theta = math.radians(spec.needle.theta_deg)
+    drift = t / math.tan(theta)  # how far a bore at θ travels in x through the bar
+    half = (t / 2 + 1.0) / math.sin(theta)  # half-length along the axis, 1 mm past each face
+    width = (max(h.x for h in holes) - min(h.x for h in holes) + drift
+             + 2 * (max(h.diameter for h in holes) / math.sin(theta) + MARGIN_MM))
     depth = 2 * (max(abs(h.y) for h in holes) + max(h.diameter for h in holes) / 2 + MARGIN_MM)
-    bar = Box(width, depth, spec.mount.thickness, align=BOTTOM)
+    bar = Pos(drift / 2, 0, 0) * Box(width, depth, t, align=BOTTOM)
     for h in holes:
-        bar -= cylinder_up(h.diameter / 2, spec.mount.thickness, h.x, h.y)
+        if h.purpose == "needle":
+            centre = (h.x + drift / 2, h.y, t / 2)
+            end = (centre[0] + half * math.cos(theta), h.y, t / 2 + half * math.sin(theta))
+            bar -= tilted_cylinder(h.diameter / 2, 2 * half, end, spec.needle.theta_deg)
+        else:
+            bar -= cylinder_up(h.diameter / 2, t, h.x, h.y)
     return bar

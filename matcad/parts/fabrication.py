@@ -40,6 +40,35 @@ def seal(spec) -> dict:
             "squeeze_low_mm": lo, "squeeze_high_mm": hi}
 
 
+def fits(spec) -> list[dict]:
+    """The fits the kit relies on, as designed (mm): hole, what goes in it, and the clearance claimed (diametral;
+    negative = interference). Each names the files a check reads it back from."""
+    from matcad.parts.features import (SELF_TAP_PILOT_MM, bolt_nominal_mm, cap_flange_diameter_mm,
+                                       pin_hole_diameter_mm)
+    from matcad.parts.guide import guide
+
+    rows = []
+    if spec.outputs.end_cap_mold:
+        k = spec.mold.key_diameter
+        rows.append({"id": "key", "fit": "mold key in lid socket (at the parting plane)",
+                     "hole_mm": k + 2 * spec.machine.key_clearance, "pin_mm": k, "clearance_mm": 2 * spec.machine.key_clearance,
+                     "files": ["end_cap_mold_lid.stl", "end_cap_mold_base.stl"]})
+    if spec.outputs.guides:
+        hole = next(h for h in guide(spec, "locator").holes if h.purpose == "cap").diameter
+        rows.append({"id": "flange", "fit": "cap flange in locator guide (line-to-line: the silicone centres "
+                     "itself)", "hole_mm": hole, "pin_mm": cap_flange_diameter_mm(spec),
+                     "clearance_mm": hole - cap_flange_diameter_mm(spec), "files": ["guide_locator.dxf", "end_cap.stl"]})
+    if spec.outputs.needle_mount:
+        bolt, pilot = bolt_nominal_mm(spec.fasteners.bolt), SELF_TAP_PILOT_MM[spec.fasteners.bolt]
+        rows.append({"id": "pilot", "fit": f"{spec.fasteners.bolt} bolt self-tapping into the mount pilot", "hole_mm": pilot,
+                     "pin_mm": bolt, "clearance_mm": pilot - bolt, "files": ["needle_mount.stl"]})
+        bore = pin_hole_diameter_mm(spec.needle.outer_diameter, spec.machine.printer, spec.needle.fit)
+        rows.append({"id": "needle", "fit": f"needle in its bore ({spec.needle.fit})", "hole_mm": bore,
+                     "pin_mm": spec.needle.outer_diameter, "clearance_mm": bore - spec.needle.outer_diameter,
+                     "files": ["needle_mount.step"]})
+    return rows
+
+
 def fabrication(spec) -> dict:
-    """The report's fabrication section: sheets to caliper, the seal."""
-    return {"caliper": sheets_to_caliper(spec), "seal": seal(spec)}
+    """The report's fabrication section: sheets to caliper, the seal, the fits."""
+    return {"caliper": sheets_to_caliper(spec), "seal": seal(spec), "fits": fits(spec)}

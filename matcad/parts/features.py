@@ -30,6 +30,26 @@ STOCK_ACRYLIC_MM = (1.0, 1.5, 1.59, 2.0, 2.5, 3.0, 3.18, 4.0, 4.76, 5.0, 6.0, 6.
 """Common cast/extruded acrylic sheet thicknesses: metric and 1/16-inch steps (mm)."""
 
 
+SHEETS = {"plate": "neck plate (thickness neck.length)", "guide": "guides (guide.thickness)",
+          "spacer": "spacers (spacer.height)"}
+"""Spec sections that are each one acrylic sheet, with its own kerf (``<section>.laser_kerf``)."""
+
+
+def sheet_kerf_mm(spec, sheet: str) -> float:
+    """Full laser kerf in ``sheet`` (a key of :data:`SHEETS`): its own ``laser_kerf`` when given, else
+    ``machine.laser_kerf`` (mm). Kerf widens with thickness (the beam's waist is short), so a 6 mm plate and a
+    1.5 mm guide rarely share one value."""
+    own = getattr(spec, sheet).laser_kerf
+    return spec.machine.laser_kerf if own is None else own
+
+
+def sheet_thickness_mm(spec, sheet: str) -> tuple[float, bool]:
+    """(thickness mm, measured) of ``sheet``."""
+    return {"plate": (spec.neck.length, spec.plate.thickness_measured),
+            "guide": (spec.guide.thickness, spec.guide.thickness_measured),
+            "spacer": (spec.spacer.height, spec.spacer.thickness_measured)}[sheet]
+
+
 def pin_hole_diameter_mm(pin_diameter_mm: float, process: str, fit: str) -> float:
     """Finished hole diameter (mm) for a pin (dowel, needle) of the given diameter, process and fit."""
     return pin_diameter_mm + PIN_FIT_ALLOWANCE_MM[process][fit]

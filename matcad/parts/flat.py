@@ -40,6 +40,7 @@ class Flat:
     name: str
     thickness: float
     thickness_measured: bool
+    kerf: float  # full kerf of this part's sheet (see features.sheet_kerf_mm)
     width: float
     depth: float
     holes: tuple[Hole, ...]
@@ -90,12 +91,13 @@ def drawn_holes(flat: Flat, kerf: float) -> list[tuple[Hole, float]]:
     return sorted(((h, drawn_diameter_mm(h.diameter, kerf)) for h in flat.holes), key=lambda hd: hd[1])
 
 
-def cut_plan(flat: Flat, kerf: float, reference_square: bool, spacing: float = 3.0) -> CutPlan:
-    """Apply kerf compensation (outline +kerf/2, holes −kerf/2) and lay out ``quantity`` copies in a row.
+def cut_plan(flat: Flat, reference_square: bool, spacing: float = 3.0) -> CutPlan:
+    """Apply the sheet's kerf compensation (outline +kerf/2, holes −kerf/2) and lay out ``quantity`` copies.
 
     Raises :class:`DrawnSizeError` when a hole would be drawn at a diameter ≤ 0 (a hole smaller than the kerf):
     the design rule ``laser.drawn_size`` reports the same thing, naming the spec field, before any build.
     """
+    kerf = flat.kerf
     for hole, drawn in drawn_holes(flat, kerf):
         if drawn <= 0:
             raise DrawnSizeError(f"{flat.name}: {hole.purpose} hole of {hole.diameter:g} mm would be drawn at "

@@ -4,7 +4,7 @@ The locator surrounds the cap's base flange; the clamp lies over the flange with
 the bolts press it down so the flange (guide thickness + squeeze) seals against the plate.
 """
 
-from matcad.parts.features import cap_flange_diameter_mm, laser_stack_holes
+from matcad.parts.features import cap_flange_diameter_mm, laser_stack_holes, sheet_kerf_mm
 from matcad.parts.flat import Flat, Hole
 
 BODY_CLEARANCE_MM = 0.2
@@ -21,5 +21,6 @@ def guide(spec, role: str) -> Flat:
     else:
         raise ValueError(f"role {role!r} invalid, must be one of {ROLES}")
     return Flat(name=f"guide_{role}", thickness=spec.guide.thickness,
-                thickness_measured=spec.guide.thickness_measured, width=spec.plate.width,
+                thickness_measured=spec.guide.thickness_measured, kerf=sheet_kerf_mm(spec, "guide"),
+                width=spec.plate.width,
                 depth=spec.plate.depth, holes=(cap_hole, *laser_stack_holes(spec)))

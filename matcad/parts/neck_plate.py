@@ -1,6 +1,6 @@
 """The acrylic neck plate: its thickness is the neck length l, its centre hole the neck d (paper Fig. 2)."""
 
-from matcad.parts.features import laser_stack_holes
+from matcad.parts.features import laser_stack_holes, sheet_kerf_mm
 from matcad.parts.flat import Engraving, Flat, Hole
 
 
@@ -15,5 +15,6 @@ def neck_plate(spec) -> Flat:
         height = min(2.0, spec.plate.depth / 12)
         label = (Engraving(-spec.plate.width / 4, -spec.plate.depth / 4 - height / 2, height, spec.plate.label),)
     return Flat(name="neck_plate", thickness=spec.neck.length, thickness_measured=spec.plate.thickness_measured,
+                kerf=sheet_kerf_mm(spec, "plate"),
                 width=spec.plate.width, depth=spec.plate.depth, holes=(neck, *laser_stack_holes(spec)),
                 engrave=label)

@@ -7,11 +7,11 @@ pilots; dowels press into it; with ``spacer.style = "standoff"`` the spacers are
 
 import math
 
-from build123d import Align, Box, Cylinder, Location, Pos, Rot
+from build123d import Box, Pos
 
 from matcad.parts.features import (SELF_TAP_PILOT_MM, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
                                    plate_bolt_positions_mm, plate_dowel_positions_mm)
-from matcad.parts.solid import TOP, cylinder_up
+from matcad.parts.solid import TOP, cylinder_up, tilted_cylinder
 
 
 def needle_bore_diameter_mm(spec) -> float:
@@ -21,9 +21,7 @@ def needle_bore_diameter_mm(spec) -> float:
 
 def _on_needle_axis(spec, start, radius: float, length: float):
     """Cylinder of ``radius`` on the needle axis, from point ``start`` on it back ``length`` mm (mm)."""
-    tilt = 90.0 - spec.needle.theta_deg  # rotating +z about y by (90 − θ) gives (cos θ, 0, sin θ)
-    return Location(start) * Rot(0, tilt, 0) * Cylinder(radius, length, align=(Align.CENTER, Align.CENTER,
-                                                                               Align.MAX))
+    return tilted_cylinder(radius, length, start, spec.needle.theta_deg)
 
 
 def needle(spec):

@@ -18,6 +18,16 @@ def frustum_up(bottom_radius: float, top_radius: float, height: float, x=0.0, y=
     return Pos(x, y, z) * Cone(bottom_radius, top_radius, height, align=BOTTOM)
 
 
+def tilted_cylinder(radius: float, length: float, end, theta_deg: float):
+    """Cylinder whose axis is (cos θ, 0, sin θ) — θ from the xy plane, tilted toward +x — ending at point ``end``
+    and reaching ``length`` back from it (mm, degrees)."""
+    from build123d import Location, Rot
+
+    tilt = 90.0 - theta_deg  # rotating +z about y by (90 − θ) gives (cos θ, 0, sin θ)
+    return Location(tuple(end)) * Rot(0, tilt, 0) * Cylinder(radius, length, align=(Align.CENTER, Align.CENTER,
+                                                                                     Align.MAX))
+
+
 def flat_solid(flat, z0: float = 0.0):
     """A laser part (design intent, finished sizes) as a solid from z0 to z0 + thickness (mm)."""
     body = Pos(0, 0, z0) * Box(flat.width, flat.depth, flat.thickness, align=BOTTOM)

@@ -1,6 +1,6 @@
 """Spacers between the neck plate and the needle mount (paper: 1.59 mm tall), one per bolt."""
 
-from matcad.parts.features import bolt_clearance_mm, plate_bolt_positions_mm
+from matcad.parts.features import bolt_clearance_mm, plate_bolt_positions_mm, sheet_kerf_mm
 from matcad.parts.flat import Flat, Hole
 
 
@@ -8,6 +8,7 @@ def spacer(spec) -> Flat:
     """Square laser-cut spacer, spacer.size wide, sheet thickness = spacer.height, one bolt hole; one per bolt."""
     bolt = bolt_clearance_mm(spec.fasteners.bolt, spec.fasteners.bolt_fit)
     return Flat(name="spacer", thickness=spec.spacer.height, thickness_measured=spec.spacer.thickness_measured,
+                kerf=sheet_kerf_mm(spec, "spacer"),
                 width=spec.spacer.size, depth=spec.spacer.size,
                 holes=(Hole(0.0, 0.0, bolt, "bolt", spec.fasteners.bolt_fit),),
                 quantity=len(plate_bolt_positions_mm(spec)), corner_radius=0.5)

@@ -52,7 +52,7 @@ def render_figures(spec, prediction, folder: Path, meshes: dict) -> list[dict]:
         if figure:
             figures.append(figure)
     for flat in laser_parts(spec):
-        plan = cut_plan(flat, spec.machine.laser_kerf, spec.outputs.reference_square)
+        plan = cut_plan(flat, spec.outputs.reference_square)
         figures.append(flat_preview(plan, folder / preview_name(flat.name)))
     for stl in sorted(meshes):
         name = Path(stl).stem

@@ -51,7 +51,7 @@ def drawn_size(spec) -> list[Finding]:
     out = []
     limit = spec.machine.laser_min_feature
     for flat in laser_parts(spec):
-        kerf = spec.machine.laser_kerf
+        kerf = flat.kerf
         seen = set()
         for hole, drawn in drawn_holes(flat, kerf):
             if hole.purpose in seen or drawn >= limit:
@@ -62,7 +62,7 @@ def drawn_size(spec) -> list[Finding]:
                      f"{drawn:.3g} mm after the {kerf:g} mm kerf")
             if drawn <= 0:
                 out.append(Finding("laser.drawn_size", "error", round(drawn, 4), "> 0",
-                                   f"{where}: nothing to cut", f"enlarge {field} or lower machine.laser_kerf"))
+                                   f"{where}: nothing to cut", f"enlarge {field} or lower the sheet's laser_kerf"))
             else:
                 out.append(Finding("laser.feature", "error", round(drawn, 4), limit,
                                    f"{where}, below the laser's smallest feature {limit:g} mm "

@@ -1,0 +1,80 @@
+"""The fits the report claims (key in socket, flange in locator, self-tap pilot), measured from the files: circle
+sections of the STLs (in the frame the report's design-to-print matrix gives back) and circles of the DXF."""
+
+import json
+
+import ezdxf
+import numpy as np
+import pytest
+import trimesh
+
+from matcad import spec as spec_mod
+from matcad.build import build
+from matcad.parts.features import cap_flange_thickness_mm, plate_bolt_positions_mm
+from tests.conftest import TEMPLATES
+from tests.readback import nearest_circle, section_circles
+
+KIT_TEMPLATES = [p for p in TEMPLATES if spec_mod.load(p).outputs.needle_mount]
+
+
+@pytest.fixture(scope="module", params=KIT_TEMPLATES, ids=lambda p: p.stem)
+def kit(request, tmp_path_factory):
+    spec = spec_mod.load(request.param)
+    out = tmp_path_factory.mktemp("fits") / spec.name
+    build(spec, out)
+    report = json.loads((out / "report.json").read_text())
+    return spec, out, report, {f["id"]: f for f in report["fabrication"]["fits"]}
+
+
+def _design_frame(out, report, name):
+    mesh = trimesh.load_mesh(out / name)
+    mesh.apply_transform(np.linalg.inv(np.array(report["meshes"][name]["design_to_print"])))
+    return mesh
+
+
+def test_key_clearance_measured_at_the_parting_plane(kit):
+    spec, out, report, fits = kit
+    from matcad.parts.end_cap_mold import layout
+
+    base, lid = (_design_frame(out, report, f"end_cap_mold_{p}.stl") for p in ("base", "lid"))
+    x, y = layout(spec).keys[0]
+    z = 1e-3
+    key = nearest_circle(section_circles(base, z), x, y)
+    socket = nearest_circle(section_circles(lid, z), x, y)
+    measured = 2 * (socket[2] - key[2])
+    claim = fits["key"]
+    assert measured == pytest.approx(claim["clearance_mm"], abs=2e-3)
+    assert 2 * key[2] == pytest.approx(claim["pin_mm"], abs=2e-3)
+    assert measured == pytest.approx(2 * spec.machine.key_clearance, abs=2e-3)
+
+
+def test_flange_in_locator_measured_from_dxf_and_cap(kit):
+    spec, out, report, fits = kit
+    locator = next(f for f in _dxf_circles(out / "guide_locator.dxf") if abs(f[0]) < 1e-9 and abs(f[1]) < 1e-9)
+    kerf = next(h for h in report["as_built"]["laser_holes"] if h["part"] == "guide_locator")["finished_mm"]
+    kerf = kerf - next(h for h in report["as_built"]["laser_holes"] if h["part"] == "guide_locator")["drawn_mm"]
+    hole = 2 * locator[2] + kerf  # as cut: drawn + kerf
+    cap = _design_frame(out, report, "end_cap.stl")
+    flange = max(section_circles(cap, cap_flange_thickness_mm(spec) / 2), key=lambda c: c[2])
+    claim = fits["flange"]
+    assert hole - 2 * flange[2] == pytest.approx(claim["clearance_mm"], abs=2e-3)
+    assert hole == pytest.approx(claim["hole_mm"], abs=1e-6)
+
+
+def test_self_tap_pilot_measured_in_the_mount(kit):
+    spec, out, report, fits = kit
+    mount = _design_frame(out, report, "needle_mount.stl")
+    z = -spec.spacer.height - spec.mount.thickness / 2
+    circles = section_circles(mount, z)
+    claim = fits["pilot"]
+    for x, y in plate_bolt_positions_mm(spec):
+        pilot = nearest_circle(circles, x, y)
+        assert (pilot[0], pilot[1]) == pytest.approx((x, y), abs=1e-3)
+        assert 2 * pilot[2] == pytest.approx(claim["hole_mm"], abs=2e-3)
+        assert 2 * pilot[2] - claim["pin_mm"] == pytest.approx(claim["clearance_mm"], abs=2e-3)
+        assert claim["clearance_mm"] < 0  # the bolt cuts its thread: interference, not clearance
+
+
+def _dxf_circles(path):
+    return [(c.dxf.center.x, c.dxf.center.y, c.dxf.radius)
+            for c in ezdxf.readfile(path).modelspace().query("CIRCLE[layer=='CUT_INNER']")]
