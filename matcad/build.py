@@ -52,17 +52,17 @@ def write_laser_part(flat, spec, folder: Path) -> list[dict]:
              "drawn_mm": c.diameter, "compensation_mm": c.compensation} for c in plan.circles]
 
 
-def write_printed_part(name: str, solid, spec, folder: Path) -> dict:
+def write_printed_part(name: str, solid, spec, folder: Path, pose: str | None = None) -> dict:
     """STL + STEP of one solid in its print pose (:data:`PRINT_POSES`); returns the STL's read-back checks,
     the B-rep volume and the pose (bed face, design → print frame matrix)."""
     from matcad.export.mesh import mesh_checks, write_step, write_stl
     from matcad.parts.catalogue import PRINT_POSES, in_print_pose
 
-    posed, matrix = in_print_pose(name, solid)
+    posed, matrix = in_print_pose(pose or name, solid)
     stl = folder / f"{name}.stl"
     write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance, matrix)
     write_step(posed, folder / f"{name}.step")
-    pose = PRINT_POSES[name]
+    pose = PRINT_POSES[pose or name]
     return mesh_checks(stl) | {"brep_volume_mm3": float(posed.volume), "printed": pose.printed,
                                "bed_face": pose.bed_face, "rotation_x_deg": pose.rx_deg,
                                "design_to_print": matrix}
@@ -88,10 +88,22 @@ def _write_solids(spec, folder: Path) -> dict[str, dict]:
     return checks
 
 
+def write_archive(folder: Path, name: str) -> None:
+    """Zip every file in ``folder`` (sorted, fixed timestamps: the same kit gives the same archive) as ``name``."""
+    import zipfile
+
+    files = sorted(p for p in folder.iterdir() if p.is_file() and p.name != name)
+    with zipfile.ZipFile(folder / name, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for path in files:
+            info = zipfile.ZipInfo(path.name, date_time=(2000, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            archive.writestr(info, path.read_bytes())
+
+
 def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:
     """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
     from matcad.render.kit import render_figures
-    from matcad.report import make_report, write_report
+    from matcad.report import KIT_ARCHIVE, make_report, write_report
 
     prediction = predict(spec)
     findings = check(spec, prediction)
@@ -105,6 +117,7 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
         figures = render_figures(spec, prediction, tmp, meshes)
         report = make_report(spec, prediction, findings, holes, meshes, tmp) | {"figures": figures}
         write_report(report, tmp)
+        write_archive(tmp, KIT_ARCHIVE)
     files = tuple(sorted(p.name for p in target.iterdir()))
     return BuildResult(target, files, tuple(findings), prediction, report)
 
@@ -113,7 +126,8 @@ def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
     """Write the laser and printed test coupons to ``out_dir`` (default out/<name>-coupon) with a hole table."""
     import json
 
-    from matcad.parts.coupon import coupon_sheets, laser_coupon, printed_coupon, printed_coupon_holes
+    from matcad.parts.coupon import (coupon_sheets, laser_coupon, printed_coupon, printed_coupon_holes,
+                                     y_sweep_mounts)
 
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec, "-coupon")
     coupons = [laser_coupon(spec, sheet) for sheet in coupon_sheets(spec)]
@@ -123,9 +137,12 @@ def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
         laser = [hole | {"sheet_mm": flat.thickness, "kerf_mm": flat.kerf}
                  for flat in coupons for hole in write_laser_part(flat, spec, tmp)]
         mesh = write_printed_part("coupon_printed", printed_coupon(spec), spec, tmp)
+        sweep = [{"file": f"{stem}.stl", "y_mm": y, "theta_deg": spec.needle.theta_deg, "notches": i + 1,
+                  "mesh": write_printed_part(stem, solid, spec, tmp, pose="needle_mount")}
+                 for i, (stem, (y, solid)) in enumerate(y_sweep_mounts(spec).items())]
         table = {"name": spec.name, "sheets": {f.name: {"thickness_mm": f.thickness, "kerf_mm": f.kerf}
                                                 for f in coupons},
-                 "printer": spec.machine.printer, "laser_holes": laser, "mesh": mesh,
+                 "printer": spec.machine.printer, "laser_holes": laser, "mesh": mesh, "needle_sweep": sweep,
                  "printed_holes": [{"purpose": h.purpose, "x_mm": h.x, "y_mm": h.y, "diameter_mm": h.diameter,
                                     "theta_deg": spec.needle.theta_deg if h.purpose == "needle" else 90.0}
                                    for h in printed_coupon_holes(spec)]}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections import defaultdict
 from pathlib import Path
 
@@ -15,7 +16,14 @@ from matcad.parts.features import (sheet_kerf_mm, bolt_nominal_mm, cap_flange_th
 from matcad.parts.fabrication import fabrication
 from matcad.spec import to_dict
 
-REPORT_FILES = ("report.json", "report.md", "report.html")
+KIT_ARCHIVE = "kit.zip"
+"""Every file of the build in one archive, written last."""
+REPORT_FILES = ("report.json", "report.md", "report.html", KIT_ARCHIVE)
+"""Written after the manifest: the reports, and the archive that holds everything."""
+HUB_CLEARANCE_MM = 3.0
+"""Needle left below the mount's underside so the hub clears it."""
+NUT_HEIGHT_PER_D = 0.8
+"""ISO 4032 hex nut height ≈ 0.8 d."""
 THREAD_ENGAGEMENT_PER_D = 2.0
 """Self-tapping screws into printed plastic want ~2 x diameter of engagement."""
 
@@ -70,8 +78,8 @@ def bill_of_materials(spec) -> dict:
                     if spec.spacer.style == "laser" else
                     {"count": len(plate_bolt_positions_mm(spec)), "style": "standoff",
                      "note": f"printed on the needle mount, {spec.spacer.height:g} mm tall"}),
-        "needle": {"count": 1, "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
-                   "y_mm": spec.needle.y},
+        "needle": needle_bom(spec),
+        **kit_hardware(spec),
     }
 
 
@@ -87,6 +95,44 @@ def casting(spec) -> dict | None:
         "vent_reach_mm": spec.mold.vent_reach, "base_face_reach_mm": plan.reach_base_mm,
         "pin_end_reach_mm": plan.reach_tip_mm, "base_face_vents_per_cap": len(plan.inner) + len(plan.outer),
         "pin_vents_per_cap": 1, "vent_diameter_mm": spec.mold.vent}}
+
+
+def needle_bom(spec) -> dict:
+    """The needle to buy and how deep it goes (mm)."""
+    from matcad.parts.features import nearest_needle_gauge, needle_tip_mm
+    from matcad.parts.needle_mount import needle_protrusion_mm
+
+    gauge, od = nearest_needle_gauge(spec.needle.outer_diameter)
+    sin_t = math.sin(math.radians(spec.needle.theta_deg))
+    through = (needle_tip_mm(spec)[2] + spec.spacer.height + spec.mount.thickness) / sin_t
+    return {"count": 1, "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
+            "y_mm": spec.needle.y, "gauge": gauge, "gauge_od_mm": od, "hub": "Luer-lock hub, blunt (dispensing) tip",
+            "min_length_mm": through + HUB_CLEARANCE_MM, "protrusion_mm": needle_protrusion_mm(spec),
+            "note": f"nearest standard: {gauge} G ({od:.3f} mm, ISO 9626); measure yours and enter "
+                    "needle.outer_diameter. Push it up the bore until its tip stands the stated protrusion out of "
+                    "the mount's top face (along the needle; a caliper depth rod), then fix the hub"}
+
+
+def kit_hardware(spec) -> dict:
+    """Mold clamp bolts and nuts, release agent, mount fixing screws (mm)."""
+    from matcad.parts.casting import RELEASE_AGENT
+    from matcad.parts.needle_mount import EAR_THICKNESS_MM, FIXING_BOLT, ear_holes_mm
+
+    out = {}
+    if spec.outputs.end_cap_mold:
+        from matcad.parts.mold_layout import layout
+
+        lay = layout(spec)
+        d = bolt_nominal_mm(spec.mold.bolt)
+        out["mold_clamp"] = {"count": len(lay.bolts), "size": spec.mold.bolt,
+                             "min_length_mm": lay.base_height + spec.mold.lid_thickness + NUT_HEIGHT_PER_D * d + 1.0,
+                             "nuts": len(lay.bolts), "washers": 2 * len(lay.bolts)}
+        out["release_agent"] = RELEASE_AGENT
+    if spec.outputs.needle_mount:
+        out["mount_fixing"] = {"count": len(ear_holes_mm(spec)), "size": FIXING_BOLT,
+                               "note": f"through the mount's ears ({EAR_THICKNESS_MM:g} mm) into a bench bracket or "
+                                       "robot plate, on standoffs taller than the needle's hub"}
+    return out
 
 
 def manifest(folder: Path) -> list[dict]:
@@ -141,6 +187,9 @@ def _fabrication_markdown(f: dict | None) -> list[str]:
     lines += ["", f"Seal: the flange is cast {s['guide_sheet_mm']:g} + {s['flange_squeeze_mm']:g} mm thick; over the "
               f"guide sheet's ±{s['sheet_tolerance_mm']:.2f} mm the clamp squeezes it {s['squeeze_low_mm']:+.2f} … "
               f"{s['squeeze_high_mm']:+.2f} mm ({'measured' if s['guide_measured'] else 'nominal'} sheet)."]
+    lines += ["", "Steps, in order:", ""]
+    lines += [f"{i}. **{_cell(s['where'])}** — {_cell(s['do'])}" + (f" (`{'`, `'.join(s['files'])}`)" if s["files"] else "")
+              for i, s in enumerate(f["steps"], 1)]
     if f["fits"]:
         lines += ["", "| fit | hole [mm] | part in it [mm] | clearance [mm] |", "|---|---:|---:|---:|"]
         lines += [f"| {_cell(x['fit'])} | {x['hole_mm']:.3f} | {x['pin_mm']:.3f} | {x['clearance_mm']:+.3f} |"
@@ -207,8 +256,17 @@ def _markdown(r: dict) -> str:
               f"- {bom['spacers']['count']} spacers: {bom['spacers']['note']}",
               f"- {bom['bolts']['count']} × {bom['bolts']['size']} bolts, ≥ {bom['bolts']['min_length_mm']:.1f} mm "
               f"({bom['bolts']['note']})",
-              f"- needle Ø{bom['needle']['outer_diameter_mm']:g} mm at θ = {bom['needle']['theta_deg']:g}°, "
-              f"y = {bom['needle']['y_mm']:g} mm"]
+              f"- needle Ø{bom['needle']['outer_diameter_mm']:g} mm ({bom['needle']['gauge']} G), "
+              f"{bom['needle']['hub']}, ≥ {bom['needle']['min_length_mm']:.1f} mm long, at θ = "
+              f"{bom['needle']['theta_deg']:g}°, y = {bom['needle']['y_mm']:g} mm; tip "
+              f"{bom['needle']['protrusion_mm']:.2f} mm out of the mount's top face ({bom['needle']['note']})"]
+    if "mold_clamp" in bom:
+        c = bom["mold_clamp"]
+        lines += [f"- mold clamp: {c['count']} × {c['size']} bolts ≥ {c['min_length_mm']:.0f} mm, {c['nuts']} nuts, "
+                  f"{c['washers']} washers", f"- release agent: {bom['release_agent']}"]
+    if "mount_fixing" in bom:
+        f = bom["mount_fixing"]
+        lines.append(f"- mount fixing: {f['count']} × {f['size']} screws {f['note']}")
     lines += _fabrication_markdown(r.get("fabrication"))
     lines += _casting_markdown(r.get("casting"))
     lines += ["", "## Files", "", "| file | bytes | sha256 |", "|---|---:|---|"]

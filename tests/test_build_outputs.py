@@ -15,6 +15,7 @@ from matcad.build import build
 from matcad.export.dxf_svg import LAYERS
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.features import cap_volume_mm3
+from matcad.report import KIT_ARCHIVE, REPORT_FILES
 from tests.conftest import TEMPLATES
 
 
@@ -34,7 +35,7 @@ def test_report_manifest_matches_files(built):
     spec, out, result = built
     report = json.loads((out / "report.json").read_text())
     listed = {f["file"]: f for f in report["files"]}
-    on_disk = {p.name for p in out.iterdir()} - {"report.json", "report.md", "report.html"}
+    on_disk = {p.name for p in out.iterdir()} - set(REPORT_FILES)
     assert set(listed) == on_disk
     for name, row in listed.items():
         data = (out / name).read_bytes()
@@ -211,3 +212,15 @@ def test_seal_squeeze_read_back_from_the_cast_cap(built):
     md = (out / "report.md").read_text()
     guide = next(c for c in report["fabrication"]["caliper"] if c["part"].startswith("guide"))
     assert guide["before_mold"] and "before printing the mold" in md
+
+
+def test_kit_archive_holds_every_file_byte_for_byte(built):
+    import zipfile
+
+    _, out, _ = built
+    with zipfile.ZipFile(out / KIT_ARCHIVE) as archive:
+        assert archive.testzip() is None
+        names = set(archive.namelist())
+        assert names == {p.name for p in out.iterdir()} - {KIT_ARCHIVE}
+        for name in names:
+            assert archive.read(name) == (out / name).read_bytes(), name

@@ -84,3 +84,58 @@ def test_per_sheet_kerf_reaches_the_kit(coupons, tmp_path):
         xs = [x for x, *_ in msp.query("LWPOLYLINE[layer=='CUT_OUTER']")[0].get_points("xyb")]
         width = spec.spacer.size if part == "spacer" else spec.plate.width
         assert max(xs) - min(xs) == pytest.approx(width + KERFS[sheet], abs=1e-9)
+
+
+def test_y_sweep_mounts_measured_on_their_step_files(coupons):
+    """The trial set spans the paper's y window at the spec's θ; each bore's y is read back from its STEP."""
+    spec, folder = coupons
+    from build123d import Pos
+
+    from matcad.parts.coupon import Y_SWEEP_MM
+    from matcad.parts.needle_mount import needle_bore_diameter_mm
+
+    table = json.loads((folder / "report.json").read_text())
+    sweep = table["needle_sweep"]
+    assert [row["y_mm"] for row in sweep] == list(Y_SWEEP_MM) and min(Y_SWEEP_MM) == 0.0 and max(Y_SWEEP_MM) == 3.47
+    assert [row["notches"] for row in sweep] == list(range(1, len(Y_SWEEP_MM) + 1))
+    for row in sweep:
+        solid = import_step(folder / row["file"].replace(".stl", ".step"))
+        solid = Pos(0, 0, -row["mesh"]["design_to_print"][2][3]) * solid
+        bore = next(f for f in solid.faces() if f.geom_type == GeomType.CYLINDER
+                    and abs(f.radius - needle_bore_diameter_mm(spec) / 2) < 1e-6
+                    and abs(f.axis_of_rotation.direction.Z) < 0.9999).axis_of_rotation
+        d, p = bore.direction, bore.position
+        assert math.degrees(math.asin(abs(d.Z))) == pytest.approx(spec.needle.theta_deg, abs=0.01)
+        x_hit = p.X - p.Z / d.Z * d.X
+        assert -spec.neck.diameter / 2 - x_hit == pytest.approx(row["y_mm"], abs=0.01)
+        assert trimesh.load_mesh(folder / row["file"]).is_watertight
+
+
+@pytest.mark.parametrize("sheet", ["plate", "guide", "spacer"])
+def test_every_laser_coupon_hole_is_labelled_with_its_size_as_outlines(coupons, sheet):
+    """No font text anywhere; under each hole an engraved outline group whose SVG title is the hole's finished
+    size, and whose DXF outlines sit just below that hole."""
+    import re
+    import xml.etree.ElementTree as ET
+
+    import numpy as np
+
+    spec, folder = coupons
+    msp = ezdxf.readfile(folder / f"coupon_{sheet}.dxf").modelspace()
+    assert not msp.query("TEXT MTEXT")
+    engraved = np.array([p[:2] for pl in msp.query("LWPOLYLINE[layer=='ENGRAVE']") for p in pl.get_points("xy")])
+    root = ET.parse(folder / f"coupon_{sheet}.svg").getroot()
+    ns = "{http://www.w3.org/2000/svg}"
+    assert not list(root.iter(f"{ns}text"))
+    titles = {}
+    for path in next(g for g in root.iter(f"{ns}g") if g.get("id") == "ENGRAVE").iter(f"{ns}path"):
+        xs = [float(v) for v in re.findall(r"M ([-\d.]+)", path.get("d"))]
+        titles.setdefault(path.find(f"{ns}title").text, []).append(min(xs))
+    kerf = KERFS[sheet]
+    for c in msp.query("CIRCLE[layer=='CUT_INNER']"):
+        finished = 2 * c.dxf.radius + kerf
+        assert f"{finished:.2f}" in titles, finished
+        below = engraved[(np.abs(engraved[:, 0] - c.dxf.center.x) < finished / 2 + 2)
+                         & (engraved[:, 1] < c.dxf.center.y - c.dxf.radius)
+                         & (engraved[:, 1] > c.dxf.center.y - c.dxf.radius - 3)]
+        assert len(below) > 10, finished

@@ -78,3 +78,29 @@ def test_self_tap_pilot_measured_in_the_mount(kit):
 def _dxf_circles(path):
     return [(c.dxf.center.x, c.dxf.center.y, c.dxf.radius)
             for c in ezdxf.readfile(path).modelspace().query("CIRCLE[layer=='CUT_INNER']")]
+
+
+def test_mount_fixing_ears_and_needle_protrusion(kit):
+    """Four M3 clearance holes in the ears (read from the STL); the needle protrusion the report states is the
+    tip's height over the mount's top face (read from the STL) along the needle."""
+    import math
+
+    from matcad.parts.features import bolt_clearance_mm, needle_tip_mm
+    from matcad.parts.needle_mount import EAR_THICKNESS_MM, FIXING_BOLT, ear_holes_mm
+
+    spec, out, report, _ = kit
+    mount = _design_frame(out, report, "needle_mount.stl")
+    bottom = float(mount.bounds[0, 2])
+    circles = section_circles(mount, bottom + EAR_THICKNESS_MM / 2)
+    for x, y in ear_holes_mm(spec):
+        hole = nearest_circle(circles, x, y)
+        assert (hole[0], hole[1]) == pytest.approx((x, y), abs=1e-3)
+        assert 2 * hole[2] == pytest.approx(bolt_clearance_mm(FIXING_BOLT, "normal"), abs=2e-3)
+    nz = mount.face_normals[:, 2]
+    up = mount.triangles_center[nz > 1 - 1e-9][:, 2]
+    areas = mount.area_faces[nz > 1 - 1e-9]
+    top = max(set(np.round(up, 4)), key=lambda z: areas[np.round(up, 4) == z].sum())  # the block's top face
+    needle = report["bom"]["needle"]
+    rise = needle_tip_mm(spec)[2] - top
+    assert needle["protrusion_mm"] == pytest.approx(rise / math.sin(math.radians(spec.needle.theta_deg)), abs=1e-3)
+    assert needle["protrusion_mm"] > 0

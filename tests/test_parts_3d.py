@@ -100,3 +100,15 @@ def test_mold_has_fill_port_and_vents_through_lid(spec):
     assert radii.count(round(spec.mold.fill_port / 2, 6)) == spec.mold.count
     assert radii.count(round(spec.mold.vent / 2, 6)) == len(lay.vents) + len(lay.pin_vents)
     assert len(lay.pin_vents) == spec.mold.count and len(lay.vents) % spec.mold.count == 0
+
+
+def test_assembly_shows_the_drilled_neck_not_the_pilot(spec):
+    """A pilot-cut neck (the SLA template) is assembled drilled to neck.diameter: the plate's bore measured."""
+    import dataclasses
+
+    from matcad.parts.assembly import assembled_parts
+    piloted = dataclasses.replace(spec, plate=dataclasses.replace(spec.plate, neck_pilot=True))
+    plate = assembled_parts(piloted)["neck_plate"]
+    bores = [f.radius for f in plate.faces() if f.geom_type == GeomType.CYLINDER
+             and abs(f.axis_of_rotation.position.X) < 1e-9 and abs(f.axis_of_rotation.position.Y) < 1e-9]
+    assert bores == [pytest.approx(spec.neck.diameter / 2, abs=1e-9)]

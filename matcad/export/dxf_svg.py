@@ -1,8 +1,8 @@
 """DXF and SVG writers for laser cut plans. Units mm everywhere; one layer / colour per operation.
 
 DXF: $INSUNITS = 4 (mm), native CIRCLE, closed LWPOLYLINE outlines with bulge arcs (no splines), layers
-CUT_INNER, CUT_OUTER, ENGRAVE, REFERENCE with distinct ACI colours; inner cuts are written first so a laser
-that follows file order cuts holes before freeing the part.
+CUT_INNER, CUT_OUTER, ENGRAVE (text as closed glyph outlines, never font text), REFERENCE with distinct ACI
+colours; inner cuts are written first so a laser that follows file order cuts holes before freeing the part.
 SVG: width/height in mm with a matching viewBox (1 user unit = 1 mm), one stroke colour per operation — for
 Glowforge-class lasers that read SVG, not DXF.
 """
@@ -23,6 +23,23 @@ LAYERS = {
     "REFERENCE": (6, "#ff00ff", "10 mm reference square to check scale on import; do not cut"),
 }
 QUARTER_BULGE = math.tan(math.pi / 8)  # bulge of a 90° arc
+
+
+CAP_HEIGHT_PER_SIZE = 0.729
+"""DejaVu Sans capital height / font size: an Engraving's height is its capital height."""
+
+
+def engraving_outlines(t) -> list[list[tuple[float, float]]]:
+    """An :class:`~matcad.parts.flat.Engraving` as closed glyph outlines (mm): the text converted to polygons
+    with DejaVu Sans (shipped with matplotlib, so every machine draws the same shapes), baseline at (t.x, t.y),
+    capitals t.height tall. Lasers engrave or score the outlines; no font is needed on the laser's computer."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextPath
+
+    path = TextPath((0.0, 0.0), t.text, size=t.height / CAP_HEIGHT_PER_SIZE,
+                    prop=FontProperties(family="DejaVu Sans"))
+    return [[(t.x + float(x), t.y + float(y)) for x, y in poly[:-1]]
+            for poly in path.to_polygons(closed_only=True) if len(poly) > 3]
 
 
 def rounded_rect_points(x0, y0, x1, y1, r):
@@ -60,7 +77,8 @@ def _write_dxf(plan: CutPlan, path: Path) -> None:
     for c in plan.circles:
         msp.add_circle((c.x, c.y), c.diameter / 2, dxfattribs={"layer": "CUT_INNER"})
     for t in plan.texts:
-        msp.add_text(t.text, height=t.height, dxfattribs={"layer": "ENGRAVE", "insert": (t.x, t.y)})
+        for outline in engraving_outlines(t):
+            msp.add_lwpolyline(outline, format="xy", close=True, dxfattribs={"layer": "ENGRAVE"})
     for x0, y0, x1, y1, r in plan.outlines:
         msp.add_lwpolyline(rounded_rect_points(x0, y0, x1, y1, r), format="xyb", close=True,
                            dxfattribs={"layer": "CUT_OUTER"})
@@ -101,8 +119,10 @@ def write_svg(plan: CutPlan, path: Path) -> None:
     out.append("</g>")
     if plan.texts:
         out.append(f'<g id="ENGRAVE" fill="{stroke["ENGRAVE"]}" stroke="none">')
-        out += [f'<text x="{t.x:.6f}" y="{-t.y:.6f}" font-size="{t.height:.6f}" font-family="sans-serif">'
-                f"{escape(t.text)}</text>" for t in plan.texts]
+        for t in plan.texts:
+            d = " ".join("M " + " L ".join(f"{x:.4f} {-y:.4f}" for x, y in outline) + " Z"
+                         for outline in engraving_outlines(t))
+            out.append(f'<path d="{d}" fill-rule="evenodd"><title>{escape(t.text)}</title></path>')
         out.append("</g>")
     out.append(f'<g id="CUT_OUTER" stroke="{stroke["CUT_OUTER"]}" {group}>')
     out += [f'<path d="{_svg_rounded_rect(*o)}"/>' for o in plan.outlines]

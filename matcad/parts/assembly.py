@@ -22,11 +22,20 @@ SECTION_COLOURS = {
 }
 
 
+def drilled(plate, neck_diameter: float):
+    """The neck plate as assembled: a pilot-cut neck drilled to its finished diameter (mm)."""
+    import dataclasses
+
+    holes = tuple(dataclasses.replace(h, diameter=neck_diameter, purpose="neck") if h.purpose == "neck_pilot" else h
+                  for h in plate.holes)
+    return dataclasses.replace(plate, holes=holes)
+
+
 def assembled_parts(spec) -> dict[str, object]:
     """Name → solid in the assembly frame (mm). Spacers are numbered when laser-cut."""
     plate_t = spec.neck.length
     parts = {
-        "neck_plate": flat_solid(neck_plate(spec)),
+        "neck_plate": flat_solid(drilled(neck_plate(spec), spec.neck.diameter)),
         "guide_locator": flat_solid(guide(spec, "locator"), plate_t),
         "guide_clamp": flat_solid(guide(spec, "clamp"), plate_t + cap_flange_thickness_mm(spec)),
         "end_cap": Pos(0, 0, plate_t) * end_cap(spec),

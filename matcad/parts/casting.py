@@ -81,7 +81,8 @@ def casting_guide(spec) -> CastingGuide:
     steps = (
         f"Print the mold ({mold['label']}): end_cap_mold_base.stl and end_cap_mold_lid.stl, each as exported "
         f"(flat face down, no supports). Clear every vent with a {spec.mold.vent:g} mm drill or pin.",
-        *((f"SLA: {mold['inhibition']}.",) if mold["inhibition"] else ()),
+        *(("SLA: post-cure the printed mold fully, or barrier-coat it, and cast a test drop (cure inhibition, "
+           "above).",) if mold["inhibition"] else ()),
         f"Release: {RELEASE_AGENT}.",
         f"Close the mold: lid on the base (the keys centre it), {len(lay.bolts)} x {spec.mold.bolt} bolts with nuts, "
         "finger-tight and even; set it level, fill ports up.",

@@ -100,3 +100,30 @@ def printed_coupon(spec):
         else:
             bar -= cylinder_up(h.diameter / 2, t, h.x, h.y)
     return bar
+
+
+Y_SWEEP_MM = (0.0, 0.87, 1.74, 2.6, 3.47)
+"""Needle offsets y the trial set spans: the paper's tested window 0–3.47 mm (Sec. II) in four steps."""
+NOTCH_MM = 1.0
+
+
+def y_sweep_mounts(spec) -> dict[str, tuple[float, object]]:
+    """A set of needle mounts, one per y in :data:`Y_SWEEP_MM` at the spec's θ, to print together and try on the
+    same plate: file stem → (y mm, solid). Mount i carries i + 1 notches on its +x edge, so they cannot be mixed
+    up; the coupon report lists which is which."""
+    import dataclasses
+
+    from build123d import Box, Pos
+
+    from matcad.parts.needle_mount import needle_mount
+    from matcad.parts.solid import TOP
+
+    out = {}
+    for i, y in enumerate(Y_SWEEP_MM):
+        trial = dataclasses.replace(spec, needle=dataclasses.replace(spec.needle, y=y))
+        mount = needle_mount(trial)
+        top = -spec.spacer.height
+        notches = [Pos(spec.plate.width / 2, (k - i / 2) * 3 * NOTCH_MM, top)
+                   * Box(2 * NOTCH_MM, NOTCH_MM, spec.mount.thickness, align=TOP) for k in range(i + 1)]
+        out[f"needle_mount_y{y:.2f}"] = (y, mount.cut(*notches))
+    return out

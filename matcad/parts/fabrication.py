@@ -69,6 +69,55 @@ def fits(spec) -> list[dict]:
     return rows
 
 
+def steps(spec) -> list[dict]:
+    """The kit made and assembled in order: each step with what to do, on which sheet or machine, which files."""
+    from matcad.parts.features import SHEETS, sheet_kerf_mm, sheet_thickness_mm
+
+    o, out = spec.outputs, []
+
+    def step(where, files, do):
+        out.append({"where": where, "files": files, "do": do})
+
+    unmeasured = [c for c in sheets_to_caliper(spec) if not c["measured"]]
+    step("calipers", [], "Caliper every sheet (table above) in several places; enter the values (neck.length, "
+         "guide.thickness, spacer.height), set *_measured = true and rebuild"
+         + (f" — still nominal: {', '.join(str(c['sheet_mm']) + ' mm' for c in unmeasured)}" if unmeasured else ""))
+    step("laser + printer", ["matcad coupon"], "Cut one coupon per sheet (coupon_<sheet>.dxf) and print "
+         "coupon_printed.stl; set each sheet's laser_kerf from the hole that fits its pin, and the needle/dowel "
+         "fits from the printed bores; rebuild")
+    cuts = {"plate": ["neck_plate.dxf"] if o.neck_plate else [],
+            "guide": ["guide_locator.dxf", "guide_clamp.dxf"] if o.guides else [],
+            "spacer": ["spacer.dxf"] if o.spacers and spec.spacer.style == "laser" else []}
+    for sheet, files in cuts.items():
+        if files:
+            t, _ = sheet_thickness_mm(spec, sheet)
+            step(f"laser, {t:g} mm acrylic", files, f"Cut the {SHEETS[sheet]} from the {t:g} mm sheet, kerf "
+                 f"{sheet_kerf_mm(spec, sheet):g} mm (already compensated in the file: cut on the line; inner "
+                 "cuts first, engraving as score)")
+    if o.neck_plate and spec.plate.neck_pilot:
+        step("drill", ["neck_plate.dxf"], f"Drill the neck pilot to {spec.neck.diameter:g} mm (drill press, "
+             "plate clamped flat, back it with scrap)")
+    printed = (["end_cap_mold_base.stl", "end_cap_mold_lid.stl"] if o.end_cap_mold else []) + \
+        (["needle_mount.stl"] if o.needle_mount else [])
+    if printed:
+        step(f"printer ({spec.machine.printer})", printed, "Print each part as exported (flat face down, no "
+             "supports; the report's mesh table gives each part's bed face)")
+    if o.end_cap_mold:
+        step("bench", ["end_cap_mold_base.stl", "end_cap_mold_lid.stl"], "Cast the caps: follow the casting guide")
+    if o.needle_mount:
+        step("bench", ["needle_mount.stl"], "Fix the mount by its ears (4 x M3) to the bench or robot; press the "
+             f"dowels into it; slide the needle up the bore until its tip stands out of the top face as the BOM "
+             "states; fix the hub")
+    stack = "spacers (spacer.dxf) over the bolt holes, " if spec.spacer.style == "laser" else ""
+    step("bench", ["neck_plate.dxf", "guide_locator.dxf", "guide_clamp.dxf"], f"Stack on the mount: {stack}"
+         "the neck plate, the locator guide; seat the cap in the locator, base face down on the plate; lay the "
+         f"clamp guide over its flange; {spec.fasteners.bolt} bolts through all layers into the mount, tightened "
+         "evenly until the clamp sits on the locator (that closes the flange squeeze)")
+    step("bench", ["report.md"], "Blow air through the needle and record: the tone should sit in the predicted "
+         "band; calibrate with `matcad calibrate`")
+    return out
+
+
 def fabrication(spec) -> dict:
-    """The report's fabrication section: sheets to caliper, the seal, the fits."""
-    return {"caliper": sheets_to_caliper(spec), "seal": seal(spec), "fits": fits(spec)}
+    """The report's fabrication section: sheets to caliper, the seal, the fits, the ordered steps."""
+    return {"caliper": sheets_to_caliper(spec), "seal": seal(spec), "fits": fits(spec), "steps": steps(spec)}

@@ -50,6 +50,16 @@ def sheet_thickness_mm(spec, sheet: str) -> tuple[float, bool]:
             "spacer": (spec.spacer.height, spec.spacer.thickness_measured)}[sheet]
 
 
+NEEDLE_GAUGE_OD_MM = {14: 2.108, 15: 1.829, 16: 1.651, 17: 1.473, 18: 1.270, 19: 1.067, 20: 0.908, 21: 0.819,
+                      22: 0.718, 23: 0.641, 25: 0.514}
+"""Nominal outer diameter of hypodermic / dispensing needle tubing by gauge (ISO 9626 normal wall, mm)."""
+
+
+def nearest_needle_gauge(outer_diameter_mm: float) -> tuple[int, float]:
+    """The standard gauge whose nominal outer diameter is nearest (gauge, OD mm)."""
+    return min(NEEDLE_GAUGE_OD_MM.items(), key=lambda kv: abs(kv[1] - outer_diameter_mm))
+
+
 def pin_hole_diameter_mm(pin_diameter_mm: float, process: str, fit: str) -> float:
     """Finished hole diameter (mm) for a pin (dowel, needle) of the given diameter, process and fit."""
     return pin_diameter_mm + PIN_FIT_ALLOWANCE_MM[process][fit]

@@ -33,6 +33,24 @@ class Engraving:
     text: str
 
 
+EM_PER_CAP = 0.62 / 0.729
+"""Mean advance of a DejaVu Sans character per capital height (for placing labels; the exporter draws them)."""
+
+
+def edge_label(text: str, width: float, depth: float, holes, height: float = 1.0, margin: float = 0.6):
+    """A part label engraved along the bottom (else top) edge of a width x depth part, clear of every hole by
+    ``margin``; () when it fits nowhere (mm)."""
+    length = len(text) * EM_PER_CAP * height
+    if length + 2 * margin > width:
+        return ()
+    for y0 in (-depth / 2 + margin, depth / 2 - margin - height):
+        box = (-length / 2 - margin, y0 - margin, length / 2 + margin, y0 + height + margin)
+        if all(h.x + h.diameter / 2 < box[0] or h.x - h.diameter / 2 > box[2] or h.y + h.diameter / 2 < box[1]
+               or h.y - h.diameter / 2 > box[3] for h in holes):
+            return (Engraving(-length / 2, y0, height, text),)
+    return ()
+
+
 @dataclass(frozen=True)
 class Flat:
     """A laser-cut part: rectangular outline centred on the origin, holes, engraved text (mm)."""

@@ -5,7 +5,7 @@ the bolts press it down so the flange (guide thickness + squeeze) seals against 
 """
 
 from matcad.parts.features import cap_flange_diameter_mm, laser_stack_holes, sheet_kerf_mm
-from matcad.parts.flat import Flat, Hole
+from matcad.parts.flat import Flat, Hole, edge_label
 
 BODY_CLEARANCE_MM = 0.2
 """Diametral clearance of the clamp's hole around the silicone body, so clamping does not pinch the cavity."""
@@ -20,7 +20,10 @@ def guide(spec, role: str) -> Flat:
         cap_hole = Hole(0.0, 0.0, spec.end_cap.outer_diameter + BODY_CLEARANCE_MM, "cap")
     else:
         raise ValueError(f"role {role!r} invalid, must be one of {ROLES}")
+    holes = (cap_hole, *laser_stack_holes(spec))
     return Flat(name=f"guide_{role}", thickness=spec.guide.thickness,
                 thickness_measured=spec.guide.thickness_measured, kerf=sheet_kerf_mm(spec, "guide"),
                 width=spec.plate.width,
-                depth=spec.plate.depth, holes=(cap_hole, *laser_stack_holes(spec)))
+                depth=spec.plate.depth, holes=holes,
+                engrave=edge_label(f"{role.upper()} {spec.guide.thickness:g}", spec.plate.width, spec.plate.depth,
+                                   holes))

@@ -1,7 +1,7 @@
 """The acrylic neck plate: its thickness is the neck length l, its centre hole the neck d (paper Fig. 2)."""
 
 from matcad.parts.features import laser_stack_holes, sheet_kerf_mm
-from matcad.parts.flat import Engraving, Flat, Hole
+from matcad.parts.flat import Engraving, Flat, Hole, edge_label
 
 
 def neck_plate(spec) -> Flat:
@@ -14,7 +14,8 @@ def neck_plate(spec) -> Flat:
     if spec.plate.label:
         height = min(2.0, spec.plate.depth / 12)
         label = (Engraving(-spec.plate.width / 4, -spec.plate.depth / 4 - height / 2, height, spec.plate.label),)
+    holes = (neck, *laser_stack_holes(spec))
+    label += edge_label(f"PLATE d{spec.neck.diameter:g}", spec.plate.width, spec.plate.depth, holes)
     return Flat(name="neck_plate", thickness=spec.neck.length, thickness_measured=spec.plate.thickness_measured,
-                kerf=sheet_kerf_mm(spec, "plate"),
-                width=spec.plate.width, depth=spec.plate.depth, holes=(neck, *laser_stack_holes(spec)),
+                kerf=sheet_kerf_mm(spec, "plate"), width=spec.plate.width, depth=spec.plate.depth, holes=holes,
                 engrave=label)

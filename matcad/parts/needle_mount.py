@@ -9,9 +9,9 @@ import math
 
 from build123d import Box, Pos
 
-from matcad.parts.features import (SELF_TAP_PILOT_MM, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
+from matcad.parts.features import (SELF_TAP_PILOT_MM, bolt_clearance_mm, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
                                    plate_bolt_positions_mm, plate_dowel_positions_mm)
-from matcad.parts.solid import TOP, cylinder_up, tilted_cylinder
+from matcad.parts.solid import BOTTOM, TOP, cylinder_up, tilted_cylinder
 
 
 def needle_bore_diameter_mm(spec) -> float:
@@ -29,11 +29,36 @@ def needle(spec):
     return _on_needle_axis(spec, needle_tip_mm(spec), spec.needle.outer_diameter / 2, spec.needle.length)
 
 
+EAR_WIDTH_MM = 9.0
+EAR_THICKNESS_MM = 3.0
+FIXING_BOLT = "M3"
+"""Two ears on ±y, flush with the mount's underside (they print on the bed, no support), each with two M3
+clearance holes: screw the mount to a bench bracket or a robot plate on standoffs tall enough for the needle's
+hub, which hangs below the mount."""
+
+
+def ear_holes_mm(spec) -> list[tuple[float, float]]:
+    """Centres (x, y) of the fixing holes in the ears, assembly frame (mm)."""
+    y = spec.plate.depth / 2 + EAR_WIDTH_MM / 2
+    return [(sx * spec.plate.width / 4, sy * y) for sy in (-1, 1) for sx in (-1, 1)]
+
+
+def needle_protrusion_mm(spec) -> float:
+    """How far the needle's tip stands out of the mount's top face, along the needle (mm): set it with a depth
+    gauge or calipers before tightening (the tip then sits needle.tip_clearance below the plate)."""
+    tip_z = needle_tip_mm(spec)[2]
+    return (tip_z + spec.spacer.height) / math.sin(math.radians(spec.needle.theta_deg))
+
+
 def needle_mount(spec):
-    """The mount solid in the assembly frame (mm)."""
+    """The mount solid in the assembly frame (mm): block, fixing ears, standoffs (if printed), bolt pilots,
+    dowel holes, the needle bore."""
     gap, thick = spec.spacer.height, spec.mount.thickness
     top = -gap
     body = Pos(0, 0, top) * Box(spec.plate.width, spec.plate.depth, thick, align=TOP)
+    ears = Pos(0, 0, top - thick) * Box(spec.plate.width, spec.plate.depth + 2 * EAR_WIDTH_MM, EAR_THICKNESS_MM,
+                                        align=BOTTOM)
+    body = body + ears
     if spec.spacer.style == "standoff":
         for x, y in plate_bolt_positions_mm(spec):
             body += cylinder_up(spec.spacer.size / 2, gap, x, y, top)
@@ -47,6 +72,8 @@ def needle_mount(spec):
         spec.needle.theta_deg)), 1e-3)
     holes = ([cylinder_up(pilot, thick + gap, x, y, top - thick) for x, y in plate_bolt_positions_mm(spec)]
              + [cylinder_up(dowel, thick, x, y, top - thick) for x, y in plate_dowel_positions_mm(spec)]
-             + [_on_needle_axis(spec, mouth_point, needle_bore_diameter_mm(spec) / 2, reach)])
+             + [_on_needle_axis(spec, mouth_point, needle_bore_diameter_mm(spec) / 2, reach)]
+             + [cylinder_up(bolt_clearance_mm(FIXING_BOLT, "normal") / 2, EAR_THICKNESS_MM, x, y, top - thick)
+                for x, y in ear_holes_mm(spec)])
     return body.cut(*holes)
 
