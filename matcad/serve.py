@@ -63,6 +63,7 @@ def predict_json(payload: dict) -> dict:
 def build_json(payload: dict) -> tuple[int, dict]:
     """Build the request's spec in a temporary folder: the kit as a base64 zip and the previews as data URIs."""
     from matcad.build import DesignRuleFailure, build
+    from matcad.report import KIT_ARCHIVE
 
     spec = _spec(payload)
     with BUILD_LOCK, tempfile.TemporaryDirectory(prefix="matcad-serve-") as tmp:
@@ -74,7 +75,8 @@ def build_json(payload: dict) -> tuple[int, dict]:
         buf = io.BytesIO()
         with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
             for name in result.files:
-                z.write(result.out_dir / name, f"{spec.name}/{name}")
+                if name != KIT_ARCHIVE:  # the build's own archive of these same files
+                    z.write(result.out_dir / name, f"{spec.name}/{name}")
         previews = []
         for fig in result.report.get("figures", ()):
             data = (result.out_dir / fig["file"]).read_bytes()
