@@ -100,7 +100,7 @@ def casting(spec) -> dict | None:
 def needle_bom(spec) -> dict:
     """The needle to buy and how deep it goes (mm)."""
     from matcad.parts.features import nearest_needle_gauge, needle_tip_mm
-    from matcad.parts.needle_mount import needle_protrusion_mm
+    from matcad.parts.features import needle_protrusion_mm
 
     gauge, od = nearest_needle_gauge(spec.needle.outer_diameter)
     sin_t = math.sin(math.radians(spec.needle.theta_deg))
@@ -116,7 +116,7 @@ def needle_bom(spec) -> dict:
 def kit_hardware(spec) -> dict:
     """Mold clamp bolts and nuts, release agent, mount fixing screws (mm)."""
     from matcad.parts.casting import RELEASE_AGENT
-    from matcad.parts.needle_mount import EAR_THICKNESS_MM, FIXING_BOLT, ear_holes_mm
+    from matcad.parts.features import EAR_THICKNESS_MM, FIXING_BOLT, ear_holes_mm
 
     out = {}
     if spec.outputs.end_cap_mold:

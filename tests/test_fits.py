@@ -86,7 +86,7 @@ def test_mount_fixing_ears_and_needle_protrusion(kit):
     import math
 
     from matcad.parts.features import bolt_clearance_mm, needle_tip_mm
-    from matcad.parts.needle_mount import EAR_THICKNESS_MM, FIXING_BOLT, ear_holes_mm
+    from matcad.parts.features import EAR_THICKNESS_MM, FIXING_BOLT, ear_holes_mm
 
     spec, out, report, _ = kit
     mount = _design_frame(out, report, "needle_mount.stl")

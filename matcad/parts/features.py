@@ -157,3 +157,26 @@ def needle_tip_mm(spec) -> tuple[float, float, float]:
     drop = spec.needle.tip_clearance + spec.needle.outer_diameter / 2 * math.cos(t)
     s = drop / max(math.sin(t), 1e-12)
     return (px - s * ux, py - s * uy, pz - s * uz)
+
+
+EAR_WIDTH_MM = 9.0
+EAR_THICKNESS_MM = 3.0
+FIXING_BOLT = "M3"
+"""Two ears on ±y, flush with the mount's underside (they print on the bed, no support), each with two M3
+clearance holes: screw the mount to a bench bracket or a robot plate on standoffs tall enough for the needle's
+hub, which hangs below the mount."""
+
+
+def ear_holes_mm(spec) -> list[tuple[float, float]]:
+    """Centres (x, y) of the fixing holes in the ears, assembly frame (mm)."""
+    y = spec.plate.depth / 2 + EAR_WIDTH_MM / 2
+    return [(sx * spec.plate.width / 4, sy * y) for sy in (-1, 1) for sx in (-1, 1)]
+
+
+def needle_protrusion_mm(spec) -> float:
+    """How far the needle's tip stands out of the mount's top face, along the needle (mm): set it with a depth
+    gauge or calipers before tightening (the tip then sits needle.tip_clearance below the plate)."""
+    import math
+
+    tip_z = needle_tip_mm(spec)[2]
+    return (tip_z + spec.spacer.height) / math.sin(math.radians(spec.needle.theta_deg))

@@ -9,7 +9,8 @@ import math
 
 from build123d import Box, Pos
 
-from matcad.parts.features import (SELF_TAP_PILOT_MM, bolt_clearance_mm, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
+from matcad.parts.features import (EAR_THICKNESS_MM, EAR_WIDTH_MM, FIXING_BOLT, SELF_TAP_PILOT_MM, bolt_clearance_mm,
+                                   ear_holes_mm, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
                                    plate_bolt_positions_mm, plate_dowel_positions_mm)
 from matcad.parts.solid import BOTTOM, TOP, cylinder_up, tilted_cylinder
 
@@ -27,27 +28,6 @@ def _on_needle_axis(spec, start, radius: float, length: float):
 def needle(spec):
     """The needle itself, ``needle.length`` long, ending at its tip (for collision checks and assembly)."""
     return _on_needle_axis(spec, needle_tip_mm(spec), spec.needle.outer_diameter / 2, spec.needle.length)
-
-
-EAR_WIDTH_MM = 9.0
-EAR_THICKNESS_MM = 3.0
-FIXING_BOLT = "M3"
-"""Two ears on ±y, flush with the mount's underside (they print on the bed, no support), each with two M3
-clearance holes: screw the mount to a bench bracket or a robot plate on standoffs tall enough for the needle's
-hub, which hangs below the mount."""
-
-
-def ear_holes_mm(spec) -> list[tuple[float, float]]:
-    """Centres (x, y) of the fixing holes in the ears, assembly frame (mm)."""
-    y = spec.plate.depth / 2 + EAR_WIDTH_MM / 2
-    return [(sx * spec.plate.width / 4, sy * y) for sy in (-1, 1) for sx in (-1, 1)]
-
-
-def needle_protrusion_mm(spec) -> float:
-    """How far the needle's tip stands out of the mount's top face, along the needle (mm): set it with a depth
-    gauge or calipers before tightening (the tip then sits needle.tip_clearance below the plate)."""
-    tip_z = needle_tip_mm(spec)[2]
-    return (tip_z + spec.spacer.height) / math.sin(math.radians(spec.needle.theta_deg))
 
 
 def needle_mount(spec):

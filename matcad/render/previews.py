@@ -18,7 +18,7 @@ ISOMETRIC = (35.264, -45.0)
 FACE_VIEWS: dict[str, tuple[str, float, float]] = {
     "end_cap": ("from below: the cavity's open end", -90.0, -90.0),
     "end_cap_mold_base": ("from above: cap cavities, fill ports, vents", 90.0, -90.0),
-    "end_cap_mold_lid": ("from below: core pins and keys", -90.0, -90.0),
+    "end_cap_mold_lid": ("from above (as printed, pins up): core pins, vents, key sockets", 90.0, -90.0),
     "needle_mount": ("from the side: the needle bore at θ", 0.0, -90.0),
 }
 """Part → (caption, elevation, azimuth) of the view that shows what matters on it."""

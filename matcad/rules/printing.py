@@ -109,6 +109,21 @@ def silicone_batch(spec) -> list[Finding]:
                     "")]
 
 
+FDM_OVERHANG_DEG = 45.0
+"""Steepest overhang (from vertical) FDM prints without support."""
+
+
+def bore_overhang(spec) -> list[Finding]:
+    """The needle bore's ceiling overhangs by 90° − θ from vertical in the mount's print pose (flat face down)."""
+    overhang = 90.0 - spec.needle.theta_deg
+    if spec.outputs.needle_mount and spec.machine.printer == "fdm" and overhang > FDM_OVERHANG_DEG:
+        return [Finding("print.bore_overhang", "warning", overhang, FDM_OVERHANG_DEG,
+                        f"needle_mount: at theta = {spec.needle.theta_deg:g} deg the bore's ceiling overhangs "
+                        f"{overhang:g} deg from vertical: FDM sags it (or the slicer fills it with support)",
+                        "print with supports and drill the bore to size, or print the mount on an SLA printer")]
+    return []
+
+
 def sla_inhibition(spec) -> list[Finding]:
     if not (spec.outputs.end_cap_mold and spec.machine.printer == "sla"):
         return []
@@ -117,4 +132,4 @@ def sla_inhibition(spec) -> list[Finding]:
                     "cast a test drop")]
 
 
-RULES = (printable_walls, key_clearance, fill_and_vents, cap_wall, silicone_batch, sla_inhibition)
+RULES = (printable_walls, key_clearance, fill_and_vents, cap_wall, silicone_batch, sla_inhibition, bore_overhang)
