@@ -127,6 +127,8 @@ def _plan(cavity_d: float, outer_d: float, flange_d: float, tip_r: float, fill_p
                 return VentPlan(inner, outer, reach, reach_tip, reach_tip <= vent_reach)
             if n_out * n_in > 4 * MAX_VENTS_PER_RING:
                 break
+    if best is None:  # not even the first rings fit: only the fill port vents the base face
+        best = VentPlan((), (), base_face_reach_mm(cavity_d / 2, flange_d / 2, fill), reach_tip, False)
     return best
 
 
