@@ -114,9 +114,7 @@ def _dimensions(spec, draw: _Drawing) -> None:
         draw.line(x0, z0, x1, z1)
     draw.line(px, 0.0, px - (r + f), 0.0, colour="#7080a0")
     draw.line(px, 0.0, px - (r + f) * ux, -(r + f) * uz, colour="#7080a0")
-    mid = math.radians(theta / 2)
-    draw.text(px - (r + 0.4 * f) * math.cos(mid), -(r + 0.4 * f) * math.sin(mid) - 0.6 * f, f"θ = {theta:g}°",
-              anchor="end")
+    draw.text(px - r - 1.3 * f, -0.9 * f, f"θ = {theta:g}°", anchor="end")  # left of the arc, clear of the needle
     z_y = -gap - spec.mount.thickness - 1.2 * f
     for x in (px, -d / 2):
         draw.line(x, 0.0, x, z_y - 0.3 * f, colour="#7080a0")
