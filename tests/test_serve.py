@@ -86,13 +86,13 @@ def test_bad_requests_are_refused_with_the_field(url):
     assert status == 404
 
 
-def test_build_leaves_no_state(url):
-    before = set(glob.glob(os.path.join(tempfile.gettempdir(), "matcad-serve-*")))
+def test_build_leaves_no_state(url, tmp_path, monkeypatch):
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # the in-process server's temporary folders land here
     status, data = _post(url, "/build", json.dumps({"spec": _spec_json()}).encode())
     assert status == 200
     names = zipfile.ZipFile(io.BytesIO(base64.b64decode(data["zip"]))).namelist()
     assert "mat-laser-only/neck_plate.dxf" in names and "mat-laser-only/report.html" in names
-    assert set(glob.glob(os.path.join(tempfile.gettempdir(), "matcad-serve-*"))) == before
+    assert glob.glob(os.path.join(tmp_path, "*")) == []
 
 
 def test_design_page_end_to_end_in_chromium(url):
