@@ -11,14 +11,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from matcad.acoustics.predict import Prediction, predict
-from matcad.output import staged_output
+from matcad.output import MANIFEST, staged_output
 from matcad.export.dxf_svg import write_dxf, write_svg
 from matcad.parts.catalogue import laser_parts, needs_cad_kernel, printed_parts
 from matcad.parts.flat import cut_plan
 from matcad.rules import Finding, check, errors
 
 
-UNFORCEABLE = ("laser.drawn_size",)
+UNFORCEABLE = ("laser.drawn_size", "needle.bore")
 """Rule ids that --force cannot override: the file itself could not be written correctly."""
 
 
@@ -60,12 +60,12 @@ def write_printed_part(name: str, solid, spec, folder: Path, pose: str | None = 
 
     posed, matrix = in_print_pose(pose or name, solid)
     stl = folder / f"{name}.stl"
-    write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance, matrix)
+    tolerance = write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance, matrix)
     write_step(posed, folder / f"{name}.step")
     pose = PRINT_POSES[pose or name]
     return mesh_checks(stl) | {"brep_volume_mm3": float(posed.volume), "printed": pose.printed,
                                "bed_face": pose.bed_face, "rotation_x_deg": pose.rx_deg,
-                               "design_to_print": matrix}
+                               "design_to_print": matrix, "chordal_tolerance_mm": tolerance}
 
 
 def _write_laser(spec, folder: Path) -> list[dict]:
@@ -118,7 +118,7 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
         report = make_report(spec, prediction, findings, holes, meshes, tmp) | {"figures": figures}
         write_report(report, tmp)
         write_archive(tmp, KIT_ARCHIVE)
-    files = tuple(sorted(p.name for p in target.iterdir()))
+    files = tuple(sorted(p.name for p in target.iterdir() if p.name != MANIFEST))
     return BuildResult(target, files, tuple(findings), prediction, report)
 
 

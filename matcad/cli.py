@@ -1,19 +1,32 @@
 """Command line. Thin: parse, call one function, print text or --json, map errors to exit codes.
 
-Exit codes: 0 ok; 1 design-rule failure, or for analyze/calibrate/sense no trustworthy result (no tone, a
-tone at the band edge, degenerate data, a force outside the calibrated range); 2 bad input.
+Exit codes (one table, :data:`EXIT_CODES`, enforced in :func:`main`):
+  0   ok
+  1   design-rule failure, or for analyze/calibrate/sense no trustworthy result (no tone, a tone at the band
+      edge, degenerate or flat data, a force outside the calibrated range)
+  2   bad input or unusable file (spec, data, recording, output folder, the file system refusing a write)
+  70  internal error (a bug): one line "internal error, please report" with the path of a log holding the
+      traceback (in the temporary folder, never under $HOME) — never 1, which is reserved for the rules
+  130 interrupted (Ctrl-C, SIGINT), anywhere, including while the CAD kernel loads; no traceback
+  143 terminated (SIGTERM), handled exactly like an interrupt
+On an interrupt the output folder is left as it was (matcad.output), further interrupts are ignored while
+the temporary folder is removed.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from pathlib import Path
 
 from matcad import __version__
 
-EXIT_OK, EXIT_RULES, EXIT_INPUT = 0, 1, 2
+EXIT_OK, EXIT_RULES, EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPT, EXIT_TERMINATED = 0, 1, 2, 70, 130, 143
+EXIT_CODES = {EXIT_OK: "ok", EXIT_RULES: "design-rule failure or no trustworthy result",
+              EXIT_INPUT: "bad input or unusable file", EXIT_INTERNAL: "internal error (please report)",
+              EXIT_INTERRUPT: "interrupted (SIGINT)", EXIT_TERMINATED: "terminated (SIGTERM)"}
 
 
 def _print_json(data) -> None:
@@ -407,12 +420,32 @@ def cmd_serve(args) -> int:
     return EXIT_OK
 
 
+def _out_path(text: str) -> Path:
+    """``--out``: made absolute at once, so that `--out .` stays meaningful after the folder is replaced."""
+    return Path(os.path.abspath(text))
+
+
+def _force_n(text: str) -> float:
+    """A ``--force`` value: finite, within the calibration's force bounds (N)."""
+    from matcad.loop.calibrate import FORCE_LIMIT_N
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not abs(value) <= FORCE_LIMIT_N:
+        from matcad.errors import shorten
+
+        raise argparse.ArgumentTypeError(f"{shorten(text)} invalid, must be a finite force with |F| <= "
+                                         f"{FORCE_LIMIT_N:g} N")
+    return value
+
+
 def _parser() -> argparse.ArgumentParser:
     import matcad
 
     parser = argparse.ArgumentParser(prog="matcad", description=matcad.__doc__,
-                                     epilog="exit codes: 0 ok; 1 design-rule error or no trustworthy result; "
-                                            "2 bad input")
+                                     epilog="exit codes: " + "; ".join(f"{k} {v}" for k, v in EXIT_CODES.items()))
     parser.add_argument("--version", action="version", version=f"matcad {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
@@ -421,7 +454,7 @@ def _parser() -> argparse.ArgumentParser:
         cmd.set_defaults(func=func)
         cmd.add_argument("--json", action="store_true", help="print JSON instead of text")
         if out_default:
-            cmd.add_argument("--out", type=Path, help=f"output folder (default {out_default})")
+            cmd.add_argument("--out", type=_out_path, help=f"output folder (default {out_default})")
         return cmd
 
     def spec_arg(cmd, flag=None, **kw):
@@ -432,10 +465,10 @@ def _parser() -> argparse.ArgumentParser:
 
     p = command("predict", cmd_predict, "predict the taxel's resonance frequency from a spec")
     spec_arg(p)
-    p.add_argument("--load", type=float, nargs="+", metavar="F",
+    p.add_argument("--load", type=_force_n, nargs="+", metavar="F",
                    help="normal loads in N: f(F) from the cap mechanics ([mechanics]; FElupe) and, with a "
                         "[calibration], from paper Eq. 5 as well")
-    p.add_argument("--force", dest="force_deprecated", type=float, nargs="+", metavar="F",
+    p.add_argument("--force", dest="force_deprecated", type=_force_n, nargs="+", metavar="F",
                    help="deprecated spelling of --load")
     p.add_argument("--model", help="use this model's f0 instead of the automatic choice ('fem' adds the FEM)")
     p.add_argument("--fem-level", type=int, help="FEM mesh refinement: elements across the neck radius (default 8)")
@@ -501,8 +534,123 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+_SIGNALLED: list[int] = []
+"""The signal that interrupted this run, if any (set by :func:`_on_signal`)."""
+
+
+def _on_signal(signum, frame) -> None:
+    """SIGINT and SIGTERM: remember which, ignore any further one while cleaning up, unwind as an interrupt."""
+    import signal
+
+    _SIGNALLED.append(signum)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, signal.SIG_IGN)
+    raise KeyboardInterrupt
+
+
+def _install_signal_handlers() -> None:
+    import signal
+
+    if _SIGNALLED:  # a new run in the same interpreter (tests call main() repeatedly)
+        _SIGNALLED.clear()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        try:
+            signal.signal(sig, _on_signal)
+        except ValueError:  # not the main thread: leave Python's default handling
+            pass
+
+
+def _private_caches() -> None:
+    """Libraries' caches (ezdxf's font cache, matplotlib's config and font list) default to folders under
+    $HOME; unless the user chose them, point them at a private folder in the temporary directory."""
+    import tempfile
+
+    if all(os.environ.get(v) for v in ("XDG_CACHE_HOME", "MPLCONFIGDIR")):
+        return
+    folder = Path(tempfile.gettempdir()) / f"matcad-cache-{os.getuid() if hasattr(os, 'getuid') else 0}"
+    try:
+        folder.mkdir(mode=0o700, exist_ok=True)
+        st = folder.lstat()
+        if folder.is_symlink() or (hasattr(os, "getuid") and st.st_uid != os.getuid()):
+            folder = Path(tempfile.mkdtemp(prefix="matcad-cache-"))
+    except OSError:
+        folder = Path(tempfile.mkdtemp(prefix="matcad-cache-"))
+    os.environ.setdefault("XDG_CACHE_HOME", str(folder))
+    os.environ.setdefault("MPLCONFIGDIR", str(folder / "matplotlib"))
+
+
+def _deliberate(exc: ValueError) -> bool:
+    """A ValueError is a refusal of input when matcad's own code raised it (``raise ValueError(...)`` in a
+    matcad module, or InputError/SpecError); one raised inside a library or by a math function is a bug."""
+    from matcad.errors import InputError
+
+    if isinstance(exc, InputError):
+        return True
+    if str(exc) in ("math domain error", "math range error"):
+        return False
+    tb = exc.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    package = str(Path(__file__).resolve().parent)
+    return tb is not None and str(Path(tb.tb_frame.f_code.co_filename).resolve()).startswith(package)
+
+
+def _internal_error(exc: BaseException) -> int:
+    """Log the traceback to a fresh file in the temporary folder and print one line pointing at it."""
+    import tempfile
+    import time
+    import traceback
+
+    text = "".join(traceback.format_exception(exc))
+    try:
+        fd, log = tempfile.mkstemp(prefix=f"matcad-internal-error-{time.strftime('%Y%m%dT%H%M%S')}-",
+                                   suffix=".log")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(f"matcad {__version__}\nargv: {sys.argv!r}\n\n{text}")
+    except OSError:
+        log = "(no log: the temporary folder is not writable)"
+    print(f"matcad: internal error, please report it with the log {log} ({exc.__class__.__name__})",
+          file=sys.stderr)
+    return EXIT_INTERNAL
+
+
+def _interrupted() -> int:
+    import signal
+
+    terminated = bool(_SIGNALLED) and _SIGNALLED[0] == signal.SIGTERM
+    print(f"matcad: {'terminated' if terminated else 'interrupted'}; no output folder is left half-written",
+          file=sys.stderr)
+    return EXIT_TERMINATED if terminated else EXIT_INTERRUPT
+
+
+def _quiet_stdout() -> None:
+    """After a broken pipe: send further output (and the interpreter's final flush) to /dev/null."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):
+        pass
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    """Run one command; every outcome maps to one row of :data:`EXIT_CODES`."""
+    _install_signal_handlers()
+    try:
+        _private_caches()
+        args = _parser().parse_args(argv)
+        return _dispatch(args)
+    except KeyboardInterrupt:
+        return _interrupted()
+    except BaseException as exc:  # noqa: BLE001 - the last line of the exit-code table
+        if isinstance(exc, SystemExit):  # argparse: usage error (2), --help/--version (0)
+            raise
+        if _SIGNALLED:  # an interrupt inside a C extension's import surfaces as ImportError/SystemError
+            return _interrupted()
+        return _internal_error(exc)
+
+
+def _dispatch(args) -> int:
     from matcad.errors import OutputError
     from matcad.loop import LoopError
     from matcad.spec import SpecError
@@ -518,24 +666,40 @@ def main(argv: list[str] | None = None) -> int:
     except LoopError as exc:
         print(f"matcad: {exc}", file=sys.stderr)
         return EXIT_RULES
-    except OSError as exc:  # unwritable output folder, unreadable input: the user's file system, not a bug
-        where = f"{exc.filename}: " if exc.filename else ""
-        print(f"matcad: error: {where}{exc.strerror or exc} (check the path and its permissions)", file=sys.stderr)
+    except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours (before OSError: a subclass)
+        _quiet_stdout()
+        return EXIT_OK
+    except OSError as exc:  # unwritable output folder, full disk, unreadable input: the user's file system
+        from matcad.errors import shorten
+
+        where = f"{shorten(str(exc.filename))}: " if exc.filename else ""
+        print(f"matcad: error: {where}{exc.strerror or exc} (check the path, its permissions and free space)",
+              file=sys.stderr)
         return EXIT_INPUT
     except ValueError as exc:
+        if not _deliberate(exc):
+            raise
         print(f"matcad: error: {exc}", file=sys.stderr)
         return EXIT_INPUT
-    except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours
-        sys.stdout = open(os.devnull, "w")
-        return EXIT_OK
 
 
 def run() -> None:
     """Console entry point. After a command that loaded OpenCASCADE, every output file is closed and moved into
     place, yet interpreter teardown would spend 0.3-0.7 s destroying kernel objects: flush and leave at once."""
+    import signal
+
     code = main()
+    for sig in (signal.SIGINT, signal.SIGTERM):  # the answer is decided: a late signal must not become a traceback
+        signal.signal(sig, signal.SIG_IGN)
     if "OCP" in sys.modules:
-        sys.stdout.flush()
+        try:
+            sys.stdout.flush()
+        except BrokenPipeError:
+            _quiet_stdout()
         sys.stderr.flush()
         os._exit(code)
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _quiet_stdout()
     sys.exit(code)

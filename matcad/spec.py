@@ -10,6 +10,7 @@ Dimension names follow the paper (mat-paper.md, Fig. 2): D, L the silicone cavit
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import re
@@ -205,9 +206,12 @@ class Machine(Section):
     nozzle: float = _length("FDM nozzle diameter (walls >= 2 nozzles)", 0.4)
     key_clearance: float | None = _param("registration-key clearance per side; default by printer "
                                          "(fdm 0.2, sla 0.1)", "mm", None, lo=0.0, hi=5.0)
-    stl_tolerance: float = _param("STL chordal deviation", "mm", 0.01, lo=1e-5, hi=10.0)
+    stl_tolerance: float = _param("STL chordal deviation; floored at 1e-4 x each part's size (the report "
+                                  "gives the one used)", "mm", 0.01, lo=1e-5, hi=10.0)
     stl_angular_tolerance: float = _param("STL angular deviation (0.1 rad keeps STL volume within 0.05 % "
-                                          "of the solid on the paper taxel)", "rad", 0.1, lo=1e-3, hi=1.0)
+                                          "of the solid on the paper taxel; below 0.02 rad the triangle "
+                                          "count, time and memory grow as its inverse square)", "rad", 0.1,
+                                          lo=0.02, hi=1.0, lo_open=False)
 
 
 @dataclass(frozen=True)
@@ -265,8 +269,9 @@ class Air(Section):
 
     temperature_c: float = _param("air temperature; sets the speed of sound", "degC", 20.0,
                                   lo=-273.15, hi=1000.0)
-    speed_of_sound: float | None = _param("speed of sound; overrides temperature_c when given", "m/s",
-                                          None, lo=0.0, hi=1e4)
+    speed_of_sound: float | None = _param("speed of sound; overrides temperature_c when given (at least "
+                                          "50 m/s: slower than any gas in use, e.g. SF6 at -50 C ~ 120 m/s)",
+                                          "m/s", None, lo=50.0, hi=1e4, lo_open=False)
 
 
 @dataclass(frozen=True)
@@ -308,7 +313,8 @@ class Mechanics(Section):
 class Calibration(Section):
     """Paper Eq. 5 constants: V_eff = v0_mm3 - a F^2 - b F (F in N)."""
 
-    v0_mm3: float = _param("effective unloaded cavity volume V_ci", "mm^3", lo=0.0, hi=1e18)
+    v0_mm3: float = _param("effective unloaded cavity volume V_ci (at least the smallest cavity a spec allows, "
+                           "(1e-3 mm)^3)", "mm^3", lo=LENGTH_MIN_MM ** 3, hi=1e18, lo_open=False)
     a: float = _param("quadratic deflection coefficient a (paper: -0.0086)", "mm^3/N^2",
                       lo=-1e12, hi=1e12, lo_open=False)
     b: float = _param("linear deflection coefficient b (paper: 0.4626)", "mm^3/N",
@@ -595,6 +601,23 @@ def reference_spec(spec: Spec) -> Spec:
         end_cap=dataclasses.replace(spec.end_cap,
                                     outer_diameter=pick(ref.cap_outer_diameter, spec.end_cap.outer_diameter),
                                     top_thickness=pick(ref.cap_top_thickness, spec.end_cap.top_thickness)))
+
+
+def variant(spec: Spec, section: str, **values: Any) -> Spec:
+    """A model variant of a validated spec (uncertainty budgets, sweeps): ``values`` set in ``section`` without
+    input validation, because a perturbation may step past what a user may write (a 1 µm neck less its sheet
+    tolerance, 10.5° of draft). Never use it for user input; ``dataclasses.replace`` validates."""
+    part = getattr(spec, section)
+    names = {f.name for f in dataclasses.fields(part)}
+    unknown = set(values) - names
+    if unknown:
+        raise TypeError(f"{section} has no field {', '.join(sorted(unknown))}")
+    part = copy.copy(part)
+    for name, value in values.items():
+        object.__setattr__(part, name, value)
+    out = copy.copy(spec)
+    object.__setattr__(out, section, part)
+    return out
 
 
 def load(path: str | Path) -> Spec:

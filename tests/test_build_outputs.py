@@ -13,6 +13,7 @@ import trimesh
 from matcad import spec as spec_mod
 from matcad.build import build
 from matcad.export.dxf_svg import LAYERS
+from matcad.output import MANIFEST
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.features import cap_volume_mm3
 from matcad.report import KIT_ARCHIVE, REPORT_FILES
@@ -35,7 +36,7 @@ def test_report_manifest_matches_files(built):
     spec, out, result = built
     report = json.loads((out / "report.json").read_text())
     listed = {f["file"]: f for f in report["files"]}
-    on_disk = {p.name for p in out.iterdir()} - set(REPORT_FILES)
+    on_disk = {p.name for p in out.iterdir()} - set(REPORT_FILES) - {MANIFEST}
     assert set(listed) == on_disk
     for name, row in listed.items():
         data = (out / name).read_bytes()
@@ -221,6 +222,6 @@ def test_kit_archive_holds_every_file_byte_for_byte(built):
     with zipfile.ZipFile(out / KIT_ARCHIVE) as archive:
         assert archive.testzip() is None
         names = set(archive.namelist())
-        assert names == {p.name for p in out.iterdir()} - {KIT_ARCHIVE}
+        assert names == {p.name for p in out.iterdir()} - {KIT_ARCHIVE, MANIFEST}
         for name in names:
             assert archive.read(name) == (out / name).read_bytes(), name

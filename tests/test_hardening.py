@@ -201,3 +201,300 @@ def test_wav_truncated_data_reads_the_whole_frames_present(tmp_path):
     samples, rate = read_mono(wav)
     assert (info.frames, rate) == (1000 - 251, 8000.0)
     np.testing.assert_allclose(samples, x[:749] / 32768.0)
+
+
+# ---- numeric fields at the open ends of their ranges ------------------------------------------------------------
+
+EXTREME_CASES = {
+    "speed-of-sound-1e-300": ("[air]\nspeed_of_sound = 1e-300\n", "air.speed_of_sound"),
+    "speed-of-sound-subnormal": ("[air]\nspeed_of_sound = 5e-324\n", "air.speed_of_sound"),
+    "v0-subnormal": ("[calibration]\nv0_mm3 = 5e-324\na = 0.0\nb = 0.1\n", "calibration.v0_mm3"),
+    "stl-angular-tolerance-tiny": ("[machine]\nstl_angular_tolerance = 0.001\n", "machine.stl_angular_tolerance"),
+}
+
+
+@pytest.mark.parametrize("cause", EXTREME_CASES)
+def test_open_range_end_refused_naming_the_field(cause, write_spec):
+    text, field = EXTREME_CASES[cause]
+    code, _, err = run_cli("predict", write_spec(MINIMAL + text), "--json", "--force", "1")
+    _assert_clean(code, err, 2, field)
+
+
+@pytest.mark.parametrize("force", ["nan", "inf", "1e154", "-1e7", "x"])
+def test_cli_force_must_be_finite_and_bounded(force):
+    code, _, err = run_cli("predict", PAPER, "--force", force)
+    _assert_clean(code, err, 2, "--force")
+
+
+def test_every_numeric_field_at_its_extremes_gives_finite_json_or_exit_2(tmp_path):
+    """Each number field at its bounds, one ulp inside them, and at 5e-324, 1e-300, 1e300: predict (with a load
+    curve) answers with finite JSON or refuses naming the field — never an internal error."""
+    import contextlib
+    import io
+    import math
+
+    from matcad.cli import main
+
+    base = dict(PAPER_TABLES)
+    tried = 0
+    for row in spec_mod.schema():
+        section, _, name = row["key"].partition(".")
+        if not name or not isinstance(row["default"], (float, type(None))) or "a finite number" not in row["allowed"]:
+            continue
+        meta = dict(next(f for f in dataclasses.fields(spec_mod.SECTIONS[section]) if f.name == name).metadata)
+        if meta["kind"] != "number":
+            continue
+        for value in {meta["lo"], math.nextafter(meta["lo"], math.inf), meta["hi"], 5e-324, 1e-300, 1e300}:
+            doc = {k: dict(v) if isinstance(v, dict) else v for k, v in base.items()}
+            doc.setdefault(section, {})[name] = value
+            doc["outputs"] = {"end_cap_mold": False, "needle_mount": False, "assembly": False}
+            path = tmp_path / "s.toml"
+            path.write_text(_toml(doc))
+            out, err = io.StringIO(), io.StringIO()
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+                code = main(["predict", str(path), "--json", "--force", "0", "5"])
+            tried += 1
+            assert code in (0, 2), (row["key"], value, err.getvalue())
+            if code == 2:
+                assert row["key"] in err.getvalue() or "calibration" in err.getvalue(), err.getvalue()
+            else:
+                json.loads(out.getvalue())  # allow_nan=False upstream: parses only if finite
+    assert tried > 150
+
+
+def _toml(doc: dict) -> str:
+    from tests.test_fuzz import to_toml
+
+    return to_toml(doc)
+
+
+PAPER_TABLES = __import__("tomllib").loads(PAPER.read_text())
+
+
+# ---- needle rules that make a bore impossible -------------------------------------------------------------------
+
+@pytest.mark.parametrize("needle", ["theta_deg = 1e-6", "y = 1e5", "y = -1e5"])
+def test_needle_that_misses_the_mount_is_an_unforceable_error(needle, write_spec, tmp_path):
+    path = write_spec(PAPER.read_text() + f"\n[needle]\n{needle}\n")
+    code, out, err = run_cli("check", path)
+    _assert_clean(code, err, 1)
+    assert "needle.bore" in out
+    code, out, err = run_cli("build", path, "--force", "--out", tmp_path / "k")
+    _assert_clean(code, err, 1)
+    assert not (tmp_path / "k").exists()
+
+
+# ---- the exit-code table ----------------------------------------------------------------------------------------
+
+def test_broken_stdout_pipe_exits_0_quietly():
+    import subprocess
+    import sys
+
+    proc = subprocess.run(f"{sys.executable} -m matcad schema | head -1; exit ${{PIPESTATUS[0]}}", shell=True,
+                          executable="/bin/bash", capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0 and proc.stderr == "" and proc.stdout.count("\n") == 1, proc.stderr
+
+
+def test_unexpected_exception_is_exit_70_with_a_log_outside_home(tmp_path):
+    import subprocess
+    import sys
+
+    home = tmp_path / "home"
+    home.mkdir()
+    code = ("import sys, matcad.acoustics.predict as p\n"
+            "def boom(*a, **k): raise ZeroDivisionError('simulated bug')\n"
+            "p.predict = boom\n"
+            "from matcad.cli import main\n"
+            f"sys.exit(main(['predict', {str(PAPER)!r}]))\n")
+    env = {**os.environ, "HOME": str(home), "TMPDIR": str(tmp_path)}
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
+    assert proc.returncode == 70, proc.stderr
+    assert "internal error, please report" in proc.stderr and "Traceback" not in proc.stderr
+    assert proc.stderr.count("\n") == 1
+    log = proc.stderr.split(" with the log ")[1].split(" (")[0]
+    assert log.startswith(str(tmp_path)) and "ZeroDivisionError: simulated bug" in open(log).read()
+    assert not any(home.iterdir())
+
+
+def test_caches_are_never_written_under_home(tmp_path):
+    import subprocess
+    import sys
+
+    home = tmp_path / "home"
+    home.mkdir()
+    env = {k: v for k, v in os.environ.items() if k not in ("XDG_CACHE_HOME", "MPLCONFIGDIR")}
+    env |= {"HOME": str(home), "TMPDIR": str(tmp_path)}
+    laser_only = PAPER.read_text() + "\n[outputs]\nend_cap_mold = false\nneedle_mount = false\nassembly = false\n"
+    spec = tmp_path / "s.toml"
+    spec.write_text(laser_only)
+    proc = subprocess.run([sys.executable, "-m", "matcad", "build", spec, "--out", tmp_path / "k"],
+                          capture_output=True, text=True, cwd=ROOT, env=env)
+    assert proc.returncode == 0, proc.stderr
+    assert not any(home.iterdir()), list(home.rglob("*"))
+
+
+ROOT = PAPER.parents[1]
+
+
+# ---- crash-safe output --------------------------------------------------------------------------------------------
+
+LASER_ONLY = PAPER.read_text() + "\n[outputs]\nend_cap_mold = false\nneedle_mount = false\nassembly = false\n"
+
+
+def _kit_intact(folder) -> bool:
+    """Every file the manifest lists is there with its sha256, and nothing else."""
+    import hashlib
+
+    from matcad.output import MANIFEST
+
+    listed = json.loads((folder / MANIFEST).read_text())["files"]
+    present = {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()} - {MANIFEST}
+    return present == set(listed) and all(
+        hashlib.sha256((folder / name).read_bytes()).hexdigest() == info["sha256"] for name, info in listed.items())
+
+
+@pytest.fixture
+def kit(tmp_path):
+    """A laser-only kit at tmp_path/out/k built through the CLI; returns (spec path, kit folder)."""
+    spec = tmp_path / "s.toml"
+    spec.write_text(LASER_ONLY)
+    code, _, err = run_cli("build", spec, "--out", tmp_path / "out" / "k")
+    assert code == 0, err
+    return spec, tmp_path / "out" / "k"
+
+
+def test_user_file_next_to_report_survives_and_build_refuses(kit):
+    spec, folder = kit
+    (folder / "notes.txt").write_text("my notes")
+    code, _, err = run_cli("build", spec, "--out", folder)
+    _assert_clean(code, err, 2, "notes.txt", "not written by matcad")
+    assert (folder / "notes.txt").read_text() == "my notes"
+    (folder / "notes.txt").unlink()
+    (folder / "report.md").write_text("edited by hand")
+    code, _, err = run_cli("build", spec, "--out", folder)
+    _assert_clean(code, err, 2, "report.md", "changed")
+
+
+def test_folder_without_manifest_is_never_replaced(tmp_path, write_spec):
+    folder = tmp_path / "k"
+    folder.mkdir()
+    (folder / "report.json").write_text("{}")  # looks like an output, but matcad did not write it
+    code, _, err = run_cli("build", write_spec(LASER_ONLY), "--out", folder)
+    _assert_clean(code, err, 2, "no .matcad-manifest.json")
+    assert (folder / "report.json").read_text() == "{}"
+
+
+def test_kit_honours_the_umask(tmp_path):
+    import subprocess
+    import sys
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(LASER_ONLY)
+    code = f"import os, sys; os.umask(0o027); from matcad.cli import main; sys.exit(main(['build', {str(spec)!r}, " \
+           f"'--out', {str(tmp_path / 'a' / 'k')!r}]))"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "a" / "k").stat().st_mode & 0o777 == 0o750
+    assert (tmp_path / "a").stat().st_mode & 0o777 == 0o750
+    assert {p.stat().st_mode & 0o777 for p in (tmp_path / "a" / "k").iterdir()} == {0o640}
+
+
+def test_failed_build_leaves_no_parents_no_temp(tmp_path):
+    from matcad.output import staged_output
+
+    with pytest.raises(RuntimeError):
+        with staged_output(tmp_path / "a" / "b" / "k") as tmp:
+            (tmp / "part.dxf").write_text("half")
+            raise RuntimeError("disk full")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_death_between_renames_is_recovered_by_the_next_run(kit):
+    """A process killed after moving the old kit aside and before moving the new one in: the next run finds
+    the backup of a dead writer without its target and restores it before anything else."""
+    from matcad.output import staged_output
+
+    _, folder = kit
+    backup = folder.parent / ".k.old-999999999-1-abcd1234"  # pid 999999999 cannot run (pid_max <= 2**22)
+    folder.rename(backup)
+    stale_tmp = folder.parent / ".k.tmp-999999999-1-0123abcd"
+    stale_tmp.mkdir()
+    (stale_tmp / "neck_plate.dxf").write_text("half")
+    with pytest.raises(RuntimeError):
+        with staged_output(folder):
+            raise RuntimeError("this run fails too")
+    assert _kit_intact(folder)
+    assert sorted(p.name for p in folder.parent.iterdir()) == ["k"]
+
+
+def test_live_writers_leftovers_are_left_alone(kit):
+    from matcad.output import _owner, _sweep
+
+    _, folder = kit
+    mine = folder.parent / f".k.tmp-{_owner()}-00000000"
+    mine.mkdir()
+    _sweep(folder.parent)
+    assert mine.is_dir()
+
+
+def test_out_dot(tmp_path, write_spec):
+    spec = write_spec(LASER_ONLY)
+    work = tmp_path / "kitdir"
+    work.mkdir()
+    for _ in range(2):  # an empty folder, then matcad's own kit: both replaced
+        code, _, err = run_cli("build", spec, "--out", ".", cwd=work)
+        assert code == 0, err
+        assert _kit_intact(work)
+    (work / "notes.txt").write_text("mine")
+    code, _, err = run_cli("build", spec, "--out", ".", cwd=work)
+    _assert_clean(code, err, 2, "notes.txt")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["kitdir", "spec.toml"]
+
+
+# ---- fault injection: kill a build at random points ---------------------------------------------------------------
+
+def _inject_faults(tmp_path, trials: int, seed: int):
+    """Rebuild over a kit and kill the build with SIGINT, SIGTERM or SIGKILL after a random delay; each time the
+    target must be a whole kit (the previous or the new one, every file matching its manifest), the exit code
+    that of the signal (or 0 if the build won), never a traceback; a following build leaves no litter.
+    Returns the counts per signal: (tried, held)."""
+    import random
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    rng = random.Random(seed)
+    full = tmp_path / "full.toml"
+    full.write_text(PAPER.read_text().replace('name = "mat-paper"', 'name = "mat-paper-2"'))
+    laser = tmp_path / "laser.toml"
+    laser.write_text(LASER_ONLY)
+    target = tmp_path / "out" / "k"
+    assert run_cli("build", laser, "--out", target)[0] == 0
+    expected = {signal.SIGINT: 130, signal.SIGTERM: 143, signal.SIGKILL: -9}
+    counts = {}
+    for _ in range(trials):
+        sig = rng.choice(list(expected))
+        spec = rng.choice([full, laser])
+        proc = subprocess.Popen([sys.executable, "-m", "matcad", "build", str(spec), "--out", str(target)],
+                                cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        time.sleep(rng.uniform(0.0, 4.0 if spec == full else 1.5))
+        proc.send_signal(sig)
+        err = proc.communicate(timeout=120)[1]
+        held = proc.returncode in (0, expected[sig]) and "Traceback" not in err and _kit_intact(target)
+        tried, ok = counts.get(sig.name, (0, 0))
+        counts[sig.name] = (tried + 1, ok + held)
+        assert held, (sig, proc.returncode, err)
+    code, _, err = run_cli("build", laser, "--out", target)
+    assert code == 0, err
+    assert sorted(p.name for p in target.parent.iterdir()) == ["k"] and _kit_intact(target)
+    return counts
+
+
+def test_fault_injection_short(tmp_path):
+    _inject_faults(tmp_path, trials=4, seed=10)
+
+
+@pytest.mark.slow
+def test_fault_injection_long(tmp_path):
+    _inject_faults(tmp_path, trials=40, seed=11)

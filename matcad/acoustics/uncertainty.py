@@ -12,7 +12,6 @@ lows and highs add in quadrature separately, in ln f (relative shifts), which ke
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 from dataclasses import dataclass
@@ -58,7 +57,9 @@ def model_errors() -> dict:
 
 
 def _replace(spec, section: str, **values):
-    return dataclasses.replace(spec, **{section: dataclasses.replace(getattr(spec, section), **values)})
+    from matcad.spec import variant
+
+    return variant(spec, section, **values)  # a perturbation may leave the user's ranges; it is not input
 
 
 def budget(spec, res, model: str, f0_hz: float, valid: bool = True) -> list[BudgetLine]:

@@ -31,6 +31,24 @@ def needle_clearance(spec) -> list[Finding]:
     return out
 
 
+def needle_bore(spec) -> list[Finding]:
+    """The needle axis must pass through the mount block, or the printed mount has no bore and holds no
+    needle (θ near 0, or |y| beyond the block). The axis meets the block's top face (z = −spacer.height) at
+    x_top and its underside at x_bot; the block spans |x| <= plate.width/2 (mm)."""
+    from matcad.parts.features import needle_axis_mm
+
+    (px, _, _), (ux, _, uz) = needle_axis_mm(spec)
+    gap, thick, half = spec.spacer.height, spec.mount.thickness, spec.plate.width / 2
+    run = ux / uz if uz > 0 else float("inf")  # x travelled per mm of descent along the axis
+    x_top, x_bot = px - gap * run, px - (gap + thick) * run
+    if uz > 0 and x_bot <= half and x_top >= -half:
+        return []
+    return [Finding("needle.bore", "error", [spec.needle.theta_deg, spec.needle.y], f"axis through |x| <= {half:g} mm",
+                    f"the needle axis (theta = {spec.needle.theta_deg:g} deg, y = {spec.needle.y:g} mm) misses "
+                    "the mount block: the mount would have no bore and hold no needle",
+                    "raise needle.theta_deg or bring needle.y within the plate")]
+
+
 def needle_window(spec) -> list[Finding]:
     out = []
     t, y = spec.needle.theta_deg, spec.needle.y
@@ -86,4 +104,4 @@ def printed_fits(spec) -> list[Finding]:
     return []
 
 
-RULES = (needle_clearance, needle_window, seal_squeeze, printed_fits)
+RULES = (needle_clearance, needle_bore, needle_window, seal_squeeze, printed_fits)
