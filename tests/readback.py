@@ -12,6 +12,7 @@ from pathlib import Path
 import ezdxf
 
 from matcad.export.dxf_svg import LAYERS
+from matcad.output import MANIFEST
 from matcad.parts.catalogue import laser_parts
 from matcad.report import REPORT_FILES
 
@@ -21,7 +22,7 @@ SVG = "{http://www.w3.org/2000/svg}"
 def assert_manifest(out: Path) -> dict:
     report = json.loads((out / "report.json").read_text())
     listed = {f["file"]: f for f in report["files"]}
-    assert set(listed) == {p.name for p in out.iterdir()} - set(REPORT_FILES)
+    assert set(listed) == {p.name for p in out.iterdir()} - set(REPORT_FILES) - {MANIFEST}
     for name, row in listed.items():
         data = (out / name).read_bytes()
         assert row["bytes"] == len(data) and row["sha256"] == hashlib.sha256(data).hexdigest()
