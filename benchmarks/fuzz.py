@@ -1,11 +1,32 @@
-"""≥ 10 000 generated specs through `check` and `build` (the same strategy and contract as tests/test_fuzz.py),
-printing how many were invalid (exit 2), refused by the design rules (exit 1) and built and read back.
+"""Hostile inputs and faults through the CLI, by category, printing tried / held / breaches per category.
 
-Run: .venv/bin/python benchmarks/fuzz.py [N]   (default 10 000; any contract breach raises with the example)
+A run *holds* when it keeps the README's contract: an exit code of its category's table (never 70, the
+internal-error code, and no exception escaping ``main``), no traceback, a one-line message on exit 2, no
+temporary folder left over, and, for builds, a kit whose files match its manifest. Categories:
+
+  specs       generated specs through `check` and `build` (tests/test_fuzz.py's strategy and read-back)
+  extremes    every number field at its bounds, one ulp inside, 5e-324, 1e-300, 1e300, pairs of them
+  toml        parser tricks: deep nesting, >= 309-digit integers, long and newline-bearing strings, unicode
+  files       non-regular and oversized inputs (FIFO, /dev/zero, folder, > limit) for every input kind
+  wav         valid WAVs with random header bytes changed or cut at a random length
+  csv         calibration data: long fields, NUL, NaN/inf, 1e154, separators, BOM, random bytes
+  calibration calibration files with random covariances, ranges and constants
+  out         --out targets: '.', nested, an existing file, a folder with a user's file, a symlink
+  faults      SIGINT / SIGTERM / SIGKILL at random moments of a build (tests/test_hardening.py's injector)
+
+Run: .venv/bin/python benchmarks/fuzz.py [N] [category ...]   (N examples per category, default 200;
+`specs` runs 10 N of its cheap examples and `faults` N / 10 kills)
 """
 
-import collections
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
 import os
+import random
+import struct
 import sys
 import tempfile
 import time
@@ -14,34 +35,312 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from hypothesis import HealthCheck, given, settings  # noqa: E402
+from matcad import spec as spec_mod  # noqa: E402
+from matcad.cli import main  # noqa: E402
+from tests.test_fuzz import BASE, to_toml  # noqa: E402
 
-from tests.test_fuzz import out_args, run_one, spec_documents  # noqa: E402
+LASER_ONLY = {"end_cap_mold": False, "needle_mount": False, "assembly": False}
 
 
-def main(n: int) -> None:
-    counts = collections.Counter()
-    base = Path(tempfile.mkdtemp(prefix="matcad-fuzz-"))
-    t0 = time.perf_counter()
+class Breach(AssertionError):
+    pass
 
-    @given(data=spec_documents(), out_arg=out_args, force=__import__("hypothesis").strategies.booleans())
+
+def run(argv: list[str], allowed=(0, 1, 2)) -> tuple[int, str]:
+    """``main(argv)`` in this process; a Breach unless the contract holds. Returns (code, stderr)."""
+    out, err = io.StringIO(), io.StringIO()
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = main([str(a) for a in argv])
+    except SystemExit as exc:  # argparse usage errors are exit 2 by design
+        code = exc.code
+    except BaseException as exc:  # noqa: BLE001 - an escaping exception is a traceback for the user
+        raise Breach(f"{argv}: {exc.__class__.__name__}: {exc}") from exc
+    text = err.getvalue()
+    if code not in allowed or "Traceback" in text:
+        raise Breach(f"{argv}: exit {code}: {text[-300:]}")
+    if code == 2 and not text.strip():
+        raise Breach(f"{argv}: exit 2 without a message")
+    return code, text
+
+
+def _no_litter(folder: Path) -> None:
+    left = [p for p in folder.rglob(".*") if ".tmp-" in p.name or ".old-" in p.name]
+    if left:
+        raise Breach(f"left over: {left}")
+
+
+def _doc(**sections) -> dict:
+    data = json.loads(json.dumps(BASE))
+    data["outputs"] = dict(LASER_ONLY)
+    for section, values in sections.items():
+        data.setdefault(section, {}).update(values)
+    return data
+
+
+def _number_fields() -> list[tuple[str, str, dict]]:
+    import dataclasses
+
+    return [(section, f.name, dict(f.metadata)) for section, cls in spec_mod.SECTIONS.items()
+            for f in dataclasses.fields(cls) if f.metadata["kind"] == "number"]
+
+
+def cat_extremes(n: int, rng: random.Random, work: Path):
+    fields = _number_fields()
+
+    def values(meta):
+        lo, hi = meta["lo"], meta["hi"]
+        return [lo, math.nextafter(lo, math.inf), hi, math.nextafter(hi, -math.inf), 5e-324, 1e-300, 1e300,
+                -0.0, -5e-324]
+
+    cases = [[(s, k, v)] for s, k, m in fields for v in values(m)]
+    while len(cases) < n:
+        cases.append([(s, k, rng.choice(values(m))) for s, k, m in rng.sample(fields, 2)])
+    for case in cases[:max(n, 1)]:
+        doc = _doc()
+        for s, k, v in case:
+            doc.setdefault(s, {})[k] = v
+        path = work / "s.toml"
+        path.write_text(to_toml(doc))
+        yield lambda p=path: (run(["predict", p, "--json", "--force", "0", "5"], (0, 2)), run(["check", p]))
+
+
+def cat_toml(n: int, rng: random.Random, work: Path):
+    minimal = 'name = "t"\n[cavity]\ndiameter = 3.18\nlength = 4.76\n[neck]\ndiameter = 2.1\nlength = 6.35\n'
+    makers = [
+        lambda: "x = " + "[" * rng.randint(10, 20000) + "\n" + minimal,
+        lambda: (lambda d: "x = " + "[" * d + "]" * d + "\n" + minimal)(rng.randint(30, 20000)),
+        lambda: minimal + "[cavity.a" + ".b" * rng.randint(30, 3000) + "]\nz = 1\n",
+        lambda: minimal.replace("length = 4.76", "length = " + "9" * rng.randint(300, 6000)),
+        lambda: minimal.replace("length = 4.76", "length = -" + "9" * rng.randint(300, 4000)),
+        lambda: minimal.replace('name = "t"', 'name = "' + "x" * rng.randint(60, 2_000_000) + '"'),
+        lambda: minimal.replace('name = "t"', rng.choice(['name = "abc\\n"', 'name = "a\\u0000"', "name = 'é'",
+                                                          'name = "a b"', 'name = ".."', 'name = "日本"'])),
+        lambda: minimal + "[plate]\nlabel = " + json.dumps("".join(chr(rng.randint(0, 0x2FFF)) for _ in range(50))),
+        lambda: minimal + "[air]\nspeed_of_sound = " + rng.choice(["1e-300", "5e-324", "nan", "inf", "-0.0",
+                                                                    "1_000_000", "0x10", "1e400"]) + "\n",
+        lambda: minimal + "[mold]\ncount = " + rng.choice(["1e3", "true", str(2 ** 64), "-1", "0"]) + "\n",
+        lambda: minimal + '[cavity]\nlength = 5\n',  # duplicate table
+        lambda: minimal + "[calibration]\nv0_mm3 = 32\na = 0\nb = 0.1\ncovariance = " +
+        json.dumps([rng.uniform(-1, 1) for _ in range(rng.choice([3, 9, 10]))]) + "\n",
+    ]
+    for _ in range(n):
+        path = work / "s.toml"
+        path.write_text(rng.choice(makers)(), encoding="utf-8")
+        yield lambda p=path: run(["check", p])
+
+
+def cat_files(n: int, rng: random.Random, work: Path):
+    from matcad.inputs import CALIBRATION_MAX_BYTES, SPEC_MAX_BYTES
+
+    fifo = work / "fifo"
+    if not fifo.exists():
+        os.mkfifo(fifo)
+    big_spec = work / "big.toml"
+    big_spec.write_bytes(b"#" * (SPEC_MAX_BYTES + 1))
+    big_cal = work / "big_cal.toml"
+    big_cal.write_bytes(b"#" * (CALIBRATION_MAX_BYTES + 1))
+    wav = work / "ok.wav"
+    from scipy.io import wavfile
+    import numpy as np
+
+    wavfile.write(wav, 8000, np.zeros(800, np.int16))
+    bad = [fifo, "/dev/zero", work, big_spec, work / "missing.toml"]
+    for _ in range(n):
+        target = rng.choice(bad)
+        kind = rng.choice(["spec", "calibration", "csv", "wav"])
+        argv = {"spec": ["check", target], "calibration": ["sense", wav, "--calibration", rng.choice([target, big_cal])],
+                "csv": ["calibrate", target, "--spec", ROOT / "templates" / "mat-paper.toml", "--out", work / "c"],
+                "wav": ["analyze", target, "--band", "1000", "3000", "--out", work / "a"]}[kind]
+        yield lambda a=argv: (run(a, (2,)), _no_litter(work))
+
+
+def _good_wav() -> bytes:
+    import numpy as np
+
+    x = (np.sin(np.arange(8000) * 2 * np.pi * 2000 / 8000) * 20000).astype("<i2").tobytes()
+    fmt = struct.pack("<HHIIHH", 1, 1, 8000, 16000, 2, 16)
+    body = b"WAVE" + b"fmt " + struct.pack("<I", 16) + fmt + b"LIST" + struct.pack("<I", 4) + b"INFO" + \
+        b"data" + struct.pack("<I", len(x)) + x
+    return b"RIFF" + struct.pack("<I", len(body)) + body
+
+
+def cat_wav(n: int, rng: random.Random, work: Path):
+    good = _good_wav()
+    for _ in range(n):
+        blob = bytearray(good)
+        mode = rng.choice(["cut", "flip", "both"])
+        if mode in ("flip", "both"):
+            for _ in range(rng.randint(1, 4)):
+                blob[rng.randrange(56)] = rng.randrange(256)
+        if mode in ("cut", "both"):
+            blob = blob[:rng.randrange(len(blob))]
+        path = work / "r.wav"
+        path.write_bytes(bytes(blob))
+        yield lambda p=path: (run(["analyze", p, "--band", "1500", "2500", "--out", work / "a"]), _no_litter(work))
+
+
+def cat_csv(n: int, rng: random.Random, work: Path):
+    spec = ROOT / "templates" / "mat-paper.toml"
+    cells = ["0", "1", "2.5", "nan", "inf", "-inf", "1e154", "-1e154", "1e308", "4500", "4600.5", "", " ",
+             "x" * 200_000, "1\x00", "\ufeff0", "0,5", '"4700"', "1e-320"]
+    for _ in range(n):
+        rows = ["force_n,frequency_hz"] if rng.random() < 0.7 else []
+        sep = rng.choice([",", ";", "\t", ","])
+        for i in range(rng.randint(0, 12)):
+            if rng.random() < 0.6:
+                rows.append(f"{i * 2}{sep}{4500 + 15 * i + rng.gauss(0, 2):.2f}")
+            else:
+                rows.append(sep.join(rng.choice(cells) for _ in range(rng.randint(1, 3))))
+        path = work / "d.csv"
+        path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+        yield lambda p=path: (run(["calibrate", p, "--spec", spec, "--out", work / "c"]), _no_litter(work))
+
+
+def cat_calibration(n: int, rng: random.Random, work: Path):
+    from scipy.io import wavfile
+    import numpy as np
+
+    wav = work / "tone.wav"
+    t = np.arange(44100) / 44100
+    wavfile.write(wav, 44100, (np.sin(2 * np.pi * 4600 * t) * 20000).astype(np.int16))
+    for _ in range(n):
+        cov = [rng.choice([0.0, rng.uniform(-1e-3, 1e-3), rng.uniform(0, 1e-3), 1e30, -1e30]) for _ in range(9)]
+        lo = rng.choice([0.0, -5.0, 10.0])
+        text = ("[calibration]\n" f"v0_mm3 = {rng.choice([32.0, 1e-9, 1e18, 0.5])}\n"
+                f"a = {rng.choice([-0.0086, 0.0086, 0.0, 1e12])}\nb = {rng.choice([0.4626, -0.4626, 0.0, 1e-12])}\n"
+                f"k_mm3_hz2 = {rng.choice([2.2e8, 1e-300, 1e30, 6.8e8])}\n"
+                f"force_range_n = [{lo}, {lo + rng.choice([0.0, 20.0, 1e6])}]\n"
+                f"covariance = [{', '.join(repr(c) for c in cov)}]\n"
+                f"residual_std_mm3 = {rng.choice([0.0, 0.01, 1e30])}\ndof = {rng.choice([1, 8, 10 ** 9])}\n")
+        path = work / "cal.toml"
+        path.write_text(text)
+        yield lambda p=path: run(["sense", wav, "--calibration", p, "--json"])
+
+
+def cat_out(n: int, rng: random.Random, work: Path):
+    spec = work / "laser.toml"
+    spec.write_text(to_toml(_doc()))
+    for i in range(n):
+        case = work / f"case{i}"
+        case.mkdir()
+        kind = rng.choice(["dot", "nested", "file", "notes", "symlink", "twice", "kit-notes"])
+        allowed = (0,)
+        if kind == "dot":
+            target = Path(".")
+        elif kind == "nested":
+            target = case / "a" / "b" / "c"
+        elif kind == "file":
+            target = case / "f"
+            target.write_text("user file")
+            allowed = (2,)
+        elif kind == "notes":
+            target = case / "k"
+            target.mkdir()
+            (target / "notes.txt").write_text("mine")
+            allowed = (2,)
+        elif kind == "symlink":
+            (case / "real").mkdir()
+            target = case / "link"
+            target.symlink_to(case / "real")
+            allowed = (2,)
+        else:
+            target = case / "k"
+
+        def one(c=case, t=target, k=kind, a=allowed):
+            cwd = os.getcwd()
+            os.chdir(c)
+            try:
+                run(["build", spec, "--out", t], a)
+                if k in ("twice", "kit-notes"):
+                    if k == "kit-notes":
+                        (c / "k" / "notes.txt").write_text("mine")
+                    run(["build", spec, "--out", t], (2,) if k == "kit-notes" else (0,))
+                    if k == "kit-notes" and (c / "k" / "notes.txt").read_text() != "mine":
+                        raise Breach("a user's file was deleted")
+                for f in ("notes.txt",):
+                    if k == "notes" and not (c / "k" / f).exists():
+                        raise Breach("a user's file was deleted")
+            finally:
+                os.chdir(cwd)
+            _no_litter(c)
+        yield one
+
+
+def cat_specs(n: int, rng: random.Random, work: Path):
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    from tests.test_fuzz import out_args, run_one, spec_documents
+
+    results = []
+
+    @given(data=spec_documents(), out_arg=out_args, force=st.booleans())
     @settings(max_examples=n, deadline=None, database=None, suppress_health_check=list(HealthCheck))
     def one(data, out_arg, force):
-        workdir = Path(tempfile.mkdtemp(dir=base))
+        workdir = Path(tempfile.mkdtemp(dir=work))
         cwd = os.getcwd()
         os.chdir(workdir)
         try:
-            counts[run_one(data, workdir, out_arg, force)] += 1
+            run_one(data, workdir, out_arg, force)
+            results.append(None)
+        except AssertionError as exc:
+            results.append(exc)
         finally:
             os.chdir(cwd)
 
     one()
-    total = sum(counts.values())
-    seconds = time.perf_counter() - t0
-    print(f"{total} generated specs in {seconds:.0f} s ({1e3 * seconds / total:.0f} ms each), 0 contract breaches")
-    for outcome in ("invalid", "rules", "built"):
-        print(f"  {outcome:<8} {counts[outcome]:>6}  ({100 * counts[outcome] / total:.1f} %)")
+    for r in results:
+        def check(r=r):
+            if r is not None:
+                raise Breach(str(r)[:300])
+        yield check
+
+
+def cat_faults(n: int, rng: random.Random, work: Path):
+    from tests.test_hardening import _inject_faults
+
+    def one():
+        counts = _inject_faults(Path(tempfile.mkdtemp(dir=work)), trials=max(1, n), seed=rng.randrange(10 ** 6))
+        return counts
+    yield one
+
+
+CATEGORIES = {"specs": cat_specs, "extremes": cat_extremes, "toml": cat_toml, "files": cat_files, "wav": cat_wav,
+              "csv": cat_csv, "calibration": cat_calibration, "out": cat_out, "faults": cat_faults}
+
+
+def main_(n: int, names: list[str]) -> None:
+    import warnings
+
+    warnings.simplefilter("ignore")
+    rng = random.Random(10)
+    print(f"{'category':<12} {'tried':>6} {'held':>6} {'breaches':>8} {'s':>6}")
+    for name in names:
+        work = Path(tempfile.mkdtemp(prefix=f"matcad-fuzz-{name}-"))
+        count = {"specs": 10 * n, "faults": max(1, n // 10)}.get(name, n)
+        tried = held = 0
+        breaches = []
+        t0 = time.perf_counter()
+        for case in CATEGORIES[name](count, rng, work):
+            try:
+                result = case()
+            except (Breach, AssertionError) as exc:
+                tried += 1
+                breaches.append(str(exc)[:300])
+                continue
+            if name == "faults":  # one case runs many kills
+                tried += sum(t for t, _ in result.values())
+                held += sum(h for _, h in result.values())
+            else:
+                tried += 1
+                held += 1
+        print(f"{name:<12} {tried:>6} {held:>6} {len(breaches):>8} {time.perf_counter() - t0:>6.0f}", flush=True)
+        for b in breaches[:5]:
+            print(f"    breach: {b}")
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 10_000)
+    args = sys.argv[1:]
+    count = int(args.pop(0)) if args and args[0].isdigit() else 200
+    main_(count, args or list(CATEGORIES))

@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import signal
 import sys
 from pathlib import Path
 
@@ -540,24 +541,22 @@ _SIGNALLED: list[int] = []
 
 def _on_signal(signum, frame) -> None:
     """SIGINT and SIGTERM: remember which, ignore any further one while cleaning up, unwind as an interrupt."""
-    import signal
-
     _SIGNALLED.append(signum)
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, signal.SIG_IGN)
     raise KeyboardInterrupt
 
 
-def _install_signal_handlers() -> None:
-    import signal
-
-    if _SIGNALLED:  # a new run in the same interpreter (tests call main() repeatedly)
-        _SIGNALLED.clear()
+def _install_signal_handlers() -> dict:
+    """Route SIGINT and SIGTERM to :func:`_on_signal`; returns the handlers they replace."""
+    _SIGNALLED.clear()  # a new run in the same interpreter (tests call main() repeatedly)
+    previous = {}
     for sig in (signal.SIGINT, signal.SIGTERM):
         try:
-            signal.signal(sig, _on_signal)
+            previous[sig] = signal.signal(sig, _on_signal)
         except ValueError:  # not the main thread: leave Python's default handling
             pass
+    return previous
 
 
 def _private_caches() -> None:
@@ -615,8 +614,6 @@ def _internal_error(exc: BaseException) -> int:
 
 
 def _interrupted() -> int:
-    import signal
-
     terminated = bool(_SIGNALLED) and _SIGNALLED[0] == signal.SIGTERM
     print(f"matcad: {'terminated' if terminated else 'interrupted'}; no output folder is left half-written",
           file=sys.stderr)
@@ -635,7 +632,7 @@ def _quiet_stdout() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run one command; every outcome maps to one row of :data:`EXIT_CODES`."""
-    _install_signal_handlers()
+    previous = _install_signal_handlers()
     try:
         _private_caches()
         args = _parser().parse_args(argv)
@@ -648,6 +645,10 @@ def main(argv: list[str] | None = None) -> int:
         if _SIGNALLED:  # an interrupt inside a C extension's import surfaces as ImportError/SystemError
             return _interrupted()
         return _internal_error(exc)
+    finally:
+        if not _SIGNALLED:  # after a signal both stay ignored: the process is on its way out
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
 
 
 def _dispatch(args) -> int:
@@ -683,11 +684,17 @@ def _dispatch(args) -> int:
         return EXIT_INPUT
 
 
+def quiet_exit() -> None:
+    """Outside :func:`main` (starting up, finishing) there is nothing to clean up: a signal exits at once with
+    its code and no traceback."""
+    signal.signal(signal.SIGINT, lambda *_: os._exit(EXIT_INTERRUPT))
+    signal.signal(signal.SIGTERM, lambda *_: os._exit(EXIT_TERMINATED))
+
+
 def run() -> None:
     """Console entry point. After a command that loaded OpenCASCADE, every output file is closed and moved into
     place, yet interpreter teardown would spend 0.3-0.7 s destroying kernel objects: flush and leave at once."""
-    import signal
-
+    quiet_exit()
     code = main()
     for sig in (signal.SIGINT, signal.SIGTERM):  # the answer is decided: a late signal must not become a traceback
         signal.signal(sig, signal.SIG_IGN)

@@ -363,6 +363,12 @@ def kit(tmp_path):
     return spec, tmp_path / "out" / "k"
 
 
+def test_report_json_spec_reloads(kit):
+    spec, folder = kit
+    report = json.loads((folder / "report.json").read_text())
+    assert spec_mod.from_dict(report["spec"]) == spec_mod.load(spec)
+
+
 def test_user_file_next_to_report_survives_and_build_refuses(kit):
     spec, folder = kit
     (folder / "notes.txt").write_text("my notes")
@@ -498,3 +504,42 @@ def test_fault_injection_short(tmp_path):
 @pytest.mark.slow
 def test_fault_injection_long(tmp_path):
     _inject_faults(tmp_path, trials=40, seed=11)
+
+
+# ---- bounded tessellation and export failures ---------------------------------------------------------------------
+
+def test_chordal_tolerance_is_floored_by_part_size():
+    from build123d import Box
+
+    from matcad.export.mesh import CHORDAL_FLOOR_PER_SIZE, effective_tolerance_mm
+
+    box = Box(30, 40, 120)  # diagonal 130 mm
+    assert effective_tolerance_mm(box, 1e-5) == pytest.approx(130 * CHORDAL_FLOOR_PER_SIZE)
+    assert effective_tolerance_mm(box, 0.5) == 0.5
+
+
+def test_stl_tolerance_1e5_builds_within_the_floor_triangles(tmp_path, write_spec):
+    """The attack's ~1e-5 mm (12 GB, or a segfault): now the same triangles as at the floor, and the report says
+    which tolerance was used."""
+    text = PAPER.read_text() + ("\n[outputs]\nend_cap_mold = false\nneedle_mount = true\nassembly = false\n"
+                                "neck_plate = false\nguides = false\nspacers = false\n")
+    fine = write_spec(text + "[machine]\nstl_tolerance = 2e-5\n", "fine.toml")
+    code, out, err = run_cli("build", fine, "--out", tmp_path / "fine", "--json")
+    assert code == 0, err
+    mesh = json.loads((tmp_path / "fine" / "report.json").read_text())["meshes"]["needle_mount.stl"]
+    assert mesh["chordal_tolerance_mm"] > 1e-3 and mesh["triangles"] < 50_000 and mesh["watertight"]
+
+
+def test_export_failure_is_an_os_error_not_a_runtime_error(tmp_path, monkeypatch):
+    import build123d
+    from build123d import Box
+
+    from matcad.export import mesh
+
+    monkeypatch.setattr(build123d, "export_stl", lambda *a, **k: False)
+    monkeypatch.setattr(build123d, "export_step", lambda *a, **k: False)
+    monkeypatch.setattr("shutil.disk_usage", lambda p: type("U", (), {"free": 0})())
+    with pytest.raises(OSError, match="no space left"):
+        mesh.write_stl(Box(1, 1, 1), tmp_path / "a.stl", 0.01, 0.1)
+    with pytest.raises(OSError, match="no space left"):
+        mesh.write_step(Box(1, 1, 1), tmp_path / "a.step")
