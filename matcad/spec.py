@@ -14,6 +14,7 @@ import copy
 import dataclasses
 import math
 import re
+import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -453,6 +454,8 @@ def _number(path: str, value: Any, meta: dict) -> float:
         x = float(value)
     except OverflowError:  # an integer of >= 309 digits
         raise SpecError(path, value, f"must be {_range_text(meta)}") from None
+    if x != 0 and abs(x) < sys.float_info.min:  # subnormal: no physical value, and 1/x overflows
+        raise SpecError(path, value, f"must be {_range_text(meta)}, not a subnormal number")
     lo_ok = x > meta["lo"] if meta["lo_open"] else x >= meta["lo"]
     if not (math.isfinite(x) and lo_ok and x <= meta["hi"]):
         raise SpecError(path, value, f"must be {_range_text(meta)}")
@@ -517,6 +520,9 @@ def _section(cls: type, path: str, data: Any) -> Any:
 
 
 def _cross_checks(spec: Spec) -> None:
+    if spec.reference is not None and not spec.reference.f0_tolerance_hz < spec.reference.f0_hz:
+        raise SpecError("reference.f0_tolerance_hz", spec.reference.f0_tolerance_hz,
+                        f"must be < reference.f0_hz = {spec.reference.f0_hz:g} Hz (a band in ln f needs f0 - tol > 0)")
     if spec.reference is not None:
         try:
             reference_spec(spec)
