@@ -127,7 +127,7 @@ def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
     import json
 
     from matcad.parts.coupon import (coupon_sheets, laser_coupon, printed_coupon, printed_coupon_holes,
-                                     y_sweep_mounts)
+                                     needle_sweep_mounts, needle_sweeps)
 
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec, "-coupon")
     coupons = [laser_coupon(spec, sheet) for sheet in coupon_sheets(spec)]
@@ -137,9 +137,12 @@ def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
         laser = [hole | {"sheet_mm": flat.thickness, "kerf_mm": flat.kerf}
                  for flat in coupons for hole in write_laser_part(flat, spec, tmp)]
         mesh = write_printed_part("coupon_printed", printed_coupon(spec), spec, tmp)
-        sweep = [{"file": f"{stem}.stl", "y_mm": y, "theta_deg": spec.needle.theta_deg, "notches": i + 1,
-                  "mesh": write_printed_part(stem, solid, spec, tmp, pose="needle_mount")}
-                 for i, (stem, (y, solid)) in enumerate(y_sweep_mounts(spec).items())]
+        sweep = [{"file": f"{stem}.stl", "varies": field, "y_mm": spec.needle.y, "theta_deg": spec.needle.theta_deg}
+                 | {"y_mm" if field == "y" else field: value, "notches": i + 1,
+                    "notch_edge": "+x" if edge > 0 else "-x",
+                    "mesh": write_printed_part(stem, solid, spec, tmp, pose="needle_mount")}
+                 for field, (values, edge) in needle_sweeps(spec).items()
+                 for i, (stem, (value, solid)) in enumerate(needle_sweep_mounts(spec, field, values, edge).items())]
         table = {"name": spec.name, "sheets": {f.name: {"thickness_mm": f.thickness, "kerf_mm": f.kerf}
                                                 for f in coupons},
                  "printer": spec.machine.printer, "laser_holes": laser, "mesh": mesh, "needle_sweep": sweep,

@@ -177,7 +177,9 @@ def cmd_coupon(args) -> int:
         _print_json({"out_dir": str(target), **table})
     else:
         print(f"coupons in {target}/: coupon_<sheet>.dxf/.svg, one per sheet with its kerf (engraved sizes), "
-              "coupon_printed.stl/.step (needle bores at theta and dowel holes, ascending left to right)")
+              "coupon_printed.stl/.step (needle bores at theta and dowel holes, ascending left to right), "
+              "needle_mount_y*.stl (y sweep, notches on +x) and needle_mount_theta*.stl (theta sweep, notches on "
+              "-x); report.json lists which is which")
     return EXIT_OK
 
 

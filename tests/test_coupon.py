@@ -86,29 +86,71 @@ def test_per_sheet_kerf_reaches_the_kit(coupons, tmp_path):
         assert max(xs) - min(xs) == pytest.approx(width + KERFS[sheet], abs=1e-9)
 
 
+def _bore_from_step(spec, folder, row):
+    """The needle bore of a trial mount read back from its STEP, in the design frame: (θ deg, y mm)."""
+    from build123d import Pos
+
+    from matcad.parts.needle_mount import needle_bore_diameter_mm
+
+    solid = import_step(folder / row["file"].replace(".stl", ".step"))
+    solid = Pos(0, 0, -row["mesh"]["design_to_print"][2][3]) * solid
+    bore = next(f for f in solid.faces() if f.geom_type == GeomType.CYLINDER
+                and abs(f.radius - needle_bore_diameter_mm(spec) / 2) < 1e-6
+                and abs(f.axis_of_rotation.direction.Z) < 0.9999).axis_of_rotation
+    d, p = bore.direction, bore.position
+    x_hit = p.X - p.Z / d.Z * d.X
+    return math.degrees(math.asin(abs(d.Z))), -spec.neck.diameter / 2 - x_hit
+
+
+def _sweep_rows(folder, field):
+    return [row for row in json.loads((folder / "report.json").read_text())["needle_sweep"] if row["varies"] == field]
+
+
 def test_y_sweep_mounts_measured_on_their_step_files(coupons):
     """The trial set spans the paper's y window at the spec's θ; each bore's y is read back from its STEP."""
     spec, folder = coupons
-    from build123d import Pos
-
     from matcad.parts.coupon import Y_SWEEP_MM
-    from matcad.parts.needle_mount import needle_bore_diameter_mm
 
-    table = json.loads((folder / "report.json").read_text())
-    sweep = table["needle_sweep"]
+    sweep = _sweep_rows(folder, "y")
     assert [row["y_mm"] for row in sweep] == list(Y_SWEEP_MM) and min(Y_SWEEP_MM) == 0.0 and max(Y_SWEEP_MM) == 3.47
     assert [row["notches"] for row in sweep] == list(range(1, len(Y_SWEEP_MM) + 1))
+    assert {row["notch_edge"] for row in sweep} == {"+x"}
     for row in sweep:
-        solid = import_step(folder / row["file"].replace(".stl", ".step"))
-        solid = Pos(0, 0, -row["mesh"]["design_to_print"][2][3]) * solid
-        bore = next(f for f in solid.faces() if f.geom_type == GeomType.CYLINDER
-                    and abs(f.radius - needle_bore_diameter_mm(spec) / 2) < 1e-6
-                    and abs(f.axis_of_rotation.direction.Z) < 0.9999).axis_of_rotation
-        d, p = bore.direction, bore.position
-        assert math.degrees(math.asin(abs(d.Z))) == pytest.approx(spec.needle.theta_deg, abs=0.01)
-        x_hit = p.X - p.Z / d.Z * d.X
-        assert -spec.neck.diameter / 2 - x_hit == pytest.approx(row["y_mm"], abs=0.01)
+        theta, y = _bore_from_step(spec, folder, row)
+        assert theta == pytest.approx(spec.needle.theta_deg, abs=0.01)
+        assert y == pytest.approx(row["y_mm"], abs=0.01)
         assert trimesh.load_mesh(folder / row["file"]).is_watertight
+
+
+def test_theta_sweep_mounts_measured_on_their_step_files(coupons):
+    """The θ trial set (FDM: 45–75°, no bore needing support; SLA: the paper's whole 30–75°) at the spec's y,
+    notched on the other edge; each bore's θ and y read back from its STEP."""
+    import dataclasses
+
+    from matcad.parts.coupon import theta_sweep_deg
+    from matcad.rules.printing import bore_overhang
+
+    spec, folder = coupons
+    assert spec.machine.printer == "fdm"
+    sweep = _sweep_rows(folder, "theta_deg")
+    thetas = [row["theta_deg"] for row in sweep]
+    assert thetas == [45.0, 52.5, 60.0, 67.5, 75.0]
+    sla = dataclasses.replace(spec, machine=dataclasses.replace(spec.machine, printer="sla"))
+    assert theta_sweep_deg(sla) == (30.0, 41.25, 52.5, 63.75, 75.0)
+    for theta in thetas:  # none of the FDM set trips the overhang warning; one step lower would
+        assert not bore_overhang(dataclasses.replace(spec, needle=dataclasses.replace(spec.needle, theta_deg=theta)))
+    low = dataclasses.replace(spec, needle=dataclasses.replace(spec.needle, theta_deg=thetas[0] - 7.5))
+    assert bore_overhang(low)
+    assert [row["notches"] for row in sweep] == list(range(1, len(thetas) + 1))
+    assert {row["notch_edge"] for row in sweep} == {"-x"}
+    assert len({row["file"] for row in json.loads((folder / "report.json").read_text())["needle_sweep"]}) == 10
+    for row in sweep:
+        theta, y = _bore_from_step(spec, folder, row)
+        print(f"{row['file']}: theta {theta:.4f} deg, y {y:.4f} mm")
+        assert theta == pytest.approx(row["theta_deg"], abs=0.01)
+        assert y == pytest.approx(spec.needle.y, abs=0.01) and row["y_mm"] == spec.needle.y
+        mesh = trimesh.load_mesh(folder / row["file"])
+        assert mesh.is_watertight and mesh.volume == pytest.approx(row["mesh"]["brep_volume_mm3"], rel=1e-3)
 
 
 @pytest.mark.parametrize("sheet", ["plate", "guide", "spacer"])

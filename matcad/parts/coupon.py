@@ -104,14 +104,38 @@ def printed_coupon(spec):
 
 Y_SWEEP_MM = (0.0, 0.87, 1.74, 2.6, 3.47)
 """Needle offsets y the trial set spans: the paper's tested window 0–3.47 mm (Sec. II) in four steps."""
+THETA_WINDOW_DEG = (30.0, 75.0)
+"""Needle angles θ the paper tested (Sec. II), deg."""
+THETA_STEPS = 5
 NOTCH_MM = 1.0
 
 
-def y_sweep_mounts(spec) -> dict[str, tuple[float, object]]:
-    """A set of needle mounts, one per y in :data:`Y_SWEEP_MM` at the spec's θ, to print together and try on the
-    same plate: file stem → (y mm, solid). Mount i carries i + 1 notches on its +x edge, so they cannot be mixed
-    up; the coupon report lists which is which."""
+def theta_sweep_deg(spec) -> tuple[float, ...]:
+    """θ values (deg) of the trial set: :data:`THETA_STEPS` evenly over the paper's window 30–75° (Sec. II), cut
+    to what the spec's printer makes without support: an FDM bore's ceiling overhangs 90° − θ from vertical, so
+    FDM starts at 90° − ``FDM_OVERHANG_DEG`` = 45° (the ``print.bore_overhang`` limit); SLA spans 30–75°."""
+    from matcad.rules.printing import FDM_OVERHANG_DEG
+
+    lo, hi = THETA_WINDOW_DEG
+    if spec.machine.printer == "fdm":
+        lo = max(lo, 90.0 - FDM_OVERHANG_DEG)
+    return tuple(round(lo + (hi - lo) * i / (THETA_STEPS - 1), 4) for i in range(THETA_STEPS))
+
+
+def needle_sweeps(spec) -> dict[str, tuple[tuple[float, ...], int]]:
+    """The trial sets `matcad coupon` prints: needle field → (values, notch edge: +1 = +x, −1 = −x). y over
+    :data:`Y_SWEEP_MM` at the spec's θ; θ over :func:`theta_sweep_deg` at the spec's y (mm, deg)."""
+    return {"y": (Y_SWEEP_MM, 1), "theta_deg": (theta_sweep_deg(spec), -1)}
+
+
+def needle_sweep_mounts(spec, field: str, values, edge: int = 1) -> dict[str, tuple[float, object]]:
+    """A set of needle mounts, one per value of needle ``field`` (``"y"`` mm or ``"theta_deg"`` deg), the rest as
+    in the spec, to print together and try on the same plate: file stem → (value, solid). Mount i carries i + 1
+    notches on its ``edge`` × x edge (+1: +x, −1: −x), so neither a set's members nor the sets can be mixed up;
+    the coupon report lists which is which. Notches sit 3 mm apart on the half-pitch grid, never on the needle
+    plane y = 0, where a low-θ bore leaves the block through its −x face."""
     import dataclasses
+    import math
 
     from build123d import Box, Pos
 
@@ -119,11 +143,11 @@ def y_sweep_mounts(spec) -> dict[str, tuple[float, object]]:
     from matcad.parts.solid import TOP
 
     out = {}
-    for i, y in enumerate(Y_SWEEP_MM):
-        trial = dataclasses.replace(spec, needle=dataclasses.replace(spec.needle, y=y))
+    for i, value in enumerate(values):
+        trial = dataclasses.replace(spec, needle=dataclasses.replace(spec.needle, **{field: value}))
         mount = needle_mount(trial)
         top = -spec.spacer.height
-        notches = [Pos(spec.plate.width / 2, (k - i / 2) * 3 * NOTCH_MM, top)
+        notches = [Pos(edge * spec.plate.width / 2, (k - math.ceil(i / 2) + 0.5) * 3 * NOTCH_MM, top)
                    * Box(2 * NOTCH_MM, NOTCH_MM, spec.mount.thickness, align=TOP) for k in range(i + 1)]
-        out[f"needle_mount_y{y:.2f}"] = (y, mount.cut(*notches))
+        out[f"needle_mount_{field.removesuffix('_deg')}{value:.2f}"] = (value, mount.cut(*notches))
     return out
