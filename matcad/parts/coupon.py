@@ -107,18 +107,20 @@ Y_SWEEP_MM = (0.0, 0.87, 1.74, 2.6, 3.47)
 THETA_WINDOW_DEG = (30.0, 75.0)
 """Needle angles θ the paper tested (Sec. II), deg."""
 THETA_STEPS = 5
+FDM_THETA_MIN_DEG = 60.0
+"""Lowest θ of the FDM trial set, deg. The ``print.bore_overhang`` rule (90° − θ ≤ 45° from vertical) would allow
+45°, but PrusaSlicer with automatic supports (its default FDM profile, tests/test_real_clients.py) still puts
+support under this mount's bore at θ = 45° (171 mm³) and 52.5° (110 mm³), none at 60° and above (measured)."""
 NOTCH_MM = 1.0
 
 
 def theta_sweep_deg(spec) -> tuple[float, ...]:
     """θ values (deg) of the trial set: :data:`THETA_STEPS` evenly over the paper's window 30–75° (Sec. II), cut
-    to what the spec's printer makes without support: an FDM bore's ceiling overhangs 90° − θ from vertical, so
-    FDM starts at 90° − ``FDM_OVERHANG_DEG`` = 45° (the ``print.bore_overhang`` limit); SLA spans 30–75°."""
-    from matcad.rules.printing import FDM_OVERHANG_DEG
-
+    to what the spec's printer makes without support: an FDM bore's ceiling overhangs 90° − θ from vertical, and a
+    slicer supports it below :data:`FDM_THETA_MIN_DEG` = 60°, so FDM spans 60–75°; SLA spans 30–75°."""
     lo, hi = THETA_WINDOW_DEG
     if spec.machine.printer == "fdm":
-        lo = max(lo, 90.0 - FDM_OVERHANG_DEG)
+        lo = max(lo, FDM_THETA_MIN_DEG)
     return tuple(round(lo + (hi - lo) * i / (THETA_STEPS - 1), 4) for i in range(THETA_STEPS))
 
 
