@@ -179,3 +179,62 @@ def test_every_laser_coupon_hole_is_labelled_with_its_size_as_outlines(coupons, 
                          & (engraved[:, 1] < c.dxf.center.y - c.dxf.radius)
                          & (engraved[:, 1] > c.dxf.center.y - c.dxf.radius - 3)]
         assert len(below) > 10, finished
+
+
+def _even_odd_area(outlines):
+    """Filled area (mm²) of glyph loops under the even-odd rule: shoelace areas, each loop signed by how many
+    other loops enclose it (matplotlib's point-in-polygon, independent of matcad's nesting)."""
+    import numpy as np
+    from matplotlib.path import Path
+
+    def shoelace(p):
+        x, y = np.array(p).T
+        return abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) / 2
+
+    return sum(shoelace(p) * (-1) ** sum(Path(q).contains_point(p[0]) for q in outlines if q is not p)
+               for p in outlines)
+
+
+def test_every_printed_coupon_hole_has_its_size_recessed_next_to_it(coupons, tmp_path):
+    """Read back from the STL: under each hole's label rectangle a floor at top − 0.4 mm whose area is the
+    label's even-odd glyph area; no floor elsewhere; the STL lost label area x depth against an unlabelled
+    coupon tessellated the same way."""
+    import numpy as np
+
+    from matcad.export.mesh import write_stl
+    from matcad.parts.coupon import (LABEL_GAP_MM, PRINTED_ENGRAVE_MM, PRINTED_LABEL_MM, printed_coupon,
+                                     printed_coupon_labels)
+    from matcad.parts.flat import engraving_outlines
+
+    spec, folder = coupons
+    mesh = trimesh.load_mesh(folder / "coupon_printed.stl")
+    top = mesh.bounds[1][2]
+    tri = mesh.triangles
+    floor = (np.abs(tri[:, :, 2] - (top - PRINTED_ENGRAVE_MM)) < 1e-6).all(axis=1) & (mesh.face_normals[:, 2] > 0.999)
+    centres, areas = mesh.triangles_center[floor], mesh.area_faces[floor]
+    holes = json.loads((folder / "report.json").read_text())["printed_holes"]
+    reach = max(h["diameter_mm"] for h in holes) / 2 + LABEL_GAP_MM
+    drift = spec.mount.thickness / math.tan(math.radians(spec.needle.theta_deg))
+    claimed = np.zeros(len(centres), bool)
+    total = 0.0
+    for h in holes:
+        mouth = h["x_mm"] + (drift if h["purpose"] == "needle" else 0.0)
+        y0 = h["y_mm"] + reach if h["y_mm"] > 0 else h["y_mm"] - reach - PRINTED_LABEL_MM
+        box = ((np.abs(centres[:, 0] - mouth) < 3.5) & (centres[:, 1] > y0 - 0.05)
+               & (centres[:, 1] < y0 + PRINTED_LABEL_MM + 0.05))
+        label = next(t for t in printed_coupon_labels(spec) if t.text == f"{h['diameter_mm']:.2f}"
+                     and abs(t.y - y0) < 1e-9)
+        expected = _even_odd_area(engraving_outlines(label))
+        assert areas[box].sum() == pytest.approx(expected, rel=1e-3), h
+        ys = centres[box, 1]
+        assert ys.max() - ys.min() > 0.9 * PRINTED_LABEL_MM  # capitals ≥ 2 mm tall
+        claimed |= box
+        total += expected
+    assert claimed.all()
+    plain = tmp_path / "plain.stl"
+    write_stl(printed_coupon(spec, labelled=False), plain, spec.machine.stl_tolerance,
+              spec.machine.stl_angular_tolerance)
+    removed = trimesh.load_mesh(plain).volume - mesh.volume
+    assert removed == pytest.approx(total * PRINTED_ENGRAVE_MM, rel=1e-2)
+    print(f"labels {len(holes)}, glyph area {total:.3f} mm², removed {removed:.3f} mm³, "
+          f"expected {total * PRINTED_ENGRAVE_MM:.3f} mm³")

@@ -13,7 +13,7 @@ import math
 from pathlib import Path
 from xml.sax.saxutils import escape
 
-from matcad.parts.flat import CutPlan
+from matcad.parts.flat import CutPlan, engraving_outlines
 
 LAYERS = {
     # name: (DXF ACI colour, SVG stroke, meaning)
@@ -23,23 +23,6 @@ LAYERS = {
     "REFERENCE": (6, "#ff00ff", "10 mm reference square to check scale on import; do not cut"),
 }
 QUARTER_BULGE = math.tan(math.pi / 8)  # bulge of a 90° arc
-
-
-CAP_HEIGHT_PER_SIZE = 0.729
-"""DejaVu Sans capital height / font size: an Engraving's height is its capital height."""
-
-
-def engraving_outlines(t) -> list[list[tuple[float, float]]]:
-    """An :class:`~matcad.parts.flat.Engraving` as closed glyph outlines (mm): the text converted to polygons
-    with DejaVu Sans (shipped with matplotlib, so every machine draws the same shapes), baseline at (t.x, t.y),
-    capitals t.height tall. Lasers engrave or score the outlines; no font is needed on the laser's computer."""
-    from matplotlib.font_manager import FontProperties
-    from matplotlib.textpath import TextPath
-
-    path = TextPath((0.0, 0.0), t.text, size=t.height / CAP_HEIGHT_PER_SIZE,
-                    prop=FontProperties(family="DejaVu Sans"))
-    return [[(t.x + float(x), t.y + float(y)) for x, y in poly[:-1]]
-            for poly in path.to_polygons(closed_only=True) if len(poly) > 3]
 
 
 def rounded_rect_points(x0, y0, x1, y1, r):

@@ -10,7 +10,7 @@ difference back (<sheet>.laser_kerf, fasteners fits).
 from __future__ import annotations
 
 from matcad.parts.features import bolt_clearance_mm, sheet_kerf_mm, sheet_thickness_mm
-from matcad.parts.flat import Engraving, Flat, Hole
+from matcad.parts.flat import Engraving, Flat, Hole, engraving_outlines
 
 NECK_SWEEP_MM = (-0.2, -0.15, -0.1, -0.05, 0.0, 0.05, 0.1, 0.15, 0.2)
 DOWEL_SWEEP_MM = (0.0, 0.05, 0.1, 0.15, 0.2)
@@ -18,6 +18,12 @@ NEEDLE_SWEEP_MM = (-0.05, 0.0, 0.05, 0.1, 0.15, 0.2, 0.3)
 PRINTED_DOWEL_SWEEP_MM = (-0.1, -0.05, 0.0, 0.05, 0.1, 0.2)
 LABEL_MM = 1.2
 MARGIN_MM = 3.0
+PRINTED_LABEL_MM = 2.0
+"""Cap height of the printed coupon's size labels: strokes ≈ 0.27 mm/mm of cap height come out ≥ 0.5 mm, wider
+than a 0.4 mm FDM nozzle's line."""
+PRINTED_ENGRAVE_MM = 0.4
+"""Depth of the printed labels: two 0.2 mm layers."""
+LABEL_GAP_MM = 1.0
 
 
 BOLT_SWEEP_MM = (-0.2, -0.1, 0.0, 0.1, 0.2)
@@ -73,24 +79,49 @@ def printed_coupon_holes(spec) -> list[Hole]:
     return _row(needles, row, pitch, "needle", x0) + _row(dowels, -row, pitch, "dowel", x0)
 
 
-def printed_coupon(spec):
+def _drift_mm(spec) -> float:
+    """How far a needle bore at θ travels in x through the coupon bar (mm)."""
+    import math
+
+    return spec.mount.thickness / math.tan(math.radians(spec.needle.theta_deg))
+
+
+def printed_coupon_labels(spec) -> list[Engraving]:
+    """Each printed hole's finished size (mm, 2 decimals), centred on the hole's mouth in the bar's top face:
+    above the needle row, below the dowel row, :data:`LABEL_GAP_MM` clear of the widest hole, capitals
+    :data:`PRINTED_LABEL_MM` tall."""
+    holes = printed_coupon_holes(spec)
+    reach = max(h.diameter for h in holes) / 2 + LABEL_GAP_MM
+    labels = []
+    for h in holes:
+        text = f"{h.diameter:.2f}"
+        xs = [x for poly in engraving_outlines(Engraving(0.0, 0.0, PRINTED_LABEL_MM, text)) for x, _ in poly]
+        mouth = h.x + (_drift_mm(spec) if h.purpose == "needle" else 0.0)
+        y0 = h.y + reach if h.y > 0 else h.y - reach - PRINTED_LABEL_MM
+        labels.append(Engraving(mouth - (min(xs) + max(xs)) / 2, y0, PRINTED_LABEL_MM, text))
+    return labels
+
+
+def printed_coupon(spec, labelled: bool = True):
     """The printed coupon: a bar of mount thickness; needle bores at the needle's θ (as in the mount, so a bore
     that passes here passes there: a tilted printed bore comes out smaller than a vertical one), dowel holes
-    vertical as in the mount (mm)."""
+    vertical as in the mount; each size recessed :data:`PRINTED_ENGRAVE_MM` into the top face (printed face up,
+    no support) unless ``labelled`` is False (mm)."""
     import math
 
     from build123d import Box, Pos
 
-    from matcad.parts.solid import BOTTOM, cylinder_up, tilted_cylinder
+    from matcad.parts.solid import BOTTOM, cylinder_up, engraved, tilted_cylinder
 
     holes = printed_coupon_holes(spec)
     t = spec.mount.thickness
     theta = math.radians(spec.needle.theta_deg)
-    drift = t / math.tan(theta)  # how far a bore at θ travels in x through the bar
+    drift = _drift_mm(spec)
     half = (t / 2 + 1.0) / math.sin(theta)  # half-length along the axis, 1 mm past each face
     width = (max(h.x for h in holes) - min(h.x for h in holes) + drift
              + 2 * (max(h.diameter for h in holes) / math.sin(theta) + MARGIN_MM))
-    depth = 2 * (max(abs(h.y) for h in holes) + max(h.diameter for h in holes) / 2 + MARGIN_MM)
+    depth = 2 * (max(abs(h.y) for h in holes) + max(h.diameter for h in holes) / 2 + LABEL_GAP_MM
+                 + PRINTED_LABEL_MM + MARGIN_MM)
     bar = Pos(drift / 2, 0, 0) * Box(width, depth, t, align=BOTTOM)
     for h in holes:
         if h.purpose == "needle":
@@ -99,6 +130,8 @@ def printed_coupon(spec):
             bar -= tilted_cylinder(h.diameter / 2, 2 * half, end, spec.needle.theta_deg)
         else:
             bar -= cylinder_up(h.diameter / 2, t, h.x, h.y)
+    if labelled:
+        bar = bar.cut(*engraved(printed_coupon_labels(spec), t, PRINTED_ENGRAVE_MM))
     return bar
 
 

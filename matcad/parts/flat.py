@@ -37,6 +37,47 @@ EM_PER_CAP = 0.62 / 0.729
 """Mean advance of a DejaVu Sans character per capital height (for placing labels; the exporter draws them)."""
 
 
+CAP_HEIGHT_PER_SIZE = 0.729
+"""DejaVu Sans capital height / font size: an Engraving's height is its capital height."""
+
+
+def engraving_outlines(t) -> list[list[tuple[float, float]]]:
+    """An :class:`~matcad.parts.flat.Engraving` as closed glyph outlines (mm): the text converted to polygons
+    with DejaVu Sans (shipped with matplotlib, so every machine draws the same shapes), baseline at (t.x, t.y),
+    capitals t.height tall. Lasers engrave or score the outlines, printed parts recess them
+    (:func:`matcad.parts.solid.engraved`); no font is needed on the laser's or printer's computer."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextPath
+
+    path = TextPath((0.0, 0.0), t.text, size=t.height / CAP_HEIGHT_PER_SIZE,
+                    prop=FontProperties(family="DejaVu Sans"))
+    return [[(t.x + float(x), t.y + float(y)) for x, y in poly[:-1]]
+            for poly in path.to_polygons(closed_only=True) if len(poly) > 3]
+
+
+def _inside(point, poly) -> bool:
+    """Even-odd ray test: is ``point`` inside polygon ``poly`` (mm)."""
+    x, y = point
+    inside = False
+    for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1]):
+        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
+            inside = not inside
+    return inside
+
+
+def even_odd_faces(outlines) -> list[tuple[list, list[list]]]:
+    """Glyph outlines grouped as filled regions under the even-odd rule: (outer loop, its inner loops) per
+    region. A loop inside an even number of others is an outer boundary; one inside an odd number is a hole
+    (the counter of 0, 6, 8, 9) of the smallest outer loop around it (mm; PostScript/SVG even-odd fill)."""
+    def containers(i):
+        return [j for j, other in enumerate(outlines) if j != i and _inside(outlines[i][0], other)]
+
+    depth = {i: containers(i) for i in range(len(outlines))}
+    outers = [i for i, c in depth.items() if len(c) % 2 == 0]
+    return [(outlines[i], [outlines[k] for k, c in depth.items()
+                           if len(c) == len(depth[i]) + 1 and i in c]) for i in outers]
+
+
 def edge_label(text: str, width: float, depth: float, holes, height: float = 1.0, margin: float = 0.6):
     """A part label engraved along the bottom (else top) edge of a width x depth part, clear of every hole by
     ``margin``; () when it fits nowhere (mm)."""

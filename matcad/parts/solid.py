@@ -32,3 +32,18 @@ def flat_solid(flat, z0: float = 0.0):
     """A laser part (design intent, finished sizes) as a solid from z0 to z0 + thickness (mm)."""
     body = Pos(0, 0, z0) * Box(flat.width, flat.depth, flat.thickness, align=BOTTOM)
     return body.cut(*(cylinder_up(h.diameter / 2, flat.thickness, h.x, h.y, z0) for h in flat.holes))
+
+
+def engraved(engravings, top: float, depth: float) -> list:
+    """Solids to subtract from a part to recess ``engravings`` (glyph outlines, :func:`engraving_outlines`)
+    ``depth`` into its face at z = ``top``: letter faces built with even-odd nesting (outer loop minus its
+    counters), extruded from top − depth to 1 mm above the face (mm)."""
+    from build123d import Face, Solid, Vector, Wire
+
+    from matcad.parts.flat import engraving_outlines, even_odd_faces
+
+    def loop(points):
+        return Wire.make_polygon([(x, y, top - depth) for x, y in points], close=True)
+
+    return [Solid.extrude(Face(loop(outer), [loop(p) for p in inner]), Vector(0, 0, depth + 1.0))
+            for t in engravings for outer, inner in even_odd_faces(engraving_outlines(t))]
