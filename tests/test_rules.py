@@ -45,7 +45,7 @@ def _levels(spec, rule_id):
     ({"end_cap__flange_squeeze": 0.7}, "seal.squeeze", "warning"),      # 0.75 mm of a 2.2 mm flange > 30 %
     ({"mold__vent_reach": 0.5}, "mold.vent_reach", "error"),
     ({"machine__printer": "sla"}, "mold.cure_inhibition", "warning"),
-    ({"needle__theta_deg": 40.0}, "print.bore_overhang", "warning"),
+    ({"needle__theta_deg": 55.0}, "print.bore_overhang", "warning"),
 ])
 def test_rule_fires(over, rule, level):
     assert level in _levels(_paper_with(**over), rule)

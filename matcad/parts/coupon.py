@@ -141,9 +141,10 @@ THETA_WINDOW_DEG = (30.0, 75.0)
 """Needle angles θ the paper tested (Sec. II), deg."""
 THETA_STEPS = 5
 FDM_THETA_MIN_DEG = 60.0
-"""Lowest θ of the FDM trial set, deg. The ``print.bore_overhang`` rule (90° − θ ≤ 45° from vertical) would allow
-45°, but PrusaSlicer with automatic supports (its default FDM profile, tests/test_real_clients.py) still puts
-support under this mount's bore at θ = 45° (171 mm³) and 52.5° (110 mm³), none at 60° and above (measured)."""
+"""Lowest needle angle θ (deg) whose bore FDM prints without support, and so the lowest θ of the FDM trial set and
+the ``print.bore_overhang`` rule's limit: PrusaSlicer with automatic supports (its default FDM profile,
+tests/test_real_clients.py) puts support under this mount's bore at θ = 45° (171 mm³) and 52.5° (110 mm³), none
+at 60° and above (measured)."""
 NOTCH_MM = 1.0
 
 

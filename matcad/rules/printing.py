@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from matcad.parts.casting import MIN_BATCH_G, MOLD_MATERIALS, casting_guide
+from matcad.parts.coupon import FDM_THETA_MIN_DEG
 from matcad.parts.mold_layout import pin_tip_radius_mm, plan_vents
 from matcad.rules import Finding
 
@@ -109,8 +110,10 @@ def silicone_batch(spec) -> list[Finding]:
                     "")]
 
 
-FDM_OVERHANG_DEG = 45.0
-"""Steepest overhang (from vertical) FDM prints without support."""
+FDM_OVERHANG_DEG = 90.0 - FDM_THETA_MIN_DEG
+"""Steepest bore-ceiling overhang (from vertical) the mount prints without support on FDM: 30°, the needle angle
+PrusaSlicer was measured to need no support at (:data:`matcad.parts.coupon.FDM_THETA_MIN_DEG`), not the
+45° rule of thumb it still supported at."""
 
 
 def bore_overhang(spec) -> list[Finding]:
