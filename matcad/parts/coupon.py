@@ -19,8 +19,9 @@ PRINTED_DOWEL_SWEEP_MM = (-0.1, -0.05, 0.0, 0.05, 0.1, 0.2)
 LABEL_MM = 1.2
 MARGIN_MM = 3.0
 PRINTED_LABEL_MM = 2.0
-"""Cap height of the printed coupon's size labels: strokes ≈ 0.27 mm/mm of cap height come out ≥ 0.5 mm, wider
-than a 0.4 mm FDM nozzle's line."""
+"""Cap height of the printed coupon's size labels (mm). DejaVu Sans strokes are roughly 0.09 em, so about
+0.25 mm wide at this size (estimate, not measured): narrower than a 0.4 mm nozzle's line; not yet checked in a
+slicer that the recessed strokes survive."""
 PRINTED_ENGRAVE_MM = 0.4
 """Depth of the printed labels: two 0.2 mm layers."""
 LABEL_GAP_MM = 1.0
