@@ -1,3 +1,0 @@
-from matcad.cli import run
-
-run()

@@ -1,1 +1,0 @@
-"""Acoustic core: pure numpy, never imports a CAD kernel. Lengths in mm, frequencies in Hz."""
