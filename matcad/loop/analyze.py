@@ -31,7 +31,7 @@ Frequencies Hz, times s, levels dB.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -90,8 +90,7 @@ class Segment:
     flag: str = ""
 
     def to_dict(self) -> dict:
-        return {"start_s": self.start_s, "end_s": self.end_s, "frames": self.frames, "mean_hz": self.mean_hz,
-                "median_hz": self.median_hz, "std_hz": self.std_hz, "flag": self.flag}
+        return asdict(self)
 
 
 @dataclass(frozen=True)

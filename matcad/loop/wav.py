@@ -80,35 +80,44 @@ def read_info(path: str | Path) -> WavInfo:
     with open_regular(path, "recording") as f:
         size = f.seek(0, 2)
         f.seek(0)
-        head = f.read(12)
-        if len(head) < 12 or head[:4] not in (b"RIFF", b"RIFX") or head[8:12] != b"WAVE":
-            raise _bad(path, "no RIFF/WAVE header")
-        end = ">" if head[:4] == b"RIFX" else "<"
-        fmt = None
-        for _ in range(MAX_CHUNKS):
-            chunk = f.read(8)
-            if len(chunk) < 8:
+        def skip(n: int, cid: bytes, fmt) -> None:
+            if f.tell() + n > size:
                 raise _bad(path, "no 'data' chunk" if fmt else "no 'fmt ' chunk")
-            cid, csize = chunk[:4], struct.unpack(end + "I", chunk[4:])[0]
-            if cid == b"fmt ":
-                if csize > MAX_FMT_BYTES:
-                    raise _bad(path, f"'fmt ' chunk of {csize} bytes")
-                fmt = _parse_fmt(path, f.read(csize), end)
-                f.seek(csize & 1, 1)
-            elif cid == b"data":
-                if fmt is None:
-                    raise _bad(path, "'data' chunk before the 'fmt ' chunk")
-                kind, bits, channels, rate = fmt
-                offset = f.tell()
-                frames = min(csize, size - offset) // (channels * bits // 8)
-                if frames <= 0:
-                    raise ValueError(f"recording {path}: holds no samples")
-                return WavInfo(rate, channels, kind, bits, offset, frames, end == ">")
-            else:
-                if f.tell() + csize > size:
-                    raise _bad(path, "no 'data' chunk" if fmt else "no 'fmt ' chunk")
-                f.seek(csize + (csize & 1), 1)
-        raise _bad(path, f"no 'data' chunk among the first {MAX_CHUNKS} chunks")
+            f.seek(n, 1)
+
+        (kind, bits, channels, rate), end, csize = _riff_header(path, f.read, skip, "")
+        offset = f.tell()
+        frames = min(csize, size - offset) // (channels * bits // 8)
+        if frames <= 0:
+            raise ValueError(f"recording {path}: holds no samples")
+        return WavInfo(rate, channels, kind, bits, offset, frames, end == ">")
+
+
+def _riff_header(name, read, skip, hint: str):
+    """Walk a RIFF/RIFX WAVE header up to its 'data' chunk: ((kind, bits, channels, rate), byte order, data
+    chunk size). ``read(n)`` returns up to n bytes, ``skip(n, chunk id, fmt so far)`` passes over an unknown
+    chunk (the caller bounds it); ``hint`` is added to the no-header message."""
+    head = read(12)
+    if len(head) < 12 or head[:4] not in (b"RIFF", b"RIFX") or head[8:12] != b"WAVE":
+        raise _bad(name, f"no RIFF/WAVE header{hint}")
+    end = ">" if head[:4] == b"RIFX" else "<"
+    fmt = None
+    for _ in range(MAX_CHUNKS):
+        chunk = read(8)
+        if len(chunk) < 8:
+            raise _bad(name, "no 'data' chunk" if fmt else "no 'fmt ' chunk")
+        cid, csize = chunk[:4], struct.unpack(end + "I", chunk[4:])[0]
+        if cid == b"fmt ":
+            if csize > MAX_FMT_BYTES:
+                raise _bad(name, f"'fmt ' chunk of {csize} bytes")
+            fmt = _parse_fmt(name, read(csize + (csize & 1))[:csize], end)
+        elif cid == b"data":
+            if fmt is None:
+                raise _bad(name, "'data' chunk before the 'fmt ' chunk")
+            return fmt, end, csize
+        else:
+            skip(csize + (csize & 1), cid, fmt)
+    raise _bad(name, f"no 'data' chunk among the first {MAX_CHUNKS} chunks")
 
 
 def _decode(raw: bytes, info: WavInfo) -> np.ndarray:
@@ -184,31 +193,15 @@ def stream_info(stream, rate_hz: float | None = None, sample_format: str | None 
             raise ValueError(f"--channels {channels} invalid, must be 1-{MAX_CHANNELS}")
         kind, bits = RAW_FORMATS[sample_format]
         return WavInfo(float(rate_hz), channels, kind, bits, 0, -1)
-    head = _read_exact(stream, 12)
-    if len(head) < 12 or head[:4] not in (b"RIFF", b"RIFX") or head[8:12] != b"WAVE":
-        raise _bad(name, "no RIFF/WAVE header (raw PCM needs --format and --rate)")
-    end = ">" if head[:4] == b"RIFX" else "<"
-    fmt = None
-    for _ in range(MAX_CHUNKS):
-        chunk = _read_exact(stream, 8)
-        if len(chunk) < 8:
-            raise _bad(name, "no 'data' chunk" if fmt else "no 'fmt ' chunk")
-        cid, csize = chunk[:4], struct.unpack(end + "I", chunk[4:])[0]
-        if cid == b"fmt ":
-            if csize > MAX_FMT_BYTES:
-                raise _bad(name, f"'fmt ' chunk of {csize} bytes")
-            fmt = _parse_fmt(name, _read_exact(stream, csize + (csize & 1))[:csize], end)
-        elif cid == b"data":
-            if fmt is None:
-                raise _bad(name, "'data' chunk before the 'fmt ' chunk")
-            kind, bits, channels, rate = fmt
-            frames = -1 if csize in (0, 0xFFFFFFFF) else csize // (channels * bits // 8)
-            return WavInfo(rate, channels, kind, bits, 0, frames, end == ">")
-        else:
-            if csize > MAX_FMT_BYTES * 64:
-                raise _bad(name, f"a '{cid.decode('latin-1')}' chunk of {csize} bytes before the data")
-            _read_exact(stream, csize + (csize & 1))
-    raise _bad(name, f"no 'data' chunk among the first {MAX_CHUNKS} chunks")
+    def skip(n: int, cid: bytes, fmt) -> None:
+        if n > MAX_FMT_BYTES * 64:
+            raise _bad(name, f"a '{cid.decode('latin-1')}' chunk of {n} bytes before the data")
+        _read_exact(stream, n)
+
+    (kind, bits, channels, rate), end, csize = _riff_header(
+        name, lambda n: _read_exact(stream, n), skip, " (raw PCM needs --format and --rate)")
+    frames = -1 if csize in (0, 0xFFFFFFFF) else csize // (channels * bits // 8)
+    return WavInfo(rate, channels, kind, bits, 0, frames, end == ">")
 
 
 def iter_stream(stream, info: WavInfo, block_frames: int = 4096, name: str = "standard input"):
