@@ -53,16 +53,16 @@ def write_laser_part(flat, spec, folder: Path) -> list[dict]:
 
 
 def write_printed_part(name: str, solid, spec, folder: Path, pose: str | None = None) -> dict:
-    """STL + STEP of one solid in its print pose (:data:`PRINT_POSES`); returns the STL's read-back checks,
+    """STL + STEP of one solid in its print pose (:func:`print_poses`); returns the STL's read-back checks,
     the B-rep volume and the pose (bed face, design → print frame matrix)."""
     from matcad.export.mesh import mesh_checks, write_step, write_stl
-    from matcad.parts.catalogue import PRINT_POSES, in_print_pose
+    from matcad.parts.catalogue import in_print_pose, print_poses
 
     posed, matrix = in_print_pose(pose or name, solid)
     stl = folder / f"{name}.stl"
     tolerance = write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance, matrix)
     write_step(posed, folder / f"{name}.step")
-    pose = PRINT_POSES[pose or name]
+    pose = print_poses()[pose or name]
     return mesh_checks(stl) | {"brep_volume_mm3": float(posed.volume), "printed": pose.printed,
                                "bed_face": pose.bed_face, "rotation_x_deg": pose.rx_deg,
                                "design_to_print": matrix, "chordal_tolerance_mm": tolerance}

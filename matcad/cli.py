@@ -446,6 +446,7 @@ def _force_n(text: str) -> float:
 
 def _parser() -> argparse.ArgumentParser:
     import matcad
+    from matcad.acoustics.registry import model_choices
 
     parser = argparse.ArgumentParser(prog="matcad", description=matcad.__doc__,
                                      epilog="exit codes: " + "; ".join(f"{k} {v}" for k, v in EXIT_CODES.items()))
@@ -473,7 +474,8 @@ def _parser() -> argparse.ArgumentParser:
                         "[calibration], from paper Eq. 5 as well")
     p.add_argument("--force", dest="force_deprecated", type=_force_n, nargs="+", metavar="F",
                    help="deprecated spelling of --load")
-    p.add_argument("--model", help="use this model's f0 instead of the automatic choice ('fem' adds the FEM)")
+    p.add_argument("--model", choices=model_choices(),
+                   help="use this model's f0 instead of the automatic choice ('fem' adds the FEM)")
     p.add_argument("--fem-level", type=int, help="FEM mesh refinement: elements across the neck radius (default 8)")
 
     spec_arg(command("check", cmd_check, "run the design rules without building (exit 1 on errors)"))

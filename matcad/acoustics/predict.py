@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from matcad.acoustics import models
+from matcad.acoustics import models, registry
 from matcad.acoustics.air import VISCOUS_REGIME_EPS, boundary_layer_drop, boundary_layer_shift
 from matcad.acoustics.load import MAT_PAPER_2024, LoadCalibration, frequency_at_force_hz, invalid_reason
 from matcad.acoustics import wall as wall_model
@@ -129,7 +129,7 @@ def _model_warnings(name: str, result: ModelResult, diameter_ratio: float) -> li
     return [text[check] for check, ok in result.checks.items() if not ok]
 
 
-def _fem(spec, c_m_s: float, f_guess_hz: float, level: int) -> ModelResult:
+def fem_result(spec, c_m_s: float, f_guess_hz: float, level: int) -> ModelResult:
     """The FEM reference for this spec: rigid walls (acoustic eigenmode), or the elastic silicone cap coupled to
     the air (forced-response peak) at the middle of the spec's kHz modulus and loss ranges."""
     from matcad.acoustics import fem
@@ -224,7 +224,7 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
     results: dict[str, ModelResult] = {
         "lumped": ModelResult(float(evaluate(res, "lumped")),
                               {"neck_air_ratio_small": lumped_ok, "end_corrections_small": corrections_small},
-                              "paper Eq. 1 with c_f = 0 (Helmholtz/Rayleigh)"),
+                              registry.model("lumped").source),
         "end_corrected": ModelResult(
             float(evaluate(res, "end_corrected")),
             {"neck_air_ratio_small": lumped_ok, "ingard_xi_below_0.4": xi < models.INGARD_XI_LIMIT},
@@ -233,15 +233,16 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
     f_tl = float(evaluate(res, "transmission_line"))
     results["transmission_line"] = ModelResult(
         f_tl, _checks_plane_wave(f_tl, c, res.cavity_diameter, res.cavity_length),
-        "Selamet et al. 1997 transmission line, Kergomard & Garcia 1987 step correction")
+        registry.model("transmission_line").source)
     chosen = "transmission_line"
     if spec.wall.model == "silicone":
         results.update(_wall_results(spec, res))
         chosen = "elastic_wall"
-    if model == "fem":
+    solver = next((m for m in registry.MODELS if m.name == model and m.needs_skfem), None)
+    if solver is not None:
         from matcad.acoustics.fem import DEFAULT_LEVEL
 
-        results["fem"] = _fem(spec, c, results[chosen].f0_hz, fem_level or DEFAULT_LEVEL)
+        results[model] = solver.function()(spec, c, results[chosen].f0_hz, fem_level or DEFAULT_LEVEL)
     if spec.reference is not None:
         results["relative"] = _relative(spec, chosen, results[chosen])
         if model is None:

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.acoustics import geometry, models, wall
+from matcad.acoustics import geometry, models, registry, wall
 from matcad.acoustics.air import speed_of_sound_m_s
 from matcad.parts.features import cap_flange_thickness_mm
 
@@ -75,29 +75,53 @@ def wall_modes(res: Resonator, shear_modulus_pa: float) -> wall.Modes:
     return wall.modes(cap_shape(res), shear_modulus_pa, res.silicone_density)
 
 
+def lumped_hz(res: Resonator, shear_modulus_pa=None, loss_factor: float = 0.0):
+    """Paper Eq. 1 with c_f = 0 on the as-built resonator (Hz); the wall arguments are unused."""
+    return models.lumped_hz(res.c_m_s, res.neck_area, res.volume, res.neck_length)
+
+
+def end_corrected_hz(res: Resonator, shear_modulus_pa=None, loss_factor: float = 0.0):
+    """Eq. 1 with the mouth's outer and Ingard's inner end correction (Hz)."""
+    return models.end_corrected_hz(res.c_m_s, res.neck_area, res.volume,
+                                   res.neck_length + res.outer_correction + res.inner_ingard)
+
+
+def _step_neck_length_mm(res: Resonator) -> float:
+    """Neck length with the outer and the step (Kergomard & Garcia 1987) inner correction (mm)."""
+    return res.neck_length + res.outer_correction + res.inner_step
+
+
+def transmission_line_hz(res: Resonator, shear_modulus_pa=None, loss_factor: float = 0.0):
+    """Selamet et al. 1997 transmission line with rigid walls (Hz)."""
+    return models.transmission_line_hz(res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
+                                       res.cavity_length, 1.0, 0.0)
+
+
+def soft_wall_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0):
+    """The transmission line with a quasi-static silicone wall at shear modulus ``shear_modulus_pa`` (Pa, scalar
+    or array) (Hz)."""
+    n, extra = models.soft_wall_length_scale(shear_modulus_pa, res.cavity_diameter, res.cap_outer_diameter)
+    return models.transmission_line_hz(res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
+                                       res.cavity_length, n, extra)
+
+
+def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0):
+    """The transmission line coupled to the cap's wall modes at the (dynamic) shear modulus (Pa, scalar) and
+    loss factor: peak of the driven response (Hz)."""
+    f_tl = transmission_line_hz(res)
+    return f_tl * wall.peak_ratio(float(f_tl), res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
+                                  res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor)
+
+
 def evaluate(res: Resonator, model: str, shear_modulus_pa=None, loss_factor: float = 0.0):
-    """f0 (Hz) of one cheap model; ``soft_wall`` takes the shear modulus (Pa, scalar or array), ``elastic_wall``
-    the (dynamic) shear modulus (Pa, scalar) and the loss factor."""
-    if model == "lumped":
-        return models.lumped_hz(res.c_m_s, res.neck_area, res.volume, res.neck_length)
-    if model == "end_corrected":
-        return models.end_corrected_hz(res.c_m_s, res.neck_area, res.volume,
-                                       res.neck_length + res.outer_correction + res.inner_ingard)
-    n, extra = 1.0, 0.0
-    l_eff = res.neck_length + res.outer_correction + res.inner_step
-    if model == "elastic_wall":
-        f_tl = evaluate(res, "transmission_line")
-        return f_tl * wall.peak_ratio(float(f_tl), res.c_m_s, res.neck_area, res.cavity_area, l_eff,
-                                      res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor)
-    if model == "soft_wall":
-        n, extra = models.soft_wall_length_scale(shear_modulus_pa, res.cavity_diameter, res.cap_outer_diameter)
-    elif model != "transmission_line":
+    """f0 (Hz) of one cheap model of :mod:`matcad.acoustics.registry`; ``soft_wall`` takes the shear modulus
+    (Pa, scalar or array), ``elastic_wall`` the (dynamic) shear modulus (Pa, scalar) and the loss factor."""
+    if model not in CHEAP_MODELS:
         raise ValueError(f"model {model!r} invalid, must be one of {list(CHEAP_MODELS)}")
-    return models.transmission_line_hz(res.c_m_s, res.neck_area, res.cavity_area, l_eff, res.cavity_length, n,
-                                       extra)
+    return registry.model(model).function()(res, shear_modulus_pa, loss_factor)
 
 
-CHEAP_MODELS = ("lumped", "end_corrected", "transmission_line", "soft_wall", "elastic_wall")
+CHEAP_MODELS = registry.cheap_models()
 
 
 def shear_moduli_pa(spec) -> tuple[float, float, float]:

@@ -12,14 +12,18 @@ from matcad.parts.features import cap_flange_thickness_mm, plate_bolt_positions_
 from matcad.parts.guide import guide
 from matcad.parts.neck_plate import neck_plate
 from matcad.parts.needle_mount import needle, needle_mount
+from matcad.parts.registry import parts as registered_parts
 from matcad.parts.solid import flat_solid
 from matcad.parts.spacer import spacer
 from matcad.render.section import annotate_section
 
-SECTION_COLOURS = {
-    "neck_plate": "#9cc8f0", "guide_locator": "#c4e0fa", "guide_clamp": "#c4e0fa", "end_cap": "#f0a050",
-    "needle_mount": "#b4b4b4", "needle": "#404040", "spacer": "#d8d0f8",
-}
+NEEDLE_COLOUR = "#404040"
+"""Section fill of the bought needle (drawn for clearance; not a registered part)."""
+
+
+def section_colours() -> dict[str, str]:
+    """Section fill per layer: each registered part's colour, and the needle's."""
+    return {p.name: p.colour for p in registered_parts()} | {"needle": NEEDLE_COLOUR}
 
 
 def drilled(plate, neck_diameter: float):
@@ -63,14 +67,14 @@ def write_section_svg(spec, path, parts=None) -> None:
     labels and the design's dimensions (:func:`matcad.render.section.annotate_section`)."""
     parts = parts or assembled_parts(spec)
     svg = ExportSVG(margin=2.0, line_weight=0.05)
-    layers = set()
+    layers, colours = set(), section_colours()
     for name, solid in parts.items():
         cut = solid & Plane.XZ
         if not cut or not cut.faces():
             continue
         layer = name.rsplit("_", 1)[0] if name.startswith("spacer_") else name
         if layer not in layers:
-            svg.add_layer(layer, fill_color=SECTION_COLOURS[layer], line_color="#000000")
+            svg.add_layer(layer, fill_color=colours[layer], line_color="#000000")
             layers.add(layer)
         svg.add_shape(Rot(-90, 0, 0) * cut, layer=layer)  # XZ plane → drawing plane, z up
     svg.write(str(path))

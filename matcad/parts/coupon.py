@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from matcad.parts.features import bolt_clearance_mm, sheet_kerf_mm, sheet_thickness_mm
 from matcad.parts.flat import Engraving, Flat, Hole, engraving_outlines
+from matcad.parts.registry import Kind, PrintPose, parts
 
 NECK_SWEEP_MM = (-0.2, -0.15, -0.1, -0.05, 0.0, 0.05, 0.1, 0.15, 0.2)
 DOWEL_SWEEP_MM = (0.0, 0.05, 0.1, 0.15, 0.2)
@@ -28,6 +29,8 @@ LABEL_GAP_MM = 1.0
 
 
 BOLT_SWEEP_MM = (-0.2, -0.1, 0.0, 0.1, 0.2)
+PRINTED_COUPON_POSE = PrintPose(0.0, "flat underside")
+"""How coupon_printed.stl is exported."""
 SHEET_ROWS = {"plate": ("neck", "dowel"), "guide": ("dowel", "bolt"), "spacer": ("bolt",)}
 """Which fits each sheet's coupon sweeps: the holes that sheet really carries."""
 
@@ -46,7 +49,8 @@ def _sweep(spec, purpose: str) -> list[float]:
 
 def coupon_sheets(spec) -> list[str]:
     """The sheets (keys of features.SHEETS) the kit cuts: one laser coupon each."""
-    return ["plate", "guide"] + (["spacer"] if spec.spacer.style == "laser" else [])
+    sheets = [p.sheet for p in parts() if p.kind is Kind.LASER and (p.when is None or p.when(spec))]
+    return list(dict.fromkeys(sheets))
 
 
 def laser_coupon(spec, sheet: str = "plate") -> Flat:

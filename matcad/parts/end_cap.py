@@ -6,7 +6,7 @@ Own frame: base on z = 0 (it sits on the neck plate), axis along +z, cavity open
 import math
 
 from matcad.parts.features import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
-from matcad.parts.solid import cylinder_up, frustum_up
+from matcad.parts.registry import Kind, Part, PrintPose
 
 
 def cavity_tip_radius_mm(spec) -> float:
@@ -16,6 +16,8 @@ def cavity_tip_radius_mm(spec) -> float:
 
 def cap_envelope(spec):
     """The cap's outer shape (flange + body), cavity not removed (mm)."""
+    from matcad.parts.solid import cylinder_up
+
     flange = cylinder_up(cap_flange_diameter_mm(spec) / 2, cap_flange_thickness_mm(spec))
     body = cylinder_up(spec.end_cap.outer_diameter / 2, cap_height_mm(spec))
     return flange + body
@@ -23,9 +25,16 @@ def cap_envelope(spec):
 
 def core_pin(spec):
     """The cavity's shape: a frustum from D at z = 0 to the drafted tip at z = L (mm)."""
+    from matcad.parts.solid import frustum_up
+
     return frustum_up(spec.cavity.diameter / 2, cavity_tip_radius_mm(spec), spec.cavity.length)
 
 
 def end_cap(spec):
     """The silicone end cap solid; its volume is the cast volume (mm³)."""
     return cap_envelope(spec) - core_pin(spec)
+
+
+PARTS = (Part("end_cap", Kind.CAST, flag="end_cap_mold", make=end_cap, order=50, colour="#f0a050",
+              pose=PrintPose(0.0, "base (the sealing face), cavity opening down: cast, not printed", printed=False),
+              view=("from below: the cavity's open end", -90.0, -90.0), label="silicone end cap"),)

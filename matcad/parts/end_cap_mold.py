@@ -14,29 +14,35 @@ the core pin's end face over the sensing membrane, vented along the pin's axis.
 
 from __future__ import annotations
 
-from build123d import Box, Pos, Rot
-
 from matcad.parts.end_cap import cap_envelope, core_pin, end_cap
 from matcad.parts.features import bolt_clearance_mm
 from matcad.parts.mold_layout import MoldLayout, layout  # noqa: F401  (the layout is part of this part's API)
-from matcad.parts.solid import BOTTOM, TOP, cylinder_up, frustum_up
+from matcad.parts.registry import Kind, Part, PrintPose
 
 KEY_TOP_RATIO = 0.6
 """Key top diameter / base diameter: a truncated cone that self-centres as the lid closes."""
 
 
 def _key(spec, grow: float, x: float, y: float):
+    from matcad.parts.solid import frustum_up
+
     m = spec.mold
     r = m.key_diameter / 2
     return frustum_up(r + grow, r * KEY_TOP_RATIO + grow, m.key_height + grow, x, y, 0.0)
 
 
 def _upside_down(shape, x: float):
+    from build123d import Pos, Rot
+
     return Pos(x, 0, 0) * Rot(180, 0, 0) * shape
 
 
 def mold_base(spec):
     """Base block: top face at z = 0, cap negatives upside down, keys on top, bolt holes (mm)."""
+    from build123d import Box
+
+    from matcad.parts.solid import TOP, cylinder_up
+
     lay = layout(spec)
     bolt_r = bolt_clearance_mm(spec.mold.bolt, "normal") / 2
     block = Box(lay.block_x, lay.block_y, lay.base_height, align=TOP)
@@ -48,6 +54,10 @@ def mold_base(spec):
 def mold_lid(spec):
     """Lid: bottom face at z = 0, core pins (each vented along its axis) hanging into the caps, key sockets, fill
     ports, vents, bolts (mm)."""
+    from build123d import Box
+
+    from matcad.parts.solid import BOTTOM, cylinder_up
+
     lay = layout(spec)
     m = spec.mold
     lid = Box(lay.block_x, lay.block_y, m.lid_thickness, align=BOTTOM)
@@ -64,3 +74,11 @@ def mold_lid(spec):
 def cast_caps(spec):
     """The caps as they sit in the closed mold (for checks: they must touch, not cut, the mold) (mm)."""
     return [_upside_down(end_cap(spec), x) for x in layout(spec).cap_x]
+
+
+PARTS = (Part("end_cap_mold_base", Kind.PRINTED, flag="end_cap_mold", make=mold_base, order=60, colour="#e0c090",
+              pose=PrintPose(0.0, "flat underside; cap cavities and keys face up"),
+              view=("from above: cap cavities, fill ports, vents", 90.0, -90.0)),
+         Part("end_cap_mold_lid", Kind.PRINTED, flag="end_cap_mold", make=mold_lid, order=70, colour="#e0c090",
+              pose=PrintPose(180.0, "outer (top) face; core pins point up, the parting face prints last"),
+              view=("from above (as printed, pins up): core pins, vents, key sockets", 90.0, -90.0)))

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.parts.catalogue import laser_parts
+from matcad.parts.registry import Kind, wanted
 
 WHY_CALIPER = {
     "neck_plate": "its thickness is the neck length l, which sets f",
@@ -85,20 +86,18 @@ def steps(spec) -> list[dict]:
     step("laser + printer", ["matcad coupon"], "Cut one coupon per sheet (coupon_<sheet>.dxf) and print "
          "coupon_printed.stl; set each sheet's laser_kerf from the hole that fits its pin, and the needle/dowel "
          "fits from the printed bores; rebuild")
-    cuts = {"plate": ["neck_plate.dxf"] if o.neck_plate else [],
-            "guide": ["guide_locator.dxf", "guide_clamp.dxf"] if o.guides else [],
-            "spacer": ["spacer.dxf"] if o.spacers and spec.spacer.style == "laser" else []}
+    cuts: dict[str, list[str]] = {}
+    for part in wanted(spec, Kind.LASER):
+        cuts.setdefault(part.sheet, []).append(f"{part.name}.dxf")
     for sheet, files in cuts.items():
-        if files:
-            t, _ = sheet_thickness_mm(spec, sheet)
-            step(f"laser, {t:g} mm acrylic", files, f"Cut the {SHEETS[sheet]} from the {t:g} mm sheet, kerf "
-                 f"{sheet_kerf_mm(spec, sheet):g} mm (already compensated in the file: cut on the line; inner "
-                 "cuts first, engraving as score)")
+        t, _ = sheet_thickness_mm(spec, sheet)
+        step(f"laser, {t:g} mm acrylic", files, f"Cut the {SHEETS[sheet]} from the {t:g} mm sheet, kerf "
+             f"{sheet_kerf_mm(spec, sheet):g} mm (already compensated in the file: cut on the line; inner "
+             "cuts first, engraving as score)")
     if o.neck_plate and spec.plate.neck_pilot:
         step("drill", ["neck_plate.dxf"], f"Drill the neck pilot to {spec.neck.diameter:g} mm (drill press, "
              "plate clamped flat, back it with scrap)")
-    printed = (["end_cap_mold_base.stl", "end_cap_mold_lid.stl"] if o.end_cap_mold else []) + \
-        (["needle_mount.stl"] if o.needle_mount else [])
+    printed = [f"{part.name}.stl" for part in wanted(spec, Kind.PRINTED)]
     if printed:
         step(f"printer ({spec.machine.printer})", printed, "Print each part as exported (flat face down, no "
              "supports; the report's mesh table gives each part's bed face)")

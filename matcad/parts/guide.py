@@ -4,8 +4,11 @@ The locator surrounds the cap's base flange; the clamp lies over the flange with
 the bolts press it down so the flange (guide thickness + squeeze) seals against the plate.
 """
 
+import functools
+
 from matcad.parts.features import cap_flange_diameter_mm, laser_stack_holes, sheet_kerf_mm
 from matcad.parts.flat import Flat, Hole, edge_label
+from matcad.parts.registry import Kind, Part
 
 BODY_CLEARANCE_MM = 0.2
 """Diametral clearance of the clamp's hole around the silicone body, so clamping does not pinch the cavity."""
@@ -27,3 +30,9 @@ def guide(spec, role: str) -> Flat:
                 depth=spec.plate.depth, holes=holes,
                 engrave=edge_label(f"{role.upper()} {spec.guide.thickness:g}", spec.plate.width, spec.plate.depth,
                                    holes))
+
+
+PARTS = (Part("guide_locator", Kind.LASER, flag="guides", make=functools.partial(guide, role="locator"), order=20,
+              colour="#c4e0fa", sheet="guide", label="locator guide"),
+         Part("guide_clamp", Kind.LASER, flag="guides", make=functools.partial(guide, role="clamp"), order=30,
+              colour="#c4e0fa", sheet="guide", label="clamp guide"))

@@ -2,6 +2,7 @@
 
 from matcad.parts.features import laser_stack_holes, sheet_kerf_mm
 from matcad.parts.flat import Engraving, Flat, Hole, edge_label
+from matcad.parts.registry import Kind, Part
 
 
 def neck_plate(spec) -> Flat:
@@ -19,3 +20,7 @@ def neck_plate(spec) -> Flat:
     return Flat(name="neck_plate", thickness=spec.neck.length, thickness_measured=spec.plate.thickness_measured,
                 kerf=sheet_kerf_mm(spec, "plate"), width=spec.plate.width, depth=spec.plate.depth, holes=holes,
                 engrave=label)
+
+
+PARTS = (Part("neck_plate", Kind.LASER, flag="neck_plate", make=neck_plate, order=10, colour="#9cc8f0",
+              sheet="plate", label="neck plate (acrylic, l thick)"),)

@@ -7,12 +7,10 @@ pilots; dowels press into it; with ``spacer.style = "standoff"`` the spacers are
 
 import math
 
-from build123d import Box, Pos
-
 from matcad.parts.features import (EAR_THICKNESS_MM, EAR_WIDTH_MM, FIXING_BOLT, SELF_TAP_PILOT_MM, bolt_clearance_mm,
                                    ear_holes_mm, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
                                    plate_bolt_positions_mm, plate_dowel_positions_mm)
-from matcad.parts.solid import BOTTOM, TOP, cylinder_up, tilted_cylinder
+from matcad.parts.registry import Kind, Part, PrintPose
 
 
 def needle_bore_diameter_mm(spec) -> float:
@@ -22,6 +20,8 @@ def needle_bore_diameter_mm(spec) -> float:
 
 def _on_needle_axis(spec, start, radius: float, length: float):
     """Cylinder of ``radius`` on the needle axis, from point ``start`` on it back ``length`` mm (mm)."""
+    from matcad.parts.solid import tilted_cylinder
+
     return tilted_cylinder(radius, length, start, spec.needle.theta_deg)
 
 
@@ -33,6 +33,10 @@ def needle(spec):
 def needle_mount(spec):
     """The mount solid in the assembly frame (mm): block, fixing ears, standoffs (if printed), bolt pilots,
     dowel holes, the needle bore."""
+    from build123d import Box, Pos
+
+    from matcad.parts.solid import BOTTOM, TOP, cylinder_up
+
     gap, thick = spec.spacer.height, spec.mount.thickness
     top = -gap
     body = Pos(0, 0, top) * Box(spec.plate.width, spec.plate.depth, thick, align=TOP)
@@ -57,3 +61,7 @@ def needle_mount(spec):
                 for x, y in ear_holes_mm(spec)])
     return body.cut(*holes)
 
+
+PARTS = (Part("needle_mount", Kind.PRINTED, flag="needle_mount", make=needle_mount, order=80, colour="#b4b4b4",
+              pose=PrintPose(0.0, "flat underside; standoffs and the needle bore's mouth face up"),
+              view=("from the side: the needle bore at θ", 0.0, -90.0), label="needle mount (printed)"),)

@@ -2,6 +2,7 @@
 
 from matcad.parts.features import bolt_clearance_mm, plate_bolt_positions_mm, sheet_kerf_mm
 from matcad.parts.flat import Flat, Hole
+from matcad.parts.registry import Kind, Part
 
 
 def spacer(spec) -> Flat:
@@ -12,3 +13,12 @@ def spacer(spec) -> Flat:
                 width=spec.spacer.size, depth=spec.spacer.size,
                 holes=(Hole(0.0, 0.0, bolt, "bolt", spec.fasteners.bolt_fit),),
                 quantity=len(plate_bolt_positions_mm(spec)), corner_radius=0.5)
+
+
+def is_laser_cut(spec) -> bool:
+    """Whether the spacers are laser-cut parts (else they are standoffs printed on the needle mount)."""
+    return spec.spacer.style == "laser"
+
+
+PARTS = (Part("spacer", Kind.LASER, flag="spacers", make=spacer, order=40, colour="#d8d0f8", sheet="spacer",
+              when=is_laser_cut),)

@@ -1,7 +1,7 @@
 """Part previews (PNG): printed parts from their STL triangles, laser parts from their cut plan. Units mm.
 
-A printed part gets two views side by side: isometric, and the face that matters for it (:data:`FACE_VIEWS`:
-the mold base from above shows the cap cavities and fill ports, the lid from below its core pins, ...).
+A printed part gets two views side by side: isometric, and the face that matters for it (its registry entry's
+``view``: the mold base from above shows the cap cavities and fill ports, the lid from below its core pins, ...).
 A laser part gets its cut plan as the laser sees it (kerf-compensated outline and holes, hole sizes labelled).
 """
 
@@ -15,17 +15,16 @@ from matcad.render.figure import figure
 
 ISOMETRIC = (35.264, -45.0)
 """(elevation, azimuth) in degrees of the isometric view: elevation atan(1/√2)."""
-FACE_VIEWS: dict[str, tuple[str, float, float]] = {
-    "end_cap": ("from below: the cavity's open end", -90.0, -90.0),
-    "end_cap_mold_base": ("from above: cap cavities, fill ports, vents", 90.0, -90.0),
-    "end_cap_mold_lid": ("from above (as printed, pins up): core pins, vents, key sockets", 90.0, -90.0),
-    "needle_mount": ("from the side: the needle bore at θ", 0.0, -90.0),
-}
-"""Part → (caption, elevation, azimuth) of the view that shows what matters on it."""
-DEFAULT_FACE = ("from above", 90.0, -90.0)
 LIGHT = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
 BASE_RGB = np.array([0.35, 0.55, 0.85])
 FLAT_COLOURS = {"outline": "#d03030", "hole": "#2040d0", "engrave": "#109010", "reference": "#c000c0"}
+
+
+def face_view(name: str) -> tuple[str, float, float]:
+    """(caption, elevation, azimuth in degrees) of the view that shows what matters on part ``name``."""
+    from matcad.parts.registry import DEFAULT_VIEW, parts
+
+    return next((p.view for p in parts() if p.name == name and p.view), DEFAULT_VIEW)
 
 
 def preview_name(part: str) -> str:
@@ -68,7 +67,7 @@ def _mesh_axes(ax, triangles: np.ndarray, elev: float, azim: float, title: str) 
 def printed_preview(name: str, stl: Path, path: Path) -> dict:
     """Isometric view and the face that matters of the STL ``stl``, side by side in ``path`` (PNG)."""
     triangles = read_stl_triangles(stl)
-    caption, elev, azim = FACE_VIEWS.get(name, DEFAULT_FACE)
+    caption, elev, azim = face_view(name)
     size = np.ptp(triangles.reshape(-1, 3), axis=0)
     with figure(path, 7.2, 3.4) as fig:
         _mesh_axes(fig.add_subplot(1, 2, 1, projection="3d"), triangles, *ISOMETRIC, "isometric")

@@ -16,11 +16,7 @@ from pathlib import Path
 
 SVG_NS = "http://www.w3.org/2000/svg"
 INK = "#203060"
-PART_NAMES = {
-    "neck_plate": "neck plate (acrylic, l thick)", "guide_locator": "locator guide", "guide_clamp": "clamp guide",
-    "end_cap": "silicone end cap", "needle_mount": "needle mount (printed)", "needle": "air-supply needle",
-    "spacer": "spacer",
-}
+NEEDLE_LABEL = "air-supply needle"
 
 
 @dataclass
@@ -139,7 +135,11 @@ def _label_points(spec) -> dict[str, tuple[float, float]]:
 
 
 def _labels(spec, present: set[str], draw: _Drawing) -> None:
-    """Part names in a column left of the drawing, leaders to a point in each part, spread so none overlap."""
+    """Part names (each registered part's section label, and the needle's) in a column left of the drawing,
+    leaders to a point in each part, spread so none overlap."""
+    from matcad.parts.registry import parts
+
+    names = {p.name: p.section_label for p in parts()} | {"needle": NEEDLE_LABEL}
     points = {name: xz for name, xz in _label_points(spec).items() if name in present}
     x_text = -spec.plate.width / 2 - 2.0 * draw.font
     z_prev = math.inf
@@ -147,7 +147,7 @@ def _labels(spec, present: set[str], draw: _Drawing) -> None:
         z_text = min(z, z_prev - 1.5 * draw.font)
         z_prev = z_text
         draw.line(x, z, x_text + 0.3 * draw.font, z_text + 0.35 * draw.font, colour="#404040")
-        draw.text(x_text, z_text, PART_NAMES[name], anchor="end")
+        draw.text(x_text, z_text, names[name], anchor="end")
 
 
 def annotate_section(spec, path: Path) -> None:
