@@ -363,6 +363,30 @@ def cmd_sense(args) -> int:
     return EXIT_OK
 
 
+def cmd_sweep(args) -> int:
+    from matcad.spec_input import apply_sets, read_spec_data
+    from matcad.sweep import Executor, parse_axes, sweep
+    from matcad.sweep.outputs import write
+
+    if not 1 <= args.workers <= 256:
+        raise ValueError(f"--workers {args.workers} invalid, must be 1-256 local processes")
+    axes = parse_axes(args.vary)
+    data = apply_sets(read_spec_data(args.spec), args.set)
+    _load_spec(args.spec, args)  # validates the base spec (exit 2 naming the field) and prints its notes
+    result = sweep(data, axes, model=args.model, executor=Executor(args.workers, args.scheduler),
+                   rules=not args.no_rules, cad=args.cad, fem_level=args.fem_level)
+    target, files = write(result, args.out or Path("out") / f"{result.name}-sweep")
+    counts = {s: sum(r["status"] == s for r in result.rows) for s in ("ok", "invalid", "failed")}
+    if args.json:
+        _print_json({"out_dir": str(target), "written": files, "model": result.model, "variants": len(result.rows),
+                     **counts, "seconds": round(result.seconds, 3)})
+    else:
+        print(f"{result.name}: {len(result.rows)} variants ({counts['ok']} ok, {counts['invalid']} invalid, "
+              f"{counts['failed']} failed) by {result.model} on {result.executor} in {result.seconds:.1f} s")
+        print(f"  {', '.join(files)} in {target}/")
+    return EXIT_OK
+
+
 def _write_json(path: Path, data) -> None:
     import json
 
@@ -520,6 +544,22 @@ def _parser() -> argparse.ArgumentParser:
                          help="raw PCM sample format on standard input (default: a WAV header is expected)")
         cmd.add_argument("--rate", type=float, help="raw PCM sample rate (Hz)")
         cmd.add_argument("--channels", type=int, default=1, help="raw PCM channels (default 1), averaged")
+
+    w = command("sweep", cmd_sweep, "f0, band, sensitivity and rule verdicts over a grid of designs (table + maps)",
+                "out/<name>-sweep")
+    spec_arg(w)
+    w.add_argument("--vary", action="append", required=True, metavar="FIELD=LO:HI:N",
+                   help="vary a numeric spec field over N evenly spaced values (or FIELD=a,b,c); repeat for a "
+                        "full grid (e.g. --vary cavity.length=3:6:7 --vary neck.diameter=1.5,2.1)")
+    w.add_argument("--model", help="model for every variant (default the spec's own choice; 'fem' adds the FEM)")
+    w.add_argument("--fem-level", type=int, help="FEM mesh refinement with --model fem (default 8)")
+    w.add_argument("--workers", type=int, default=1, help="local processes for the per-variant work (default 1)")
+    w.add_argument("--scheduler", metavar="ADDRESS", help="run the per-variant work on this Dask scheduler "
+                                                          "(tcp://host:8786; needs matcad[cluster])")
+    w.add_argument("--no-rules", action="store_true", help="skip the design rules (fast-model sweeps then "
+                                                           "need no per-variant work)")
+    w.add_argument("--cad", action="store_true", help="also build each variant's end cap (build123d) and read "
+                                                      "its STL volume back")
 
     command("schema", cmd_schema, "print every spec field with unit, default and allowed range")
 

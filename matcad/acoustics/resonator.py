@@ -6,7 +6,7 @@ the chosen model on perturbed specs).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -44,23 +44,34 @@ class Resonator:
         return float(np.sqrt(self.neck_area / self.cavity_area))
 
 
+def as_built(c_m_s, cavity_diameter, cavity_length, neck_diameter, neck_length, draft_deg, mouth, gap_mm,
+             gap_radius_mm) -> Resonator:
+    """The acoustic quantities of as-built geometry (mm, m/s), broadcast over numpy arrays (a sweep's variants):
+    the drafted cavity as its equal-volume cylinder, the neck and its end corrections. The cap fields are NaN;
+    :func:`resonator` fills them from a spec."""
+    volume = geometry.drafted_cavity_volume_mm3(cavity_diameter, cavity_length, draft_deg)
+    cav_diameter = geometry.equivalent_diameter_mm(volume, cavity_length)
+    nan = float("nan")
+    return Resonator(
+        c_m_s=c_m_s, volume=volume, cavity_diameter=cav_diameter, cavity_length=cavity_length,
+        neck_area=geometry.neck_area_mm2(neck_diameter), cavity_area=geometry.circle_area_mm2(cav_diameter),
+        neck_length=neck_length,
+        outer_correction=models.mouth_end_correction_mm(mouth, neck_diameter / 2, gap_mm, gap_radius_mm),
+        inner_ingard=models.ingard_end_correction_mm(neck_diameter, cav_diameter),
+        inner_step=models.step_end_correction_mm(neck_diameter, cav_diameter),
+        cap_outer_diameter=nan, cap_top_thickness=nan, cap_clamp_height=nan, silicone_density=nan)
+
+
 def resonator(spec) -> Resonator:
-    """Derive the as-built acoustic quantities of ``spec``."""
+    """Derive the as-built acoustic quantities of ``spec`` (:func:`as_built` plus the cap, as floats)."""
     cav, neck = spec.cavity, spec.neck
     c = float(spec.air.speed_of_sound or speed_of_sound_m_s(spec.air.temperature_c))
-    volume = float(geometry.drafted_cavity_volume_mm3(cav.diameter, cav.length, spec.mold.draft_deg))
-    cav_diameter = float(geometry.equivalent_diameter_mm(volume, cav.length))
-    gap_radius = min(spec.plate.width, spec.plate.depth) / 2.0
-    return Resonator(
-        c_m_s=c, volume=volume, cavity_diameter=cav_diameter, cavity_length=cav.length,
-        neck_area=float(geometry.neck_area_mm2(neck.diameter)),
-        cavity_area=float(geometry.circle_area_mm2(cav_diameter)), neck_length=neck.length,
-        outer_correction=float(models.mouth_end_correction_mm(neck.mouth, neck.diameter / 2, spec.spacer.height,
-                                                               gap_radius)),
-        inner_ingard=float(models.ingard_end_correction_mm(neck.diameter, cav_diameter)),
-        inner_step=float(models.step_end_correction_mm(neck.diameter, cav_diameter)),
-        cap_outer_diameter=spec.end_cap.outer_diameter, cap_top_thickness=spec.end_cap.top_thickness,
-        cap_clamp_height=cap_flange_thickness_mm(spec), silicone_density=spec.silicone.density_g_cm3 * 1000.0)
+    res = as_built(c, cav.diameter, cav.length, neck.diameter, neck.length, spec.mold.draft_deg, neck.mouth,
+                   spec.spacer.height, min(spec.plate.width, spec.plate.depth) / 2.0)
+    values = {f.name: float(getattr(res, f.name)) for f in fields(Resonator)}
+    values.update(cap_outer_diameter=spec.end_cap.outer_diameter, cap_top_thickness=spec.end_cap.top_thickness,
+                  cap_clamp_height=cap_flange_thickness_mm(spec), silicone_density=spec.silicone.density_g_cm3 * 1000.0)
+    return Resonator(**values)
 
 
 def cap_shape(res: Resonator) -> wall.CapShape:

@@ -1,0 +1,151 @@
+"""A design sweep: every variant of the grid → f0, band, sensitivities and rule verdicts, one row each.
+
+Frequencies Hz; sensitivities in Hz per the varied field's unit (Hz/mm for lengths) and Hz/N.
+
+- The closed-form rungs (:data:`matcad.sweep.fast.VECTORISED`) are evaluated on all variants at once; their
+  df0/dfield is the model's own derivative (central difference at each variant).
+- Any other model (elastic_wall, soft_wall, relative, fem) runs :func:`matcad.acoustics.predict.predict` per
+  variant on the executor; df0/dfield is then the slope of f0 along that axis of the grid (``numpy.gradient``:
+  central differences inside, one-sided at the ends; blank for an axis of one value or next to a failed variant).
+- df0/dF (Hz/N) is paper Eq. 5's slope at 0 N, f(0)·b/(2·V0), from the spec's [calibration] (blank without one):
+  it follows the neck and the air, not the cavity, because V0 is the calibrated taxel's. The cap mechanics
+  (FElupe, seconds per variant) is not run in a sweep.
+- The design rules run per variant on the executor (on the sweep model's prediction) unless ``rules=False``.
+Variants that fail validation or a solver are rows with ``status`` invalid or failed and the reason.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from matcad.sweep import fast
+from matcad.sweep.executor import Executor, run as run_tasks
+from matcad.sweep.grid import Axis, grid, variant_data
+from matcad.sweep.tasks import run_chunk
+
+RESULT_KEYS = ("status", "reason", "f0_hz", "band_low_hz", "band_high_hz", "model_valid", "rule_errors",
+               "rule_warnings", "failing_rules", "cad_stl_volume_mm3", "cad_closed_form_volume_mm3",
+               "cad_watertight", "cad_triangles")
+"""What a worker's result may set in a row (its timing is summed, not tabulated, so tables compare equal)."""
+
+
+def sensitivity_column(axis: Axis) -> str:
+    """Column name of df0/d(field), e.g. ``df0_d_cavity.length_hz_per_mm``."""
+    unit = axis.unit.replace("/", "_").replace("^", "") or "unit"
+    return f"df0_d_{axis.field}_hz_per_{unit}"
+
+
+LOAD_SENSITIVITY = "df0_dF_hz_per_n"
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """The table (one dict per variant, grid order: the first axis varies slowest) and how it was made."""
+
+    name: str
+    model: str
+    axes: tuple[Axis, ...]
+    rows: tuple[dict, ...]
+    vectorised: bool
+    executor: str
+    rules: bool
+    seconds: float
+    worker_seconds: float
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(a.values) for a in self.axes)
+
+    def columns(self) -> list[str]:
+        names = ["index", *(a.field for a in self.axes), "status", "reason", "model", "f0_hz", "band_low_hz",
+                 "band_high_hz", "model_valid", *(sensitivity_column(a) for a in self.axes), LOAD_SENSITIVITY]
+        if self.rules:
+            names += ["rule_errors", "rule_warnings", "failing_rules"]
+        extra = sorted({k for r in self.rows for k in r if k.startswith("cad_")})
+        return names + extra
+
+    def column(self, name: str) -> np.ndarray:
+        """A numeric column as a float array in grid shape (NaN where a variant has no value)."""
+        values = [r.get(name) for r in self.rows]
+        return np.array([np.nan if v is None or v == "" else float(v) for v in values]).reshape(self.shape)
+
+
+def allowed_models(spec) -> list[str]:
+    """Model names ``--model`` accepts for ``spec``: the cheap rungs, ``fem``, and ``relative`` with a
+    [reference]."""
+    from matcad.acoustics.resonator import CHEAP_MODELS
+
+    return [*CHEAP_MODELS, "fem", *(["relative"] if spec.reference is not None else [])]
+
+
+def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor: Executor = Executor(),
+          rules: bool = True, cad: bool = False, fem_level: int | None = None) -> SweepResult:
+    """Sweep the spec ``data`` (raw TOML-like data; each variant is it with the axes' values set, validated like a
+    file, so defaults such as the cap's 2.5 × D follow the varied cavity) over the full grid of ``axes``.
+    ``model`` defaults to the spec's own choice (:func:`predict`); ``cad`` also builds each variant's end cap."""
+    from matcad.acoustics.predict import predict, spec_calibration
+    from matcad.acoustics.load import frequency_at_force_hz
+    from matcad.spec import SpecError, from_dict
+
+    start = time.perf_counter()
+    base = from_dict(data)
+    if model is None:
+        model = predict(base, mechanics=False).model
+    elif model not in allowed_models(base):
+        raise ValueError(f"--model {model!r} invalid, must be one of {', '.join(allowed_models(base))}")
+    rows: list[dict] = []
+    datas, specs = {}, {}
+    for i, values in enumerate(grid(axes)):
+        rows.append({"index": i, **{a.field: v for a, v in zip(axes, values)}, "status": "ok", "reason": "",
+                     "model": model})
+        datas[i] = variant_data(data, axes, values)
+        try:
+            specs[i] = from_dict(datas[i])
+        except SpecError as exc:
+            rows[i].update(status="invalid", reason=str(exc))
+    ok = sorted(specs)
+    vectorised = model in fast.VECTORISED
+    if vectorised and ok:
+        v = fast.from_specs([specs[i] for i in ok])
+        f0 = fast.f0_hz(v, model)
+        valid = fast.valid(v, model, f0)
+        low, high = fast.band_hz(v, model, f0, valid)
+        slopes = {sensitivity_column(a): fast.sensitivity(v, model, a.field) for a in axes}
+        for j, i in enumerate(ok):
+            rows[i].update(f0_hz=float(f0[j]), band_low_hz=float(low[j]), band_high_hz=float(high[j]),
+                           model_valid=bool(valid[j]), **{k: float(s[j]) for k, s in slopes.items()})
+    for i in ok:
+        cal = spec_calibration(specs[i])
+        if cal is not None:
+            s = specs[i]
+            c = s.air.speed_of_sound or float(fast.speed_of_sound_m_s(s.air.temperature_c))
+            f_zero = float(frequency_at_force_hz(cal, 0.0, c, s.neck.diameter, s.neck.length))
+            rows[i][LOAD_SENSITIVITY] = f_zero * cal.b / (2.0 * cal.v0_mm3)
+    worker_seconds = 0.0
+    if not vectorised or rules or cad:
+        tasks = [{"index": i, "data": datas[i], "model": model, "fem_level": fem_level, "predict": not vectorised,
+                  "rules": rules, "cad": cad} for i in ok]
+        for result in run_tasks(run_chunk, tasks, executor):
+            worker_seconds += result.get("seconds", 0.0)
+            rows[result["index"]].update({k: v for k, v in result.items() if k in RESULT_KEYS or k.startswith("cad_")})
+    result = SweepResult(base.name, model, tuple(axes), tuple(rows), vectorised, executor.describe(), rules,
+                         0.0, worker_seconds)
+    if not vectorised:
+        _grid_slopes(result)
+    return SweepResult(**{**result.__dict__, "seconds": time.perf_counter() - start})
+
+
+def _grid_slopes(result: SweepResult) -> None:
+    """df0/dfield along each axis of the grid for the per-variant models (numpy.gradient on the axis values)."""
+    f0 = result.column("f0_hz")
+    for k, axis in enumerate(result.axes):
+        name = sensitivity_column(axis)
+        if len(axis.values) < 2:
+            continue
+        slope = np.gradient(f0, np.array(axis.values), axis=k).ravel()
+        for row, s in zip(result.rows, slope):
+            if np.isfinite(s):
+                row[name] = float(s)

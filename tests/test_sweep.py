@@ -1,0 +1,271 @@
+"""`matcad sweep`: the vectorised rungs against predict, the grid's input errors, the table and maps read back,
+the executors (local processes, a Dask LocalCluster) giving the same table, failures recorded."""
+
+import csv
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from matcad.acoustics.load import frequency_at_force_hz
+from matcad.acoustics.predict import predict, spec_calibration
+from matcad.spec import from_dict
+from matcad.spec_input import read_spec_data
+from matcad.sweep import MAX_POINTS, Executor, parse_axes, sweep
+from matcad.sweep import fast
+from matcad.sweep.run import LOAD_SENSITIVITY, sensitivity_column
+from tests.conftest import MINIMAL, PAPER, run_cli
+
+
+def _random_specs(n, seed):
+    """Random valid variants of the paper taxel across the ranges a sweep explores (mm, deg, °C)."""
+    rng = np.random.default_rng(seed)
+    data = read_spec_data(PAPER)
+    specs = []
+    for _ in range(n):
+        cavity_d = rng.uniform(1.5, 8.0)
+        d = dict(data)
+        d["cavity"] = {"diameter": cavity_d, "length": rng.uniform(0.8, 12.0)}
+        d["neck"] = {**data["neck"], "diameter": rng.uniform(0.3, 1.0) * cavity_d, "length": rng.uniform(0.5, 10.0),
+                     "mouth": str(rng.choice(["mount", "baffled", "unflanged"]))}
+        d["mold"] = {"draft_deg": rng.uniform(0.0, 2.0)}
+        d["air"] = {"temperature_c": rng.uniform(-10.0, 50.0)} if rng.random() < 0.7 else \
+            {"speed_of_sound": rng.uniform(300.0, 400.0)}
+        d["spacer"] = {"height": rng.uniform(0.3, 4.0)}
+        d["plate"] = {"width": rng.uniform(10.0, 40.0), "depth": rng.uniform(10.0, 40.0),
+                      "neck_pilot": bool(rng.random() < 0.3), "thickness_measured": bool(rng.random() < 0.5)}
+        d["machine"] = {"printer": str(rng.choice(["fdm", "sla"]))}
+        specs.append(from_dict(d))
+    return specs
+
+
+@pytest.mark.parametrize("model", fast.VECTORISED)
+def test_vectorised_rungs_equal_predict(model):
+    specs = _random_specs(60, seed=fast.VECTORISED.index(model))
+    for mouth in ("mount", "baffled", "unflanged"):
+        group = [s for s in specs if s.neck.mouth == mouth]
+        v = fast.from_specs(group)
+        f0 = fast.f0_hz(v, model)
+        ok = fast.valid(v, model, f0)
+        low, high = fast.band_hz(v, model, f0, ok)
+        for i, spec in enumerate(group):
+            p = predict(spec, model=model, mechanics=False)
+            assert f0[i] == pytest.approx(p.f0_hz, rel=1e-9)
+            assert (low[i], high[i]) == pytest.approx(p.band_hz, rel=1e-9)
+            assert bool(ok[i]) == p.models[model].valid
+
+
+def test_vectorised_sensitivity_is_the_slope_of_predict():
+    """df0/dfield (central difference at 1e-6) against predict at ±1e-3 mm: an independent route, O(h²)."""
+    spec = from_dict(read_spec_data(PAPER))
+    v = fast.from_specs([spec])
+    for section, name in (("cavity", "length"), ("neck", "diameter"), ("air", "temperature_c")):
+        x = getattr(getattr(spec, section), name)
+        ends = [from_dict({**read_spec_data(PAPER), section: {**read_spec_data(PAPER).get(section, {}),
+                                                                 name: x + s * 1e-3}}) for s in (-1, 1)]
+        f = [predict(e, model="transmission_line", mechanics=False).f0_hz for e in ends]
+        slope = (f[1] - f[0]) / 2e-3
+        assert fast.sensitivity(v, "transmission_line", f"{section}.{name}")[0] == pytest.approx(slope, rel=1e-5)
+    assert fast.sensitivity(v, "transmission_line", "guide.thickness")[0] == 0.0
+
+
+def test_sweep_table_load_sensitivity_is_eq5_slope():
+    data = read_spec_data(PAPER)
+    result = sweep(data, parse_axes(["neck.diameter=1.8,2.1"]), model="transmission_line", rules=False)
+    for row in result.rows:
+        spec = from_dict({**data, "neck": {**data["neck"], "diameter": row["neck.diameter"]}})
+        cal = spec_calibration(spec)
+        c = predict(spec, mechanics=False).speed_of_sound_m_s
+        f = frequency_at_force_hz(cal, np.array([0.0, 1e-4]), c, spec.neck.diameter, spec.neck.length)
+        assert row[LOAD_SENSITIVITY] == pytest.approx((f[1] - f[0]) / 1e-4, rel=1e-3)
+
+
+def test_grid_model_and_rules_match_predict_per_variant():
+    data = read_spec_data(PAPER)
+    result = sweep(data, parse_axes(["cavity.length=3:6:3", "neck.diameter=1.6,3.3"]), model="end_corrected")
+    assert len(result.rows) == 6 and result.shape == (3, 2)
+    invalid = [r for r in result.rows if r["status"] == "invalid"]
+    assert [r["neck.diameter"] for r in invalid] == [3.3] * 3 and "neck.diameter" in invalid[0]["reason"]
+    from matcad.rules import check
+
+    for row in (r for r in result.rows if r["status"] == "ok"):
+        spec = from_dict({**data, "cavity": {**data["cavity"], "length": row["cavity.length"]},
+                          "neck": {**data["neck"], "diameter": row["neck.diameter"]}})
+        p = predict(spec, model="end_corrected", mechanics=False)
+        assert row["f0_hz"] == pytest.approx(p.f0_hz, rel=1e-12)
+        findings = check(spec, p)
+        assert row["rule_errors"] == sum(f.level == "error" for f in findings)
+        assert row["rule_warnings"] == sum(f.level == "warning" for f in findings)
+
+
+def test_per_variant_model_and_grid_slope():
+    """elastic_wall runs predict per variant; df0/dfield is then numpy.gradient along the axis."""
+    data = read_spec_data(PAPER)
+    result = sweep(data, parse_axes(["cavity.length=4:5:3"]), rules=False)
+    assert result.model == "elastic_wall" and not result.vectorised
+    f0 = [r["f0_hz"] for r in result.rows]
+    for row, x in zip(result.rows, (4.0, 4.5, 5.0)):
+        p = predict(from_dict({**data, "cavity": {**data["cavity"], "length": x}}), mechanics=False)
+        assert row["f0_hz"] == p.f0_hz and (row["band_low_hz"], row["band_high_hz"]) == p.band_hz
+    col = sensitivity_column(result.axes[0])
+    assert result.rows[1][col] == pytest.approx((f0[2] - f0[0]) / 1.0)
+    assert result.rows[0][col] == pytest.approx((f0[1] - f0[0]) / 0.5)
+
+
+def test_failed_variant_is_recorded_not_fatal(monkeypatch):
+    import matcad.rules
+
+    real = matcad.rules.check
+
+    def flaky(spec, prediction=None):
+        if spec.cavity.length > 5:
+            raise RuntimeError("solver diverged")
+        return real(spec, prediction)
+
+    monkeypatch.setattr(matcad.rules, "check", flaky)
+    result = sweep(read_spec_data(PAPER), parse_axes(["cavity.length=4,6"]), model="transmission_line")
+    assert [r["status"] for r in result.rows] == ["ok", "failed"]
+    assert "RuntimeError: solver diverged" in result.rows[1]["reason"]
+    assert result.rows[0]["rule_errors"] is not None
+
+
+def _table(result):
+    return [{k: v for k, v in r.items()} for r in result.rows]
+
+
+def test_dask_local_cluster_gives_the_same_table():
+    distributed = pytest.importorskip("dask.distributed")  # matcad[cluster], part of the dev extra
+    data = read_spec_data(PAPER)
+    axes = parse_axes(["cavity.length=3.5:5.5:3", "neck.diameter=1.8,2.4"])
+    local = sweep(data, axes)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) \
+            as cluster:
+        remote = sweep(data, axes, executor=Executor(scheduler=cluster.scheduler_address))
+    assert remote.executor.startswith("dask") and local.executor == "this process"
+    assert _table(remote) == _table(local)
+
+
+@pytest.mark.slow
+def test_local_processes_give_the_same_table():
+    data = read_spec_data(PAPER)
+    axes = parse_axes(["cavity.length=3.5:5.5:3", "neck.diameter=1.8,2.4"])
+    assert _table(sweep(data, axes, executor=Executor(2))) == _table(sweep(data, axes))
+
+
+def test_unreachable_scheduler_is_bad_input(tmp_path):
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--scheduler", "tcp://127.0.0.1:9",
+                           "--out", tmp_path / "s")
+    assert code == 2 and "--scheduler tcp://127.0.0.1:9" in err
+    assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.parametrize("vary,words", [
+    ("cavity.lenght=3:6:4", ["cavity.lenght", "did you mean 'cavity.length'"]),
+    ("cavity.length=3:6:0", ["cavity.length", "N = 0", f"1 <= N <= {MAX_POINTS}"]),
+    (f"cavity.length=3:6:{MAX_POINTS + 1}", ["cavity.length", f"<= {MAX_POINTS}"]),
+    ("cavity.length=6:3:4", ["cavity.length", "LO = 6 must be <= HI = 3"]),
+    ("cavity.length=-1:3:4", ["cavity.length", "-1", "outside the field's range", "0.001 <= value <= 100000 mm"]),
+    ("mold.draft_deg=0,12", ["mold.draft_deg", "12", "<= 10 deg"]),
+    ("neck.mouth=1,2", ["neck.mouth", "not a numeric spec field"]),
+    ("cavity.length=3:x:4", ["cavity.length", "finite number"]),
+    ("mold.count=1.5,2", ["mold.count", "whole numbers"]),
+])
+def test_bad_vary_is_exit_2_and_writes_nothing(tmp_path, vary, words):
+    out = tmp_path / "sweep"
+    code, _, err = run_cli("sweep", PAPER, "--vary", vary, "--out", out)
+    assert code == 2, err
+    assert "Traceback" not in err and all(w in err for w in words), err
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_grid_cap_and_bad_model(tmp_path):
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3:6:200", "--vary", "neck.diameter=1:2:200",
+                           "--out", tmp_path / "s")
+    assert code == 2 and "40000 variants, at most 20000" in err
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--model", "lumpd", "--out", tmp_path / "s")
+    assert code == 2 and "--model 'lumpd' invalid" in err and "lumped" in err
+    assert not list(tmp_path.iterdir())
+
+
+def _png_axes(path):
+    from PIL import Image
+
+    with Image.open(path) as im:
+        assert im.format == "PNG" and im.size[0] > 300 and im.size[1] > 200
+        pixels = np.asarray(im.convert("L"), dtype=float)
+        assert pixels.std() > 5  # something is drawn
+        return im.text["matcad:x"], im.text["matcad:y"], im.text["matcad:quantity"]
+
+
+def test_cli_two_axes_table_and_heat_maps_read_back(tmp_path):
+    out = tmp_path / "s2"
+    code, stdout, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3:6:4", "--vary", "neck.diameter=1.5,2.1,3.3",
+                                "--model", "transmission_line", "--set", "microphone.sample_rate_hz=12000",
+                                "--out", out, "--json")
+    assert code == 0, err
+    summary = json.loads(stdout)
+    assert summary["variants"] == 12 and summary["invalid"] == 4
+    with open(out / "sweep.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 12
+    assert [(float(r["cavity.length"]), float(r["neck.diameter"])) for r in rows[:3]] == \
+        [(3.0, 1.5), (3.0, 2.1), (3.0, 3.3)]
+    ok = [r for r in rows if r["status"] == "ok"]
+    assert all(float(r["band_low_hz"]) < float(r["f0_hz"]) < float(r["band_high_hz"]) for r in ok)
+    assert any(int(r["rule_errors"]) > 0 and "acoustic.band_high:error" in r["failing_rules"] for r in ok)
+    assert all(r["f0_hz"] == "" and r["reason"] for r in rows if r["status"] == "invalid")
+    doc = json.loads((out / "sweep.json").read_text())
+    assert [a["field"] for a in doc["axes"]] == ["cavity.length", "neck.diameter"] and len(doc["rows"]) == 12
+    maps = sorted(p.name for p in (out / "maps").iterdir())
+    assert maps == sorted(["f0.png", "band_low.png", "band_high.png", "df0_d_cavity.length.png",
+                           "df0_d_neck.diameter.png", "rule_errors.png"])
+    assert _png_axes(out / "maps" / "f0.png") == ("neck.diameter [mm]", "cavity.length [mm]", "f0_hz")
+    manifest = json.loads((out / ".matcad-manifest.json").read_text())
+    assert set(manifest["files"]) == {"sweep.csv", "sweep.json", *(f"maps/{m}" for m in maps)}
+
+
+def test_cli_one_axis_line_maps(tmp_path, write_spec):
+    out = tmp_path / "s1"
+    code, _, err = run_cli("sweep", write_spec(MINIMAL), "--vary", "neck.length=2:8:7", "--out", out)
+    assert code == 0, err
+    with open(out / "sweep.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 7 and all(r["model"] == "transmission_line" for r in rows)
+    f0 = [float(r["f0_hz"]) for r in rows]
+    assert all(a > b for a, b in zip(f0, f0[1:]))  # a longer neck sings lower
+    assert all(float(r["df0_d_neck.length_hz_per_mm"]) < 0 for r in rows)
+    assert _png_axes(out / "maps" / "df0_d_neck.length.png") == \
+        ("neck.length [mm]", "df0/d(neck.length) [Hz/mm]", "df0_d_neck.length_hz_per_mm")
+
+
+def test_fast_sweep_imports_no_cad_kernel_nor_dask(tmp_path):
+    code = ("import sys; from matcad.cli import main; "
+            "assert main(['sweep', %r, '--vary', 'cavity.length=3:6:5', '--no-rules', '--model', 'lumped', "
+            "'--out', %r]) == 0; "
+            "bad = [m for m in ('build123d', 'OCP', 'trimesh', 'dask', 'distributed', 'skfem', 'felupe') "
+            "if m in sys.modules]; assert not bad, bad" % (str(PAPER), str(tmp_path / 's')))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+
+
+@pytest.mark.slow
+def test_fem_rung_on_local_processes_equals_predict():
+    data = read_spec_data(PAPER)
+    data = {**data, "wall": {"model": "rigid"}}
+    result = sweep(data, parse_axes(["cavity.length=4,5"]), model="fem", fem_level=4, rules=False,
+                   executor=Executor(2))
+    for row in result.rows:
+        spec = from_dict({**data, "cavity": {**data["cavity"], "length": row["cavity.length"]}})
+        assert row["f0_hz"] == pytest.approx(predict(spec, model="fem", fem_level=4, mechanics=False).f0_hz,
+                                             rel=1e-9)
+
+
+@pytest.mark.slow
+def test_cad_rung_stl_volume_matches_closed_form():
+    result = sweep(read_spec_data(PAPER), parse_axes(["cavity.diameter=2.5,3.5"]), model="lumped", rules=False,
+                   cad=True)
+    for row in result.rows:
+        assert row["cad_watertight"] is True
+        assert row["cad_stl_volume_mm3"] == pytest.approx(row["cad_closed_form_volume_mm3"], rel=5e-3)
