@@ -25,6 +25,8 @@ VECTORISED = ("lumped", "end_corrected", "transmission_line")
 FIELDS = ("cavity.diameter", "cavity.length", "neck.diameter", "neck.length", "mold.draft_deg", "air.temperature_c",
           "air.speed_of_sound", "spacer.height", "plate.width", "plate.depth")
 """The spec fields the closed-form rungs read; df0/dfield of any other field is exactly 0 for them."""
+CHUNK = 16_384
+"""Variants per numpy pass in :func:`f0_hz`: arrays that stay in cache (measured ~2x faster than one 1e6 pass)."""
 RELATIVE_STEP = 1e-6
 """Central-difference step of :func:`sensitivity`, relative to the field's value (at least 1e-6 of its unit)."""
 
@@ -42,6 +44,11 @@ class Variants:
 
     def __len__(self) -> int:
         return len(self.values["cavity.diameter"])
+
+    def part(self, start: int, stop: int) -> "Variants":
+        """Variants ``start:stop``."""
+        return Variants({k: x[start:stop] for k, x in self.values.items()}, self.neck_diameter_tol[start:stop],
+                        self.sheet_tol[start:stop], self.cavity_diameter_tol[start:stop], self.mouth)
 
     def with_value(self, field: str, array) -> "Variants":
         return Variants({**self.values, field: np.asarray(array, dtype=float)}, self.neck_diameter_tol,
@@ -83,6 +90,8 @@ def f0_hz(v: Variants, model: str) -> np.ndarray:
     """f0 (Hz) of every variant by one of :data:`VECTORISED` (paper Eq. 1; Rayleigh/Ingard; Selamet 1997)."""
     if model not in VECTORISED:
         raise ValueError(f"model {model!r} is not vectorised, must be one of {list(VECTORISED)}")
+    if len(v) > CHUNK:
+        return np.concatenate([f0_hz(v.part(i, i + CHUNK), model) for i in range(0, len(v), CHUNK)])
     return np.asarray(evaluate(resonators(v), model), dtype=float)
 
 
