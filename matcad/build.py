@@ -104,7 +104,13 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
     """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
     from matcad.render.kit import render_figures
     from matcad.report import KIT_ARCHIVE, make_report, write_report
+    from matcad.spec import SpecError
+    from matcad.taxel import taxel_spec, taxels
 
+    board = taxels(spec)
+    if len(board) > 1 or (board[0].x, board[0].y) != (0.0, 0.0):  # board parts are not built yet: refuse rather
+        raise SpecError("taxel", f"{len(board)} taxels", "build makes one taxel at the plate centre so far")
+    spec = taxel_spec(spec, board[0])
     prediction = predict(spec)
     findings = check(spec, prediction)
     blocking = [f for f in errors(findings) if not force or f.id in UNFORCEABLE]

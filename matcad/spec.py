@@ -366,6 +366,61 @@ class Reference(Section):
     cap_top_thickness: float | None = _length("reference end-cap top thickness; default this design's", None)
 
 
+MAX_TAXELS = 64
+"""Most taxels one spec may describe (one microphone hears a handful; 64 bounds the work per input)."""
+
+
+@dataclass(frozen=True)
+class Array(Section):
+    """Grid helper for a board of identical taxels: ``columns`` x ``rows`` taxels centred on the neck plate, named
+    t1, t2, ... row by row from the top left (+y up). Use [[taxel]] entries instead for taxels that differ."""
+
+    columns: int = _param("taxels along x", default=1, kind="integer", lo=1, hi=MAX_TAXELS)
+    rows: int = _param("taxels along y", default=1, kind="integer", lo=1, hi=MAX_TAXELS)
+    pitch_x: float | None = _length("distance between neighbouring neck axes along x (required for columns > 1)",
+                                    None)
+    pitch_y: float | None = _length("distance between neighbouring neck axes along y (required for rows > 1)",
+                                    None)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.columns * self.rows > MAX_TAXELS:
+            raise SpecError("array.rows", self.rows, f"must keep columns x rows <= {MAX_TAXELS} taxels "
+                                                     f"(columns = {self.columns})")
+        for count, pitch in (("columns", "pitch_x"), ("rows", "pitch_y")):
+            if getattr(self, count) > 1 and getattr(self, pitch) is None:
+                raise SpecError(f"array.{pitch}", None, f"is required when array.{count} > 1 (mm between neck "
+                                                        "axes)")
+
+
+def _position(doc: str) -> Any:
+    return _param(doc, "mm", lo=-LENGTH_MAX_MM, hi=LENGTH_MAX_MM, lo_open=False)
+
+
+@dataclass(frozen=True)
+class TaxelEntry(Section):
+    """One [[taxel]] of an array spec: where its neck is on the plate and how its geometry differs from the shared
+    [cavity], [neck], [end_cap] and [needle] tables (a field left out is the shared value). The neck length is the
+    plate's sheet and the mouth is the plate's, so neither is per taxel."""
+
+    x: float = _position("neck axis x on the neck plate, plate centre = 0")
+    y: float = _position("neck axis y on the neck plate, plate centre = 0")
+    name: str | None = _param("taxel name in reports and loop outputs; default t<i> (1-based, in file order)",
+                              default=None, kind="name")
+    cavity_diameter: float | None = _length("this taxel's cavity diameter D; default [cavity]", None)
+    cavity_length: float | None = _length("this taxel's cavity length L; default [cavity]", None)
+    neck_diameter: float | None = _length("this taxel's neck diameter d; default [neck]", None)
+    cap_outer_diameter: float | None = _length(
+        f"this taxel's end-cap outer diameter; default [end_cap] if given there, else {CAP_OUTER_PER_D} x its D",
+        None)
+    cap_top_thickness: float | None = _length(
+        f"this taxel's end-cap top thickness; default [end_cap] if given there, else {CAP_TOP_PER_D} x its D", None)
+    needle_theta_deg: float | None = _param("this taxel's needle angle to the plate; default [needle]", "deg",
+                                            None, lo=0.0, hi=90.0)
+    needle_y: float | None = _param("this taxel's needle offset y (see needle.y); default [needle]", "mm", None,
+                                    lo=-LENGTH_MAX_MM, hi=LENGTH_MAX_MM, lo_open=False)
+
+
 @dataclass(frozen=True)
 class Spec:
     """A whole taxel design. Lengths in mm."""
@@ -390,6 +445,8 @@ class Spec:
     calibration: Calibration | None = None
     mechanics: Mechanics = field(default_factory=Mechanics)
     reference: Reference | None = None
+    array: Array | None = None
+    taxel: tuple[TaxelEntry, ...] = ()
 
     def __post_init__(self) -> None:
         name_meta = dict(dataclasses.fields(Spec)[0].metadata)
@@ -400,6 +457,9 @@ class Spec:
                 raise SpecError(section, None, f"is required: add a [{section}] table")
             if value is not None and not isinstance(value, cls):
                 raise SpecError(section, value, f"must be a {cls.__name__} section")
+        object.__setattr__(self, "taxel", tuple(self.taxel))
+        if not all(isinstance(entry, TaxelEntry) for entry in self.taxel):
+            raise SpecError("taxel", self.taxel, "must be [[taxel]] entries")
         _cross_checks(self)
 
 
@@ -407,8 +467,8 @@ SECTIONS: dict[str, type] = {
     "cavity": Cavity, "neck": Neck, "plate": Plate, "guide": Guide, "spacer": Spacer, "end_cap": EndCap,
     "fasteners": Fasteners, "needle": Needle, "mount": Mount, "mold": Mold, "machine": Machine,
     "outputs": Outputs, "air": Air, "wall": Wall, "microphone": Microphone, "silicone": Silicone,
-    "calibration": Calibration, "mechanics": Mechanics, "reference": Reference}
-SECTION_NAMES: dict[type, str] = {cls: name for name, cls in SECTIONS.items()}
+    "calibration": Calibration, "mechanics": Mechanics, "reference": Reference, "array": Array}
+SECTION_NAMES: dict[type, str] = {cls: name for name, cls in SECTIONS.items()} | {TaxelEntry: "taxel"}
 REQUIRED_SECTIONS = ("cavity", "neck")
 _NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
 """Matched with fullmatch: ``$`` would accept a final newline."""
@@ -444,6 +504,8 @@ def _allowed_text(meta: dict) -> str:
         return "at most 40 printable ASCII characters"
     if kind == "vector9":
         return "9 finite numbers"
+    if kind == "name":
+        return "A-Z a-z 0-9 . _ - (1-64)"
     return _range_text(meta)
 
 
@@ -528,23 +590,38 @@ def _cross_checks(spec: Spec) -> None:
             reference_spec(spec)
         except SpecError as err:
             raise SpecError(f"reference ({err.field})", err.value, err.allowed) from None
-    if spec.neck.diameter > spec.cavity.diameter:
-        raise SpecError("neck.diameter", spec.neck.diameter,
-                        f"must be <= cavity.diameter = {spec.cavity.diameter:g} mm (a neck cannot be "
+    if spec.array is not None and spec.taxel:
+        raise SpecError("array", "[array] and [[taxel]]", "give either an [array] grid or [[taxel]] entries, not both")
+    names = [entry.name for entry in spec.taxel]
+    for i, name in enumerate(names, 1):
+        if name is not None and name in names[:i - 1]:
+            raise SpecError(f"taxel[{i}].name", name, "must be unique among the [[taxel]] entries")
+    from matcad.taxel import field_path, taxels
+
+    for index, t in enumerate(taxels(spec)):
+        _geometry_checks(t, lambda key, i=index: field_path(spec, i, key), spec.mold.draft_deg)
+
+
+def _geometry_checks(t, path, draft_deg: float) -> None:
+    """What makes one taxel's geometry impossible (``t`` a :class:`matcad.taxel.Taxel`; ``path(key)`` names the
+    spec field that sets ``key``, e.g. 'neck.diameter' or 'taxel[2].neck_diameter')."""
+    if t.neck.diameter > t.cavity.diameter:
+        raise SpecError(path("neck.diameter"), t.neck.diameter,
+                        f"must be <= {path('cavity.diameter')} = {t.cavity.diameter:g} mm (a neck cannot be "
                         "wider than its cavity)")
-    tip = spec.cavity.diameter - 2 * spec.cavity.length * math.tan(math.radians(spec.mold.draft_deg))
+    tip = t.cavity.diameter - 2 * t.cavity.length * math.tan(math.radians(draft_deg))
     if tip <= 0:
-        raise SpecError("mold.draft_deg", spec.mold.draft_deg,
-                        f"must leave the cavity open: draft closes a {spec.cavity.diameter:g} mm cavity within "
-                        f"its {spec.cavity.length:g} mm length")
-    if spec.end_cap.outer_diameter is not None and spec.end_cap.outer_diameter <= spec.cavity.diameter:
-        raise SpecError("end_cap.outer_diameter", spec.end_cap.outer_diameter,
-                        f"must be > cavity.diameter = {spec.cavity.diameter:g} mm")
+        raise SpecError("mold.draft_deg", draft_deg,
+                        f"must leave the cavity open: draft closes a {t.cavity.diameter:g} mm cavity within "
+                        f"its {t.cavity.length:g} mm length ({path('cavity.length')})")
+    if t.end_cap.outer_diameter is not None and t.end_cap.outer_diameter <= t.cavity.diameter:
+        raise SpecError(path("end_cap.outer_diameter"), t.end_cap.outer_diameter,
+                        f"must be > {path('cavity.diameter')} = {t.cavity.diameter:g} mm")
 
 
 def from_dict(data: dict) -> Spec:
     """Validate a parsed TOML document into a :class:`Spec` (lengths in mm). Raises SpecError."""
-    known = ["name", *SECTIONS]
+    known = ["name", *SECTIONS, "taxel"]
     for key in data:
         if key not in known:
             raise SpecError(key, data[key], _did_you_mean(key, known))
@@ -559,7 +636,17 @@ def from_dict(data: dict) -> Spec:
             values[section] = _section(cls, section, data[section])
         elif section in REQUIRED_SECTIONS:
             raise SpecError(section, None, f"is required: add a [{section}] table")
+    if "taxel" in data:
+        values["taxel"] = _taxel_entries(data["taxel"])
     return _resolve_defaults(Spec(**values))  # Spec.__post_init__ runs the cross-field checks
+
+
+def _taxel_entries(data: Any) -> tuple[TaxelEntry, ...]:
+    if not isinstance(data, (list, tuple)) or not all(isinstance(item, dict) for item in data):
+        raise SpecError("taxel", data, "must be [[taxel]] tables, one per taxel")
+    if not 1 <= len(data) <= MAX_TAXELS:
+        raise SpecError("taxel", f"{len(data)} entries", f"must be 1 to {MAX_TAXELS} [[taxel]] entries")
+    return tuple(_section(TaxelEntry, f"taxel[{i}]", item) for i, item in enumerate(data, 1))
 
 
 KEY_CLEARANCE_MM = {"fdm": 0.2, "sla": 0.1}
@@ -570,6 +657,11 @@ def _resolve_defaults(spec: Spec) -> Spec:
     """Fill defaults that depend on other fields (cap body proportional to the cavity; key clearance; silicone
     values from its grade)."""
     cap = spec.end_cap
+    entries = tuple(dataclasses.replace(
+        e, cap_outer_diameter=_proportional(e.cap_outer_diameter, cap.outer_diameter, CAP_OUTER_PER_D,
+                                            e.cavity_diameter or spec.cavity.diameter),
+        cap_top_thickness=_proportional(e.cap_top_thickness, cap.top_thickness, CAP_TOP_PER_D,
+                                        e.cavity_diameter or spec.cavity.diameter)) for e in spec.taxel)
     d = spec.cavity.diameter
     cap = dataclasses.replace(
         cap, outer_diameter=cap.outer_diameter if cap.outer_diameter is not None else CAP_OUTER_PER_D * d,
@@ -588,7 +680,14 @@ def _resolve_defaults(spec: Spec) -> Spec:
         wall = dataclasses.replace(wall, loss_factor=grade.loss_factor)
     if wall.khz_modulus_factor is None:
         wall = dataclasses.replace(wall, khz_modulus_factor=grade.khz_modulus_factor)
-    return dataclasses.replace(spec, end_cap=cap, machine=machine, silicone=silicone, wall=wall)
+    return dataclasses.replace(spec, end_cap=cap, machine=machine, silicone=silicone, wall=wall, taxel=entries)
+
+
+def _proportional(own: float | None, shared: float | None, per_d: float, cavity_diameter: float) -> float:
+    """A taxel's cap size: its own, else the shared [end_cap] value the user gave, else ``per_d`` x its D (mm)."""
+    if own is not None:
+        return own
+    return shared if shared is not None else per_d * cavity_diameter
 
 
 def reference_spec(spec: Spec) -> Spec:
@@ -702,7 +801,7 @@ def schema() -> list[dict]:
     rows.append({"key": "name", "unit": "", "default": None, "allowed": "A-Z a-z 0-9 . _ - (1-64)",
                  "required": True, "doc": name_meta["doc"], "kind": "name", "choices": [], "lo": None,
                  "hi": None, "required_in_table": True})
-    for section, cls in SECTIONS.items():
+    for section, cls in [*SECTIONS.items(), ("taxel[]", TaxelEntry)]:
         for f in dataclasses.fields(cls):
             meta = f.metadata
             allowed = _allowed_text(dict(meta))
@@ -717,5 +816,7 @@ def schema() -> list[dict]:
 
 
 def to_dict(spec: Spec) -> dict:
-    """The resolved spec (defaults filled in) as plain TOML-like data."""
-    return dataclasses.asdict(spec)
+    """The resolved spec (defaults filled in) as plain TOML-like data; ``taxel`` only when it has entries."""
+    data = dataclasses.asdict(spec)
+    entries = data.pop("taxel")
+    return data | ({"taxel": list(entries)} if entries else {})

@@ -73,6 +73,10 @@ def to_toml(data: dict) -> str:
         if isinstance(table, dict):
             lines.append(f"[{section}]")
             lines += [f"{k} = {value(v)}" for k, v in table.items()]
+        elif isinstance(table, list) and table and all(isinstance(t, dict) for t in table):  # [[taxel]]
+            for entry in table:
+                lines.append(f"[[{section}]]")
+                lines += [f"{k} = {value(v)}" for k, v in entry.items()]
     return "\n".join(lines) + "\n"
 
 

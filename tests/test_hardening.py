@@ -241,12 +241,17 @@ def test_every_numeric_field_at_its_extremes_gives_finite_json_or_exit_2(tmp_pat
         section, _, name = row["key"].partition(".")
         if not name or not isinstance(row["default"], (float, type(None))) or "a finite number" not in row["allowed"]:
             continue
-        meta = dict(next(f for f in dataclasses.fields(spec_mod.SECTIONS[section]) if f.name == name).metadata)
+        entry = section == "taxel[]"  # a [[taxel]] field: one entry at the centre carrying it
+        cls = spec_mod.TaxelEntry if entry else spec_mod.SECTIONS[section]
+        meta = dict(next(f for f in dataclasses.fields(cls) if f.name == name).metadata)
         if meta["kind"] != "number":
             continue
         for value in {meta["lo"], math.nextafter(meta["lo"], math.inf), meta["hi"], 5e-324, 1e-300, 1e300}:
             doc = {k: dict(v) if isinstance(v, dict) else v for k, v in base.items()}
-            doc.setdefault(section, {})[name] = value
+            if entry:
+                doc["taxel"] = [{"x": 0.0, "y": 0.0} | {name: value}]
+            else:
+                doc.setdefault(section, {})[name] = value
             doc["outputs"] = {"end_cap_mold": False, "needle_mount": False, "assembly": False}
             path = tmp_path / "s.toml"
             path.write_text(_toml(doc))
@@ -256,7 +261,7 @@ def test_every_numeric_field_at_its_extremes_gives_finite_json_or_exit_2(tmp_pat
             tried += 1
             assert code in (0, 2), (row["key"], value, err.getvalue())
             if code == 2:
-                assert section in err.getvalue(), err.getvalue()  # the field, or its section's required one
+                assert section.replace("[]", "[") in err.getvalue(), err.getvalue()  # the field or its section's
             else:
                 json.loads(out.getvalue())  # allow_nan=False upstream: parses only if finite
     assert tried > 150

@@ -216,6 +216,14 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
     ``model`` overrides the automatic choice: one of the returned ``models`` keys, or ``fem`` (elements
     across the neck radius ``fem_level``, default :data:`matcad.acoustics.fem.DEFAULT_LEVEL`).
     """
+    if spec.taxel or spec.array is not None:
+        from matcad.spec import SpecError
+        from matcad.taxel import taxel_spec, taxels
+
+        board = taxels(spec)
+        if len(board) > 1:  # per-taxel predictions land with the band allocation; refuse rather than answer for one
+            raise SpecError("taxel", f"{len(board)} taxels", "predict answers for one taxel so far")
+        spec = taxel_spec(spec, board[0])
     neck = spec.neck
     res = resonator(spec)
     c, xi, air_ratio = res.c_m_s, res.diameter_ratio, res.neck_air_ratio
