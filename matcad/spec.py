@@ -800,7 +800,7 @@ def schema() -> list[dict]:
     name_meta = dataclasses.fields(Spec)[0].metadata
     rows.append({"key": "name", "unit": "", "default": None, "allowed": "A-Z a-z 0-9 . _ - (1-64)",
                  "required": True, "doc": name_meta["doc"], "kind": "name", "choices": [], "lo": None,
-                 "hi": None, "required_in_table": True})
+                 "hi": None, "lo_open": True, "required_in_table": True})
     for section, cls in [*SECTIONS.items(), ("taxel[]", TaxelEntry)]:
         for f in dataclasses.fields(cls):
             meta = f.metadata
@@ -811,7 +811,7 @@ def schema() -> list[dict]:
                          "default": list(default) if isinstance(default, tuple) else default,
                          "allowed": allowed, "required": required, "doc": meta["doc"], "kind": meta["kind"],
                          "choices": list(meta["choices"]), "lo": meta["lo"], "hi": meta["hi"],
-                         "required_in_table": f.default is dataclasses.MISSING})
+                         "lo_open": meta["lo_open"], "required_in_table": f.default is dataclasses.MISSING})
     return rows
 
 

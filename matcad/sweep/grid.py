@@ -41,15 +41,11 @@ class Axis:
 
 
 def _fields() -> dict[str, dict]:
-    """Every numeric spec field: its schema row (allowed text, lo, hi, unit) plus whether lo is open."""
-    import dataclasses
+    """Every numeric field of the shared tables: its schema row (allowed text, lo, hi, lo_open, unit); [[taxel]]
+    entries are not swept."""
+    from matcad.spec import schema
 
-    from matcad.spec import SECTIONS, schema
-
-    open_lo = {f"{section}.{f.name}": f.metadata["lo_open"] for section, cls in SECTIONS.items()
-               for f in dataclasses.fields(cls)}
-    return {row["key"]: {**row, "lo_open": open_lo[row["key"]]} for row in schema()
-            if row["kind"] in VARIABLE_KINDS}
+    return {row["key"]: row for row in schema() if row["kind"] in VARIABLE_KINDS and "[]" not in row["key"]}
 
 
 def _error(field: str, value, allowed: str):
