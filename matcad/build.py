@@ -100,8 +100,19 @@ def write_archive(folder: Path, name: str) -> None:
             archive.writestr(info, path.read_bytes())
 
 
+def board_bands(spec) -> dict:
+    """Every taxel's band as report data (:func:`matcad.acoustics.bands.summary`). An array's loaded bands take
+    the cap mechanics when it has no [calibration] (its rules need them anyway); a single taxel without one takes
+    the cheap path (no FElupe: the loaded rise is marked not computed, `matcad predict --load` gives it)."""
+    from matcad.acoustics.bands import summary, taxel_bands
+    from matcad.taxel import is_array
+
+    return summary(spec, taxel_bands(spec, mechanics=is_array(spec)))
+
+
 def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:
     """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
+    from matcad.render.bands import BANDS_PNG, band_chart
     from matcad.render.kit import render_figures
     from matcad.report import KIT_ARCHIVE, make_report, write_report
     from matcad.spec import SpecError
@@ -117,11 +128,12 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
     if blocking:
         raise DesignRuleFailure(findings)
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
+    bands = board_bands(spec)
     with staged_output(target) as tmp:
         holes = _write_laser(spec, tmp)
         meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
-        figures = render_figures(spec, prediction, tmp, meshes)
-        report = make_report(spec, prediction, findings, holes, meshes, tmp) | {"figures": figures}
+        figures = render_figures(spec, prediction, tmp, meshes) + [band_chart(bands, tmp / BANDS_PNG)]
+        report = make_report(spec, prediction, findings, holes, meshes, tmp) | {"figures": figures, "bands": bands}
         write_report(report, tmp)
         write_archive(tmp, KIT_ARCHIVE)
     files = tuple(sorted(p.name for p in target.iterdir() if p.name != MANIFEST))

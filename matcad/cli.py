@@ -111,12 +111,51 @@ def cmd_predict(args) -> int:
         print("matcad: note: predict --force is deprecated (it clashed with build --force); use --load",
               file=sys.stderr)
     spec = _load_spec(args.spec, args)
+    from matcad.taxel import is_array
+
+    if is_array(spec):
+        return _predict_array(spec, args)
     result = predict(spec, forces_n=args.load or args.force_deprecated or (), model=args.model,
                      fem_level=args.fem_level)
     if args.json:
         _print_json(result.to_dict())
     else:
         print(_format_prediction(spec, result))
+    return EXIT_OK
+
+
+def _predict_array(spec, args) -> int:
+    """`predict` of an array spec: each taxel's f0, unloaded and loaded band (matcad.acoustics.bands), and the
+    band conflicts; --json adds each taxel's whole prediction."""
+    from matcad.acoustics.bands import summary, taxel_band
+    from matcad.acoustics.predict import predict
+    from matcad.taxel import taxel_spec, taxels
+
+    bands, predictions = [], {}
+    for t in taxels(spec):
+        one = taxel_spec(spec, t)
+        p = predict(one, forces_n=args.load or args.force_deprecated or (), model=args.model, fem_level=args.fem_level)
+        bands.append(taxel_band(one, t.name, t.x, t.y, prediction=p))
+        predictions[t.name] = p
+    data = summary(spec, bands)
+    if args.json:
+        _print_json({"name": spec.name, **data, "predictions": {k: p.to_dict() for k, p in predictions.items()}})
+        return EXIT_OK
+    lines = [f"{spec.name}: {len(bands)} taxels; loaded band = predicted band + rise to {data['max_force_n']:g} N; "
+             f"guard {data['guard_hz']:.0f} Hz",
+             f"  {'taxel':<8} {'x, y [mm]':>14} {'f0 [Hz]':>8}  {'model':<18} {'unloaded [Hz]':>13} "
+             f"{'loaded [Hz]':>13} {'rise':>7}"]
+    for b in bands:
+        lines.append(f"  {b.name:<8} {f'{b.x_mm:g}, {b.y_mm:g}':>14} {b.f0_hz:8.0f}  {b.model:<18} "
+                     f"{f'{b.unloaded_hz[0]:.0f}-{b.unloaded_hz[1]:.0f}':>13} "
+                     f"{f'{b.loaded_hz[0]:.0f}-{b.loaded_hz[1]:.0f}':>13} {100 * (b.rise - 1):+6.1f}%")
+    lines += [f"  rise from {source}" for source in dict.fromkeys(b.rise_source for b in bands)]
+    lines += [f"  conflict: {c['message']}" for c in data["conflicts"]] or ["  bands disjoint (guard and 2f/3f rule)"]
+    for name, p in predictions.items():
+        lines += [f"  {name} warning: {w}" for w in p.warnings]
+        if p.load_curve:
+            lines += [f"  {name}:"] + _format_load_curve(p)
+    print("\n".join(lines))
     return EXIT_OK
 
 
@@ -387,6 +426,74 @@ def cmd_sweep(args) -> int:
     return EXIT_OK
 
 
+def cmd_design(args) -> int:
+    """Inverse design: one taxel onto --target-hz, or --taxels N disjoint bands in --band LO HI."""
+    from matcad.design import RulesFailed
+    from matcad.design.spec_toml import write_design
+
+    spec = _load_spec(args.spec, args)
+    if (args.target_hz is None) == (args.taxels is None):
+        raise ValueError("design needs either --target-hz F (one taxel) or --taxels N --band LO HI (an array)")
+    try:
+        if args.target_hz is not None:
+            from matcad.design.solve import parse_vary, solve
+
+            if args.band:
+                raise ValueError("--band goes with --taxels, not with --target-hz")
+            if not args.vary:
+                raise ValueError("--target-hz needs --vary FIELD [FIELD ...] (the fields the solver may change)")
+            result = solve(spec, args.target_hz, parse_vary(spec, args.vary))
+            result = type(result)(**{**result.__dict__, "spec": _renamed(result.spec, args.name or
+                                                                          f"{spec.name}-{args.target_hz:.0f}hz")})
+        else:
+            from matcad.design.allocate import allocate
+            from matcad.design.solve import CONTINUOUS, parse_vary
+
+            if not args.band:
+                raise ValueError("--taxels needs --band LO HI (Hz)")
+            result = allocate(spec, args.taxels, *args.band, parse_vary(spec, args.vary or ["neck.diameter"],
+                                                                       CONTINUOUS), args.name)
+    except RulesFailed as exc:
+        if args.json:
+            _print_json({"verdict": "fail", "error": str(exc), "findings": [f.to_dict() for f in exc.findings]})
+        else:
+            print(_format_findings([f for f in exc.findings if f.level == "error"]))
+        print(f"matcad: {exc}; nothing written", file=sys.stderr)
+        return EXIT_RULES
+    target = args.out or Path("out") / f"{result.spec.name}-design"
+    report = {"source": str(args.spec), **result.to_dict()}
+    write_design(target, result.spec, report, f"written by `matcad design` from {args.spec}")
+    if args.json:
+        _print_json({**report, "out_dir": str(target), "spec_file": str(target / f"{result.spec.name}.toml")})
+    else:
+        print(_format_design(result))
+        print(f"  {result.spec.name}.toml and design.json in {target}/")
+    return EXIT_OK
+
+
+def _renamed(spec, name: str):
+    import dataclasses
+
+    return dataclasses.replace(spec, name=name)
+
+
+def _format_design(result) -> str:
+    if hasattr(result, "target_hz"):
+        fields = ", ".join(f"{k} {a:g} -> {b:.4g} mm" for k, (a, b) in result.fields.items())
+        lines = [f"{result.spec.name}: f0 = {result.f0_hz:.1f} Hz by predict ({result.model}) for target "
+                 f"{result.target_hz:g} Hz, error {100 * result.error:+.3f} %; {fields}; {result.seconds:.2f} s, "
+                 f"{result.evaluations} model evaluations"]
+        return "\n".join(lines + [f"  note: {n}" for n in result.notes])
+    lines = [f"{result.spec.name}: {len(result.bands)} taxels in {result.band_hz[0]:g}-{result.band_hz[1]:g} Hz, "
+             f"guard {result.guard_hz:.0f} Hz, {result.seconds:.1f} s"]
+    for b, s in zip(result.bands, result.solutions):
+        fields = ", ".join(f"{k} {v[1]:.4g} mm" for k, v in s.fields.items())
+        lines.append(f"  {b.name} at ({b.x_mm:g}, {b.y_mm:g}) mm: f0 {b.f0_hz:.0f} Hz, unloaded "
+                     f"{b.unloaded_hz[0]:.0f}-{b.unloaded_hz[1]:.0f} Hz, loaded {b.loaded_hz[0]:.0f}-"
+                     f"{b.loaded_hz[1]:.0f} Hz; {fields}")
+    return "\n".join(lines)
+
+
 def _write_json(path: Path, data) -> None:
     import json
 
@@ -560,6 +667,17 @@ def _parser() -> argparse.ArgumentParser:
                                                            "need no per-variant work)")
     w.add_argument("--cad", action="store_true", help="also build each variant's end cap (build123d) and read "
                                                       "its STL volume back")
+
+    d = command("design", cmd_design, "solve a taxel for a target f0, or N taxels for disjoint bands; writes a spec",
+                "out/<name>-design")
+    spec_arg(d)
+    d.add_argument("--target-hz", type=float, metavar="F", help="target unloaded f0 (Hz) of one taxel")
+    d.add_argument("--vary", nargs="+", metavar="FIELD[=LO:HI]",
+                   help="fields the solver may change: neck.diameter, cavity.diameter, cavity.length (optional range "
+                        "in mm) and neck.length (a stock sheet); with --taxels default neck.diameter")
+    d.add_argument("--taxels", type=int, metavar="N", help="design an array of N taxels with disjoint bands")
+    d.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="with --taxels: the band (Hz) they share")
+    d.add_argument("--name", help="name of the written spec (default <name>-<F>hz or <name>-<N>taxels)")
 
     command("schema", cmd_schema, "print every spec field with unit, default and allowed range")
 

@@ -217,6 +217,8 @@ def _casting_markdown(c: dict | None) -> list[str]:
 
 
 def _markdown(r: dict) -> str:
+    from matcad.render.bands import bands_markdown
+
     p, ab, bom = r["prediction"], r["as_built"], r["bom"]
     lines = [f"# {r['name']} — matcad {r['matcad_version']} build report", "",
              f"**Verdict: {r['verdict']}** · f0 = {p['f0_hz']:.0f} Hz ({p['model']}), band "
@@ -241,6 +243,7 @@ def _markdown(r: dict) -> str:
               for b in p["budget"]]
     if p["warnings"]:  # what the physics says and where a model does not hold (e.g. the paper's measured 4.0 kHz)
         lines += ["", "Prediction notes:", ""] + [f"- {w}" for w in p["warnings"]]
+    lines += bands_markdown(r.get("bands"))
     lines += ["", "## Design rules", "", "| level | rule | part | message | fix |", "|---|---|---|---|---|"]
     lines += [f"| {f['level']} | {f['id']} | {_part_link(f, r)} | {_cell(f['message'])} | {_cell(f['fix'])} |"
               for f in r["findings"]]

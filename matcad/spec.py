@@ -308,6 +308,9 @@ class Mechanics(Section):
     steps: int = _param("load steps over that travel", default=10, kind="integer", lo=1, hi=200)
     element_size_mm: float | None = _param("mesh element size; default from the cap's thinnest part", "mm", None,
                                            lo=LENGTH_MIN_MM, hi=LENGTH_MAX_MM)
+    max_force_n: float = _param("largest normal force a taxel must sense: the top of its loaded band (the paper "
+                                "loads its taxel to ~20-25 N, Fig. 7; its Eq. 5 fit turns back at 26.9 N)", "N", 20.0,
+                                lo=0.0, hi=1e4)
 
 
 @dataclass(frozen=True)

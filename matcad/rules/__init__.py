@@ -29,11 +29,11 @@ class Finding:
 def check(spec, prediction=None) -> list[Finding]:
     """Run every rule on ``spec``; ``prediction`` (from acoustics.predict) is computed when not given."""
     from matcad.acoustics.predict import predict
-    from matcad.rules import acoustic, laser, printing, stack
+    from matcad.rules import acoustic, bands, laser, printing, stack
 
     prediction = prediction or predict(spec)
     findings: list[Finding] = []
-    for module in (laser, printing, stack):
+    for module in (laser, printing, stack, bands):
         for rule in module.RULES:
             findings += rule(spec)
     for rule in acoustic.RULES:

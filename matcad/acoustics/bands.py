@@ -1,0 +1,199 @@
+"""Each taxel's frequency band: where one microphone must listen for it, unloaded and pressed. Frequencies Hz.
+
+A taxel's band is its unloaded predicted band (:func:`matcad.acoustics.predict.predict`'s ``band_hz``: the chosen
+model's f0 with the uncertainty budget, root-sum-square in ln f) widened upward by the rise of f under load up to
+``mechanics.max_force_n``:
+
+- with a ``[calibration]``: paper Eq. 5 (:mod:`matcad.acoustics.load`), f(F)/f(0) = sqrt(V_eff(0)/V_eff(F)); the
+  ratio does not depend on the calibration's area convention or K;
+- without one: the cap mechanics (:mod:`matcad.mechanics`, FElupe; docs/mechanics.md), f(F)/f(0) from the
+  transmission line on the deformed cavity. One run takes seconds, so each distinct cap (cavity, end cap, flange,
+  draft, silicone, [mechanics] law) is computed once per process and shared by every taxel with that cap.
+
+The rise is a ratio r = max f(F)/f(0) over 0 <= F <= max force, so the loaded band is
+(unloaded low x min(1, min ratio), unloaded high x r): the model's relative uncertainty is carried onto the loaded
+end. Bands of one array must stay ``guard_hz`` apart and clear of each other's 2nd and 3rd harmonics
+(:func:`conflicts`; the rules in :mod:`matcad.rules.bands` report them).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+HARMONICS = (2, 3)
+"""Overtones of a taxel's tone that another taxel's band must avoid: an edge tone is rich in harmonics, and
+overblowing jumps to them (paper Sec. VI-B); the 2nd and 3rd are the strong ones."""
+EQ5_POINTS = 65
+"""Forces sampled from 0 to the maximum force to find Eq. 5's highest f (it may turn back inside the range)."""
+
+
+@dataclass(frozen=True)
+class TaxelBand:
+    """One taxel's bands (Hz): the unloaded prediction f0 (``model``), its predicted band ``unloaded_hz`` (model
+    uncertainty) and ``loaded_hz``, that band widened by f's rise up to ``max_force_n`` (N). ``rise`` is
+    max f(F)/f(0) over that force range and ``rise_source`` says where it came from; ``x_mm``, ``y_mm`` the neck
+    axis on the plate."""
+
+    name: str
+    f0_hz: float
+    unloaded_hz: tuple[float, float]
+    loaded_hz: tuple[float, float]
+    model: str
+    max_force_n: float
+    rise: float
+    rise_source: str
+    x_mm: float = 0.0
+    y_mm: float = 0.0
+
+    def to_dict(self) -> dict:
+        d = dataclasses.asdict(self)
+        d["unloaded_hz"], d["loaded_hz"] = list(self.unloaded_hz), list(self.loaded_hz)
+        return d
+
+
+@dataclass(frozen=True)
+class Conflict:
+    """Two taxels whose bands come closer than the guard (Hz): ``other``'s loaded band meets ``taxel``'s loaded
+    band (``harmonic`` = 1) or its ``harmonic``-th multiple ``band_hz``; ``gap_hz`` is the gap between them
+    (negative: they overlap by that much)."""
+
+    taxel: str
+    harmonic: int
+    other: str
+    band_hz: tuple[float, float]
+    other_hz: tuple[float, float]
+    gap_hz: float
+    guard_hz: float
+
+    def describe(self) -> str:
+        what = f"{self.taxel}'s loaded band" if self.harmonic == 1 else \
+            f"{self.taxel}'s harmonic {self.harmonic}f ({self.harmonic} x its loaded band)"
+        how = f"overlap by {-self.gap_hz:.0f} Hz" if self.gap_hz < 0 else f"are only {self.gap_hz:.0f} Hz apart"
+        return (f"{what}, {self.band_hz[0]:.0f}-{self.band_hz[1]:.0f} Hz, and {self.other}'s loaded band, "
+                f"{self.other_hz[0]:.0f}-{self.other_hz[1]:.0f} Hz, {how} (guard {self.guard_hz:.0f} Hz)")
+
+
+def guard_hz(sample_rate_hz: float) -> float:
+    """Least gap between two taxels' bands (Hz) for the loop (:mod:`matcad.loop.analyze`) to keep them apart: a
+    tone at one band's edge spreads its Hann main lobe over ±EXCLUDE_BINS bins, and a ridge within EDGE_BINS bins
+    of a band's edge is refused as hugging it; so the gap is (EXCLUDE_BINS + EDGE_BINS) bins of the tracker's
+    zero-padded spectrum, fs / (ZERO_PAD · window). 43 Hz at 44.1 kHz (window 4096, 5.4 Hz bins)."""
+    from matcad.loop.analyze import EDGE_BINS, EXCLUDE_BINS, ZERO_PAD, window_samples
+
+    return (EXCLUDE_BINS + EDGE_BINS) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
+
+
+def conflicts(bands, guard: float, harmonics=HARMONICS) -> list[Conflict]:
+    """Every pair whose loaded bands (Hz) come within ``guard`` (Hz) of each other, and every harmonic n·band of
+    one taxel (n in ``harmonics``) that comes within ``guard`` of another's band."""
+    out = []
+    for i, a in enumerate(bands):
+        for n in (1, *harmonics):
+            lo, hi = n * a.loaded_hz[0], n * a.loaded_hz[1]
+            for j, b in enumerate(bands):
+                if j == i or (n == 1 and j < i):
+                    continue
+                gap = max(lo, b.loaded_hz[0]) - min(hi, b.loaded_hz[1])
+                if gap < guard:
+                    out.append(Conflict(a.name, n, b.name, (lo, hi), b.loaded_hz, gap, guard))
+    return out
+
+
+def eq5_rise(cal, max_force_n: float) -> tuple[float, float]:
+    """(min, max) of f(F)/f(0) over 0 <= F <= ``max_force_n`` (N) by paper Eq. 5, f ∝ V_eff^(-1/2); SpecError
+    naming ``mechanics.max_force_n`` where the fit has no meaning (past its V_eff minimum, V_eff <= 0)."""
+    from matcad.acoustics.load import effective_volume_mm3, invalid_reason
+    from matcad.spec import SpecError
+
+    why = invalid_reason(cal, max_force_n)
+    if why:
+        raise SpecError("mechanics.max_force_n", max_force_n, f"must stay where the calibration's Eq. 5 holds: {why}")
+    v = effective_volume_mm3(cal, np.linspace(0.0, max_force_n, EQ5_POINTS))
+    ratio = np.sqrt(v[0] / v)
+    return float(ratio.min()), float(ratio.max())
+
+
+_CAP_CURVES: dict = {}
+"""Cap mechanics curves by cap (see :func:`_cap_key`): one FElupe run per distinct cap per process."""
+
+
+def _cap_key(spec) -> tuple:
+    """What a cap curve depends on: the cap's geometry (cavity, end cap, flange from the guide, draft), the
+    silicone grade and the [mechanics] law and loading (not the force the band is taken to)."""
+    return (spec.cavity, spec.end_cap, spec.guide, spec.mold.draft_deg, spec.silicone.grade,
+            tuple(getattr(spec.mechanics, f.name) for f in dataclasses.fields(spec.mechanics) if f.name != "max_force_n"))
+
+
+def cap_curve_cached(spec):
+    """:func:`matcad.mechanics.solver.cap_curve` of ``spec``'s cap, computed once per distinct cap."""
+    key = _cap_key(spec)
+    if key not in _CAP_CURVES:
+        from matcad.mechanics.solver import cap_curve
+
+        _CAP_CURVES[key] = cap_curve(spec)
+    return _CAP_CURVES[key]
+
+
+def mechanics_rise(spec, f0_hz: float, max_force_n: float) -> tuple[float, float, str]:
+    """(min, max) of f(F)/f(0) over 0 <= F <= ``max_force_n`` (N) from the cap mechanics, and its source text;
+    SpecError naming ``mechanics.max_force_n`` when the computed curve stops below that force."""
+    from matcad.mechanics.frequency import at_forces, force_curve
+    from matcad.spec import SpecError
+
+    curve = cap_curve_cached(spec)
+    fc = force_curve(spec, curve, f0_hz)
+    forces = np.array([s.force_n for s in fc.states])
+    f = np.array([s.f_hz for s in fc.states])
+    top = at_forces(fc, [max_force_n])[0][1]
+    if top is None:
+        why = curve.message or "raise mechanics.displacement_mm to extend it"
+        raise SpecError("mechanics.max_force_n", max_force_n,
+                        f"must be <= {forces[-1]:.3g} N, the largest force the cap mechanics curve reached ({why})")
+    inside = np.append(f[forces <= max_force_n], top) / f[0]
+    return (float(inside.min()), float(inside.max()),
+            f"cap mechanics ({curve.material.model}, {curve.contact}, G = {curve.material.shear_modulus_mpa:.3g} MPa)")
+
+
+def taxel_band(spec, name: str = "t1", x_mm: float = 0.0, y_mm: float = 0.0, mechanics: bool = True,
+               prediction=None) -> TaxelBand:
+    """The band of the single-taxel ``spec`` (see the module docstring). ``mechanics=False`` is the cheap path:
+    without a [calibration] the rise is then not computed (``rise`` 1, ``rise_source`` says so) and FElupe is not
+    imported. ``prediction`` is ``predict(spec)`` when the caller has it."""
+    from matcad.acoustics.predict import predict, spec_calibration
+
+    p = prediction or predict(spec, mechanics=False)
+    force = spec.mechanics.max_force_n
+    cal = spec_calibration(spec)
+    if cal is not None:
+        low, high = eq5_rise(cal, force)
+        source = f"calibration {cal.name} (paper Eq. 5)"
+    elif mechanics:
+        low, high, source = mechanics_rise(spec, p.f0_hz, force)
+    else:
+        low, high = 1.0, 1.0
+        source = ("not computed (no [calibration]; the cap mechanics run was skipped: `matcad predict --load` or "
+                  "an array's `matcad check` runs it)")
+    lo, hi = p.band_hz
+    return TaxelBand(name, p.f0_hz, (lo, hi), (lo * min(1.0, low), hi * high), p.model, force, high, source,
+                     x_mm, y_mm)
+
+
+def taxel_bands(spec, mechanics: bool = True) -> list[TaxelBand]:
+    """One :class:`TaxelBand` per taxel of ``spec``, in :func:`matcad.taxel.taxels` order (Hz, mm)."""
+    from matcad.taxel import taxel_spec, taxels
+
+    return [taxel_band(taxel_spec(spec, t), t.name, t.x, t.y, mechanics) for t in taxels(spec)]
+
+
+def summary(spec, bands) -> dict:
+    """The bands of a board as plain data (report.json's ``bands``, `predict --json` of an array): the guard (Hz),
+    max force (N), harmonics checked, one row per taxel and every :func:`conflicts`, with its message."""
+    guard = guard_hz(spec.microphone.sample_rate_hz)
+    return {"guard_hz": guard, "max_force_n": spec.mechanics.max_force_n, "harmonics": list(HARMONICS),
+            "taxels": [b.to_dict() for b in bands],
+            "conflicts": [{"taxel": c.taxel, "harmonic": c.harmonic, "other": c.other, "band_hz": list(c.band_hz),
+                           "other_hz": list(c.other_hz), "gap_hz": c.gap_hz, "message": c.describe()}
+                          for c in conflicts(bands, guard)]}

@@ -1,0 +1,156 @@
+"""N taxels sharing one microphone: N disjoint bands in [LO, HI], one taxel solved for each, on a grid.
+
+Bands are placed upward from LO. For taxel k the allocation starts at ``start`` (LO, or the previous loaded band's
+top plus the guard, :func:`matcad.acoustics.bands.guard_hz`); its f0 target is ``start`` times the ratio f0 / loaded
+low of its band shape, solved by :func:`matcad.design.solve.solve` and its real band computed
+(:func:`matcad.acoustics.bands.taxel_band`: predicted band, rise to ``mechanics.max_force_n``), repeating while the
+band's shape changes with the geometry. A band that another taxel's 2f or 3f would land in is moved above that
+harmonic (plus the guard). Every band must end at or below HI; otherwise the message says how far the N bands
+reach. The taxels go on a grid (columns = ceil(√N)) of [[taxel]] entries with the pitch of the largest cap flange
+plus the laser's smallest web, on a plate grown by the grid's extent. Frequencies Hz, lengths mm.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+from matcad.design import RulesFailed, Unreachable
+from matcad.design.solve import CONTINUOUS, solve
+
+SHAPE_ITERATIONS = 6
+"""Re-solves of one taxel while its band's shape (f0 / loaded low) settles; it moves by < 1e-3 after 2-3."""
+TARGET_MARGIN = 1e-4
+"""Aim each f0 this much above the allocation start so rounding never leaves a band a hair below it."""
+PER_TAXEL = {"neck.diameter": "neck_diameter", "cavity.diameter": "cavity_diameter",
+             "cavity.length": "cavity_length"}
+"""Fields a [[taxel]] entry may set for itself (the neck length is the plate's sheet, shared)."""
+
+
+@dataclass(frozen=True)
+class Allocation:
+    """The written array spec, each taxel's band (:class:`matcad.acoustics.bands.TaxelBand`) and solution, the
+    guard (Hz), the asked band (Hz) and the run time (s)."""
+
+    spec: object
+    bands: tuple
+    solutions: tuple
+    guard_hz: float
+    band_hz: tuple[float, float]
+    seconds: float
+
+    def to_dict(self) -> dict:
+        return {"name": self.spec.name, "band_hz": list(self.band_hz), "guard_hz": self.guard_hz,
+                "seconds": self.seconds, "room_left_hz": self.band_hz[1] - self.bands[-1].loaded_hz[1],
+                "taxels": [b.to_dict() | {"target_hz": s.target_hz, "error": s.error,
+                                          "fields": {k: v[1] for k, v in s.fields.items()}}
+                           for b, s in zip(self.bands, self.solutions)]}
+
+
+def _harmonic_top(placed, band, guard: float) -> float | None:
+    """The top (Hz) of the highest harmonic of an earlier band that ``band`` meets within the guard, or None."""
+    from matcad.acoustics.bands import conflicts
+
+    hits = [c for c in conflicts([*placed, band], guard) if c.other == band.name]
+    return max(c.band_hz[1] for c in hits) if hits else None
+
+
+def _one(base, name: str, start: float, vary, ratio: float):
+    """Solve one taxel so that its loaded band starts at or just above ``start`` (Hz): (solution, band)."""
+    from matcad.acoustics.bands import taxel_band
+
+    for _ in range(SHAPE_ITERATIONS):
+        solution = solve(base, start * ratio * (1 + TARGET_MARGIN), vary)
+        band = taxel_band(solution.spec, name)
+        if band.loaded_hz[0] >= start:
+            return solution, band
+        ratio = band.f0_hz / band.loaded_hz[0]
+    return solution, band
+
+
+def grid(n: int, pitch: float) -> list[tuple[float, float]]:
+    """Neck positions (mm) of n taxels on a grid of ceil(√n) columns centred on the plate, row by row from the top."""
+    columns = math.ceil(math.sqrt(n))
+    rows = math.ceil(n / columns)
+    return [((c - (columns - 1) / 2) * pitch, ((rows - 1) / 2 - r) * pitch)
+            for r in range(rows) for c in range(columns)][:n]
+
+
+def array_spec(base, solutions, name: str):
+    """An array spec: ``base``'s shared tables, one [[taxel]] per solution with its varied fields, on a grid
+    (pitch = widest cap flange + the laser's smallest web), the plate grown by the grid's extent (mm)."""
+    from matcad.parts.features import cap_flange_diameter_mm
+    from matcad.spec import from_dict
+    from matcad.design.spec_toml import plain
+    from matcad.spec import to_dict
+
+    pitch = max(cap_flange_diameter_mm(s.spec) for s in solutions) + base.machine.laser_min_feature
+    points = grid(len(solutions), pitch)
+    xs, ys = [p[0] for p in points], [p[1] for p in points]
+    data = plain(to_dict(base))
+    data["name"] = name
+    data["plate"]["width"] = base.plate.width + max(xs) - min(xs)
+    data["plate"]["depth"] = base.plate.depth + max(ys) - min(ys)
+    data["taxel"] = [{"name": f"t{i}", "x": round(x, 6), "y": round(y, 6)}
+                     | {PER_TAXEL[k]: v[1] for k, v in s.fields.items()}
+                     for i, ((x, y), s) in enumerate(zip(points, solutions), 1)]
+    return from_dict(data)
+
+
+def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = None) -> Allocation:
+    """Allocate ``n`` disjoint bands in [``lo_hz``, ``hi_hz``] and solve one taxel for each (see the module
+    docstring); ``vary`` as for :func:`matcad.design.solve.solve`, continuous per-taxel fields only. Raises
+    :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
+    from matcad.acoustics.bands import guard_hz, taxel_band
+    from matcad.rules import check, errors
+    from matcad.taxel import taxel_spec, taxels
+
+    start_time = time.perf_counter()
+    if not 2 <= n <= 16:
+        raise ValueError(f"--taxels {n} invalid, must be 2-16 (one microphone, one band each)")
+    if not (math.isfinite(lo_hz) and math.isfinite(hi_hz) and 0 < lo_hz < hi_hz):
+        raise ValueError(f"--band {lo_hz:g} {hi_hz:g} invalid, must be 0 < LO < HI (Hz)")
+    bad = [k for k in vary if k not in CONTINUOUS]
+    if bad:
+        raise ValueError(f"--vary {bad[0]}: with --taxels only per-taxel fields vary: {', '.join(CONTINUOUS)} "
+                         "(the neck length is the plate's sheet, shared by every taxel)")
+    base = taxel_spec(spec, taxels(spec)[0])
+    guard = guard_hz(spec.microphone.sample_rate_hz)
+    shape = taxel_band(base)
+    ratio = shape.f0_hz / shape.loaded_hz[0]
+    start, placed, solutions = lo_hz, [], []
+    for k in range(1, n + 1):
+        while True:
+            try:
+                solution, band = _one(base, f"t{k}", start, vary, ratio)
+            except (Unreachable, RulesFailed) as exc:
+                raise type(exc)(*_fit_text(exc, k, n, lo_hz, hi_hz, placed)) from None
+            top = _harmonic_top(placed, band, guard)
+            if top is None:
+                break
+            start = top + guard
+        if band.loaded_hz[1] > hi_hz:
+            raise Unreachable(_fit_text(None, k, n, lo_hz, hi_hz, [*placed, band])[0])
+        placed.append(band)
+        solutions.append(solution)
+        ratio = band.f0_hz / band.loaded_hz[0]
+        start = band.loaded_hz[1] + guard
+    out = array_spec(base, solutions, name or f"{spec.name}-{n}taxels")
+    findings = check(out)
+    if errors(findings):
+        bad = "; ".join(f"{f.id}: {f.message}" for f in errors(findings))
+        raise RulesFailed(f"the {n}-taxel array breaks a design rule: {bad}", findings)
+    placed = [dataclasses.replace(b, x_mm=t.x, y_mm=t.y) for b, t in zip(placed, taxels(out))]
+    return Allocation(out, tuple(placed), tuple(solutions), guard, (lo_hz, hi_hz), time.perf_counter() - start_time)
+
+
+def _fit_text(exc, k: int, n: int, lo: float, hi: float, placed) -> tuple:
+    """Why the n bands do not fit in [lo, hi]: where the bands so far reach, and the exception's own reason."""
+    bands = "; ".join(f"{b.name} {b.loaded_hz[0]:.0f}-{b.loaded_hz[1]:.0f} Hz" for b in placed) or "none"
+    text = (f"--band {lo:g} {hi:g}: {n} disjoint bands do not fit (guard and 2f/3f rule); taxel {k} of {n} "
+            f"{'ends above ' + format(hi, 'g') + ' Hz' if exc is None else 'cannot be solved: ' + str(exc)}. "
+            f"Bands so far: {bands}. Widen the band, lower mechanics.max_force_n, or narrow each taxel's band "
+            "(plate.thickness_measured, a [reference] taxel)")
+    return (text,) if exc is None or not isinstance(exc, RulesFailed) else (text, exc.findings)

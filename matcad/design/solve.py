@@ -1,0 +1,265 @@
+"""One taxel's unloaded f0 onto a target: stock sheet first, then the continuous fields by root finding.
+
+The model is the one `matcad predict` chooses for the spec (transmission line, elastic wall, or the measured
+reference times its ratio), evaluated on its own (milliseconds); the answer is then confirmed by
+:func:`matcad.acoustics.predict.predict` and held to the design rules (:func:`matcad.rules.check`).
+
+With several continuous fields there are many solutions; the solver moves them together along the steepest
+route in log space, x_i(t) = x_i0 · exp(t · g_i) with g_i = ∂ln f/∂ln x_i at the start (the least relative change
+to first order), restricted to every field's range, scans f along it and refines the root nearest the start with
+Brent's method (scipy.optimize.brentq). ``neck.length`` is a sheet: it is chosen among the stock thicknesses
+(:data:`matcad.parts.features.STOCK_ACRYLIC_MM`) nearest the start first, and the continuous fields solved for each
+until one passes the rules. Frequencies Hz, lengths mm.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from matcad.design import RulesFailed, Unreachable
+
+CONTINUOUS = ("neck.diameter", "cavity.diameter", "cavity.length")
+SHEET = "neck.length"
+FIELDS = CONTINUOUS + (SHEET,)
+SCAN_POINTS = 33
+"""Points scanned along the route for sign changes of f − target (f may not be monotonic near a wall mode)."""
+XTOL = 1e-10
+"""Brent's tolerance on the route parameter t (ln units): far below the 0.5 % the design must hit."""
+DEFAULT_LENGTH_SPAN = 3.0
+"""Default cavity.length range: [PANCAKE_L_OVER_D · D, this × the starting length] (give FIELD=LO:HI for another)."""
+
+
+@dataclass(frozen=True)
+class Solution:
+    """A solved spec: the target and the f0 ``predict`` gives it (Hz), the relative error, each varied field
+    (start, solved) in mm, the model used, the run time (s) and model evaluations, the rule findings and notes."""
+
+    spec: object
+    target_hz: float
+    f0_hz: float
+    model: str
+    fields: dict
+    seconds: float
+    evaluations: int
+    findings: tuple
+    notes: tuple = ()
+
+    @property
+    def error(self) -> float:
+        return self.f0_hz / self.target_hz - 1
+
+    def to_dict(self) -> dict:
+        return {"name": self.spec.name, "target_hz": self.target_hz, "f0_hz": self.f0_hz, "error": self.error,
+                "model": self.model, "fields": {k: {"start": a, "solved": b} for k, (a, b) in self.fields.items()},
+                "seconds": self.seconds, "evaluations": self.evaluations, "notes": list(self.notes),
+                "findings": [f.to_dict() for f in self.findings]}
+
+
+def get_field(spec, path: str) -> float:
+    section, name = path.split(".")
+    return getattr(getattr(spec, section), name)
+
+
+def with_fields(spec, values: dict):
+    """``spec`` with dotted fields set, validated (SpecError on an impossible geometry, e.g. neck > cavity)."""
+    sections: dict[str, dict] = {}
+    for path, value in values.items():
+        section, name = path.split(".")
+        sections.setdefault(section, {})[name] = float(value)
+    return dataclasses.replace(spec, **{s: dataclasses.replace(getattr(spec, s), **v) for s, v in sections.items()})
+
+
+def default_range(spec, path: str) -> tuple[float, float]:
+    """The search range of one field (mm) when the user gives none: the neck between the laser's smallest feature
+    and the cavity; the cavity between the neck and the cap's outside; its length from the flat-cavity limit of the
+    1-D models (L/D = 0.3) to :data:`DEFAULT_LENGTH_SPAN` × the start."""
+    from matcad.acoustics.predict import PANCAKE_L_OVER_D
+
+    if path == "neck.diameter":
+        return spec.machine.laser_min_feature, spec.cavity.diameter
+    if path == "cavity.diameter":
+        return spec.neck.diameter, spec.end_cap.outer_diameter
+    if path == "cavity.length":
+        return PANCAKE_L_OVER_D * spec.cavity.diameter, DEFAULT_LENGTH_SPAN * spec.cavity.length
+    raise AssertionError(path)
+
+
+def parse_vary(spec, items, allowed=FIELDS) -> dict[str, tuple[float, float] | None]:
+    """``--vary`` items, FIELD or FIELD=LO:HI (mm), as {field: range or None (default)}; ValueError naming the
+    item and what is allowed."""
+    out: dict[str, tuple[float, float] | None] = {}
+    for item in items:
+        path, _, rng = item.partition("=")
+        if path not in allowed:
+            raise ValueError(f"--vary {item}: field must be one of {', '.join(allowed)}")
+        if path in out:
+            raise ValueError(f"--vary {path} given twice")
+        if not rng:
+            out[path] = None
+            continue
+        if path == SHEET:
+            raise ValueError(f"--vary {item}: {SHEET} is a sheet, chosen among the stock thicknesses; give it "
+                             "without a range")
+        try:
+            lo, hi = (float(v) for v in rng.split(":"))
+        except ValueError:
+            lo = hi = math.nan
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+            raise ValueError(f"--vary {item}: range must be LO:HI in mm with 0 < LO < HI")
+        out[path] = (lo, hi)
+    if not out:
+        raise ValueError(f"--vary needs at least one field: {', '.join(allowed)}")
+    return out
+
+
+def model_f0(spec, model: str, base: str) -> float:
+    """f0 (Hz) of ``spec`` by ``model`` exactly as :func:`matcad.acoustics.predict.predict` computes it: one of
+    the cheap models, or 'relative' (the measured reference f0 times ``base``'s ratio, this design / reference)."""
+    from matcad.acoustics.resonator import evaluate, resonator, wall_arguments
+    from matcad.spec import reference_spec
+
+    def f(s, name):
+        return float(evaluate(resonator(s), name, *wall_arguments(s, name)))
+
+    if model == "relative":
+        return spec.reference.f0_hz * f(spec, base) / f(reference_spec(spec), base)
+    return f(spec, model)
+
+
+def chosen_model(spec) -> tuple[str, str]:
+    """(model, base): the model `predict` picks for ``spec`` and, for 'relative', the physics model it scales."""
+    base = "elastic_wall" if spec.wall.model == "silicone" else "transmission_line"
+    return ("relative" if spec.reference is not None else base), base
+
+
+class _Route:
+    """f along x(t) = x0 · exp(t · g) for the continuous fields (NaN where the geometry is impossible)."""
+
+    def __init__(self, spec, ranges: dict[str, tuple[float, float]], model: str, base: str):
+        self.spec, self.model, self.base = spec, model, base
+        self.x0 = {p: get_field(spec, p) for p in ranges}
+        self.evaluations = 0
+        f0 = self.f(self._point(0.0, {p: 0.0 for p in ranges}))
+        grad = {}
+        for p in ranges:  # ∂ln f/∂ln x by central differences (1e-4 in ln x)
+            h = 1e-4
+            up = self.f(with_fields(spec, {p: self.x0[p] * math.exp(h)}))
+            down = self.f(with_fields(spec, {p: self.x0[p] * math.exp(-h)}))
+            grad[p] = (math.log(up) - math.log(down)) / (2 * h)
+        norm = math.sqrt(sum(g * g for g in grad.values())) or 1.0
+        self.g = {p: g / norm for p, g in grad.items()}
+        self.f_start = f0
+        lo, hi = -math.inf, math.inf
+        for p, (a, b) in ranges.items():  # every field stays inside its range
+            g = self.g[p]
+            if abs(g) < 1e-12:
+                continue
+            ends = sorted((math.log(a / self.x0[p]) / g, math.log(b / self.x0[p]) / g))
+            lo, hi = max(lo, ends[0]), min(hi, ends[1])
+        self.t_range = (lo, hi)
+
+    def _point(self, t: float, g: dict):
+        return with_fields(self.spec, {p: self.x0[p] * math.exp(t * g[p]) for p in self.x0})
+
+    def f(self, spec) -> float:
+        self.evaluations += 1
+        return model_f0(spec, self.model, self.base)
+
+    def at(self, t: float):
+        from matcad.spec import SpecError
+
+        try:
+            s = self._point(t, self.g)
+        except SpecError:
+            return None, math.nan
+        return s, self.f(s)
+
+
+def _roots(route: _Route, target_hz: float) -> tuple[list[float], tuple[float, float]]:
+    """Every root of f(t) = target along the route, nearest the start first, and the range of f seen (Hz)."""
+    from scipy.optimize import brentq
+
+    lo, hi = route.t_range
+    ts = np.linspace(lo, hi, SCAN_POINTS)
+    fs = np.array([route.at(t)[1] for t in ts])
+    seen = (float(np.nanmin(fs)), float(np.nanmax(fs))) if np.isfinite(fs).any() else (math.nan, math.nan)
+    roots = []
+    for a, b, fa, fb in zip(ts[:-1], ts[1:], fs[:-1], fs[1:]):
+        if np.isfinite(fa) and np.isfinite(fb) and (fa - target_hz) * (fb - target_hz) <= 0:
+            roots.append(brentq(lambda t: route.at(t)[1] - target_hz, a, b, xtol=XTOL, rtol=4 * np.finfo(float).eps))
+    return sorted(roots, key=abs), seen
+
+
+def _stock_order(spec) -> list[float]:
+    """Stock sheets (mm), nearest the start's neck.length first (in ratio)."""
+    from matcad.parts.features import STOCK_ACRYLIC_MM
+
+    return sorted(STOCK_ACRYLIC_MM, key=lambda t: (abs(math.log(t / spec.neck.length)), t))
+
+
+def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -> Solution:
+    """Solve ``spec``'s f0 = ``target_hz`` (Hz) varying the fields of ``vary`` ({field: (lo, hi) mm or None for
+    :func:`default_range`}); see the module docstring. Raises :class:`Unreachable` (no geometry in range reaches
+    the target) or :class:`RulesFailed` (every solution breaks a design rule)."""
+    from matcad.acoustics.predict import predict
+    from matcad.rules import check, errors
+
+    start = time.perf_counter()
+    if not (math.isfinite(target_hz) and target_hz > 0):
+        raise ValueError(f"--target-hz {target_hz:g} invalid, must be a finite frequency > 0 Hz")
+    model, base = chosen_model(spec)
+    sheets = _stock_order(spec) if SHEET in vary else [spec.neck.length]
+    continuous = {p: (r or default_range(spec, p)) for p, r in vary.items() if p != SHEET}
+    candidates, reached, evaluations, failed = [], [], 0, None
+    for sheet in sheets:
+        try:
+            s = with_fields(spec, {SHEET: sheet}) if sheet != spec.neck.length else spec
+        except ValueError:
+            continue
+        if continuous:
+            route = _Route(s, continuous, model, base)
+            roots, seen = _roots(route, target_hz)
+            evaluations += route.evaluations
+            reached.append((sheet, seen))
+            solved = [route.at(t)[0] for t in roots]
+        else:
+            solved = [s]
+            evaluations += 1
+            reached.append((sheet, (model_f0(s, model, base),) * 2))
+        for candidate in solved:
+            findings = check(candidate)
+            if errors(findings):
+                failed = failed or (candidate, findings)
+                continue
+            candidates.append((candidate, findings))
+            break
+        if candidates and continuous:
+            break  # the stock sheet nearest the start that works
+    if not candidates:
+        if failed:
+            bad = "; ".join(f"{f.id}: {f.message}" for f in errors(failed[1]))
+            raise RulesFailed(f"every solution for {target_hz:g} Hz breaks a design rule (first: {bad})", failed[1])
+        raise Unreachable(_unreachable_text(spec, target_hz, vary, continuous, reached, model))
+    # sheet alone: the stock sheet whose f0 is nearest the target
+    best, findings = min(candidates, key=lambda c: abs(math.log(model_f0(c[0], model, base) / target_hz))) \
+        if not continuous else candidates[0]
+    p = predict(best, mechanics=False)
+    fields = {k: (get_field(spec, k), get_field(best, k)) for k in vary}
+    notes = () if continuous else (f"{SHEET} alone takes stock values only: the nearest gives {p.f0_hz:.0f} Hz; add "
+                                   "a continuous field to --vary to hit the target",)
+    return Solution(best, target_hz, p.f0_hz, p.model, fields, time.perf_counter() - start, evaluations,
+                    tuple(findings), notes)
+
+
+def _unreachable_text(spec, target_hz, vary, continuous, reached, model) -> str:
+    finite = [r for _, r in reached if np.isfinite(r[0])]
+    span = (f"{min(r[0] for r in finite):.0f}-{max(r[1] for r in finite):.0f} Hz" if finite else "no valid geometry")
+    ranges = ", ".join(f"{p} {a:g}-{b:g} mm" for p, (a, b) in continuous.items())
+    sheets = f"{SHEET} among the stock sheets" if SHEET in vary else f"{SHEET} = {spec.neck.length:g} mm"
+    return (f"--target-hz {target_hz:g} unreachable: varying {ranges or ''}{', ' if ranges else ''}{sheets} "
+            f"({model}) reaches {span}; widen a range (--vary FIELD=LO:HI) or vary another field")

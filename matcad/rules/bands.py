@@ -1,0 +1,36 @@
+"""Rules on a board's bands: one microphone must tell every taxel apart (matcad.acoustics.bands).
+
+Each taxel's loaded band (its predicted band plus the rise up to ``mechanics.max_force_n``) must stay the loop's
+guard (:func:`matcad.acoustics.bands.guard_hz`) away from every other taxel's, and the 2nd and 3rd harmonics of its
+loaded band must stay that far from every other band: otherwise the tracker cannot say which taxel it hears.
+Single-taxel specs have nothing to separate and skip these rules (so their check never runs the cap mechanics).
+"""
+
+from __future__ import annotations
+
+from matcad.rules import Finding
+
+FIX = ("move the taxels apart in frequency (`matcad design --taxels N --band LO HI` allocates disjoint bands), "
+       "lower mechanics.max_force_n, or narrow the bands: a calipered sheet (plate.thickness_measured) and a "
+       "recorded [reference] taxel shrink the model uncertainty")
+
+
+def band_separation(spec) -> list[Finding]:
+    """Errors for every pair of loaded bands closer than the guard, and every 2f/3f of one taxel's loaded band
+    within the guard of another's band; an info line with each taxel's bands (Hz)."""
+    from matcad.acoustics.bands import conflicts, guard_hz, taxel_bands
+    from matcad.taxel import is_array
+
+    if not is_array(spec):
+        return []
+    bands = taxel_bands(spec)
+    guard = guard_hz(spec.microphone.sample_rate_hz)
+    out = [Finding("bands.overlap" if c.harmonic == 1 else "bands.harmonic", "error", round(c.gap_hz, 1),
+                   round(guard, 1), c.describe(), FIX) for c in conflicts(bands, guard)]
+    out.append(Finding("bands.allocation", "info", {b.name: [round(v) for v in b.loaded_hz] for b in bands},
+                       round(guard, 1), "loaded bands up to " f"{spec.mechanics.max_force_n:g} N: " + "; ".join(
+                           f"{b.name} {b.loaded_hz[0]:.0f}-{b.loaded_hz[1]:.0f} Hz" for b in bands)))
+    return out
+
+
+RULES = (band_separation,)

@@ -1,0 +1,119 @@
+"""Taxel bands: unloaded band + loaded rise (Eq. 5 or the cap mechanics), the guard, overlap and harmonic checks."""
+
+import dataclasses
+import sys
+
+import numpy as np
+import pytest
+
+from matcad import spec as spec_mod
+from matcad.acoustics import bands
+from matcad.acoustics.bands import TaxelBand, conflicts, guard_hz, taxel_band
+from matcad.acoustics.load import frequency_at_force_hz
+from matcad.acoustics.predict import predict, spec_calibration
+from matcad.spec import SpecError
+from tests.conftest import MINIMAL, PAPER
+
+FAST = MINIMAL + """[end_cap]
+outer_diameter = 8.0
+top_thickness = 2.0
+[mechanics]
+material = "neo_hookean"
+shear_modulus_mpa = 0.3
+displacement_mm = 1.0
+steps = 4
+max_force_n = 6.0
+"""
+
+
+def _band(name, lo, hi):
+    return TaxelBand(name, (lo + hi) / 2, (lo, hi), (lo, hi), "transmission_line", 20.0, 1.0, "test")
+
+
+def test_calibrated_band_is_the_predicted_band_raised_by_eq5():
+    s = spec_mod.load(PAPER)
+    b = taxel_band(s)
+    p = predict(s)
+    cal = spec_calibration(s)
+    f = frequency_at_force_hz(cal, [0.0, s.mechanics.max_force_n], 343.0, 2.1, 6.35)  # f(F)/f(0) needs no K
+    assert b.f0_hz == p.f0_hz and b.unloaded_hz == p.band_hz
+    assert b.rise == pytest.approx(f[1] / f[0], rel=1e-12)
+    assert b.loaded_hz == (pytest.approx(p.band_hz[0]), pytest.approx(p.band_hz[1] * f[1] / f[0]))
+    assert "Eq. 5" in b.rise_source and b.rise > 1.05  # the paper's taxel rises ~10 % by 20 N
+
+
+def test_max_force_past_the_eq5_minimum_names_the_field():
+    s = spec_mod.load(PAPER)
+    s = dataclasses.replace(s, mechanics=dataclasses.replace(s.mechanics, max_force_n=30.0))
+    with pytest.raises(SpecError) as err:
+        taxel_band(s)
+    assert err.value.field == "mechanics.max_force_n" and "26.9" in str(err.value)
+    with pytest.raises(SpecError):
+        spec_mod.from_dict({"name": "x", "cavity": {"diameter": 3, "length": 4}, "neck": {"diameter": 2, "length": 6},
+                            "mechanics": {"max_force_n": -1}})
+
+
+def test_cheap_path_without_calibration_skips_felupe():
+    s = spec_mod.from_dict(spec_mod.tomllib.loads(MINIMAL))
+    b = taxel_band(s, mechanics=False)
+    assert b.loaded_hz == b.unloaded_hz and b.rise == 1.0 and "not computed" in b.rise_source
+
+
+def test_mechanics_rise_once_per_cap_and_equal_to_predict_load(monkeypatch):
+    """Two taxels with the same cap and different necks: one FElupe run; the rise equals `predict --load`'s."""
+    from matcad.mechanics import solver
+
+    calls = []
+    real = solver.cap_curve
+    monkeypatch.setattr(solver, "cap_curve", lambda s: calls.append(1) or real(s))
+    monkeypatch.setattr(bands, "_CAP_CURVES", {})
+    s = spec_mod.from_dict(spec_mod.tomllib.loads(FAST))
+    wide = dataclasses.replace(s, neck=dataclasses.replace(s.neck, diameter=2.6))
+    b1, b2 = taxel_band(s), taxel_band(wide)
+    assert len(calls) == 1 and b2.f0_hz > b1.f0_hz * 1.1
+    p = predict(s, forces_n=[s.mechanics.max_force_n])
+    f_max = next(q.f_hz for q in p.load_curve if q.source.startswith("cap mechanics"))
+    assert b1.rise == pytest.approx(f_max / p.f0_hz, rel=1e-9)  # f rises monotonically on this cap to 6 N
+    assert b1.loaded_hz[1] == pytest.approx(b1.unloaded_hz[1] * f_max / p.f0_hz, rel=1e-9)
+    assert 1.01 < b1.rise < 1.5
+
+
+def test_max_force_beyond_the_mechanics_curve_names_the_field(monkeypatch):
+    s = spec_mod.from_dict(spec_mod.tomllib.loads(FAST.replace("max_force_n = 6.0", "max_force_n = 500.0")))
+    with pytest.raises(SpecError) as err:
+        taxel_band(s)
+    assert err.value.field == "mechanics.max_force_n" and "displacement_mm" in str(err.value)
+
+
+def test_guard_follows_the_trackers_bins():
+    from matcad.loop.analyze import EDGE_BINS, EXCLUDE_BINS, Framer
+
+    for fs in (44100.0, 48000.0, 96000.0):
+        df = np.diff(Framer(fs).freqs[:2])[0]
+        assert guard_hz(fs) == pytest.approx((EXCLUDE_BINS + EDGE_BINS) * df)
+    assert guard_hz(44100.0) == pytest.approx(43.07, abs=0.01)
+
+
+def test_conflicts_overlap_guard_and_harmonics():
+    g = 40.0
+    assert conflicts([_band("a", 4000, 4400), _band("b", 4441, 4900)], g) == []
+    (c,) = conflicts([_band("a", 4000, 4400), _band("b", 4420, 4900)], g)
+    assert (c.taxel, c.other, c.harmonic, c.gap_hz) == ("a", "b", 1, pytest.approx(20.0))
+    (c,) = conflicts([_band("a", 4000, 4500), _band("b", 4400, 4900)], g)
+    assert c.gap_hz == pytest.approx(-100.0) and "overlap by 100 Hz" in c.describe()
+    # 2 x [3000, 3100] = [6000, 6200] lands in b's band; 3 x [2000, 2100] = [6000, 6300] too
+    found = conflicts([_band("a", 3000, 3100), _band("b", 6100, 6500), _band("c", 2000, 2100)], g)
+    assert {(c.taxel, c.harmonic, c.other) for c in found} == {("a", 2, "b"), ("c", 3, "b")}
+    hit = next(c for c in found if c.taxel == "a")
+    assert hit.band_hz == (6000, 6200) and hit.gap_hz == pytest.approx(-100.0)
+    assert "a's harmonic 2f" in hit.describe() and "b's loaded band" in hit.describe()
+
+
+def test_bands_module_does_not_import_felupe_on_the_cheap_path():
+    import subprocess
+
+    code = ("import sys; from matcad import spec; from matcad.acoustics.bands import taxel_band; "
+            "s = spec.load(%r); taxel_band(s); taxel_band(s, mechanics=False); "
+            "assert 'felupe' not in sys.modules and 'skfem' not in sys.modules" % str(PAPER))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr

@@ -1,0 +1,103 @@
+"""`matcad design --target-hz`: inverse design hits its target by `predict`, within rules and stock sheets."""
+
+import json
+
+import pytest
+
+from matcad import spec as spec_mod
+from matcad.acoustics.predict import predict
+from matcad.design import RulesFailed, Unreachable
+from matcad.design.solve import FIELDS, get_field, parse_vary, solve
+from matcad.output import MANIFEST
+from matcad.parts.features import STOCK_ACRYLIC_MM
+from matcad.rules import check, errors
+from tests.conftest import PAPER, ROOT, run_cli
+
+LASER = ROOT / "templates" / "mat-laser-only.toml"
+
+
+@pytest.mark.parametrize("template", [PAPER, LASER], ids=["silicone-wall", "rigid"])
+@pytest.mark.parametrize("vary", [["cavity.length"], ["cavity.diameter", "neck.diameter"],
+                                  ["neck.length", "neck.diameter"]], ids=lambda v: "+".join(v))
+@pytest.mark.parametrize("target", [4200.0, 5000.0, 5900.0])
+def test_inverse_design_hits_target_by_predict(template, vary, target):
+    s = spec_mod.load(template)
+    result = solve(s, target, parse_vary(s, vary))
+    f0 = predict(result.spec).f0_hz  # an independent call of the whole prediction on the solved spec
+    assert abs(f0 / target - 1) < 0.005 and result.f0_hz == f0
+    assert not errors(check(result.spec))
+    for field in FIELDS:  # only the varied fields moved
+        if field not in vary:
+            assert get_field(result.spec, field) == get_field(s, field)
+    assert any(abs(get_field(result.spec, f) - get_field(s, f)) > 1e-6 for f in vary)
+    if "neck.length" in vary:
+        assert result.spec.neck.length in STOCK_ACRYLIC_MM
+
+
+def test_neck_diameter_alone_and_a_range():
+    s = spec_mod.load(LASER)
+    for target in (4000.0, 4500.0, 6000.0):
+        r = solve(s, target, parse_vary(s, ["neck.diameter=1.2:3.0"]))
+        assert abs(predict(r.spec).f0_hz / target - 1) < 0.005 and 1.2 <= r.spec.neck.diameter <= 3.0
+
+
+def test_sheet_alone_picks_the_nearest_stock_sheet():
+    s = spec_mod.load(LASER)
+    r = solve(s, 4300.0, parse_vary(s, ["neck.length"]))
+    stock_f0 = {t: predict(spec_mod.variant(s, "neck", length=t)).f0_hz for t in STOCK_ACRYLIC_MM}
+    best = min(stock_f0, key=lambda t: abs(stock_f0[t] / 4300.0 - 1))
+    assert r.spec.neck.length == best and r.notes and "stock" in r.notes[0]
+
+
+def test_unreachable_and_rule_failures():
+    s = spec_mod.load(LASER)
+    with pytest.raises(Unreachable, match=r"neck.diameter 1-3.18 mm.* reaches \d+-\d+ Hz") as err:
+        solve(s, 30000.0, parse_vary(s, ["neck.diameter"]))
+    ends = [predict(spec_mod.variant(s, "neck", diameter=d)).f0_hz for d in (1.0, 3.18)]  # f0 rises with d
+    assert f"reaches {ends[0]:.0f}-{ends[1]:.0f} Hz" in str(err.value)
+    paper = spec_mod.load(PAPER)  # 4 kHz needs a 1.1 mm neck: below the laser's 1 mm feature after kerf
+    with pytest.raises(RulesFailed) as err:
+        solve(paper, 4000.0, parse_vary(paper, ["neck.diameter"]))
+    assert any(f.id == "laser.feature" for f in err.value.findings)
+
+
+@pytest.mark.parametrize("items,words", [
+    (["neck.width"], "must be one of neck.diameter"), (["neck.diameter=3:1"], "0 < LO < HI"),
+    (["neck.length=1:2"], "stock"), (["neck.diameter", "neck.diameter"], "twice")])
+def test_bad_vary_names_the_field(items, words):
+    with pytest.raises(ValueError, match=words):
+        parse_vary(spec_mod.load(LASER), items)
+
+
+def test_cli_writes_a_spec_predict_agrees_with(tmp_path):
+    out = tmp_path / "d"
+    code, stdout, err = run_cli("design", LASER, "--target-hz", "5500", "--vary", "cavity.length", "--out", out,
+                                "--json")
+    assert code == 0, err
+    data = json.loads(stdout)
+    assert sorted(p.name for p in out.iterdir()) == sorted([MANIFEST, "design.json", data["name"] + ".toml"])
+    code, stdout, err = run_cli("predict", out / f"{data['name']}.toml", "--json")
+    assert code == 0, err
+    assert abs(json.loads(stdout)["f0_hz"] / 5500 - 1) < 0.005
+    assert code == 0 and run_cli("check", out / f"{data['name']}.toml")[0] == 0
+    assert data["seconds"] > 0 and abs(data["error"]) < 0.005
+
+
+@pytest.mark.parametrize("args,code,words", [
+    (["--target-hz", "30000", "--vary", "neck.diameter"], 2, "unreachable"),
+    (["--target-hz", "-5", "--vary", "neck.diameter"], 2, "--target-hz"),
+    (["--target-hz", "5000", "--vary", "plate.width"], 2, "--vary plate.width"),
+    (["--target-hz", "5000"], 2, "--vary"),
+    (["--taxels", "3"], 2, "--band"),
+])
+def test_cli_bad_input_exit_2_nothing_written(tmp_path, args, code, words):
+    out = tmp_path / "d"
+    rc, _, err = run_cli("design", LASER, *args, "--out", out)
+    assert rc == code and words in err and "Traceback" not in err
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_cli_rule_failure_exit_1(tmp_path):
+    rc, stdout, err = run_cli("design", PAPER, "--target-hz", "4000", "--vary", "neck.diameter", "--out",
+                              tmp_path / "d")
+    assert rc == 1 and "laser.feature" in stdout and "nothing written" in err and not (tmp_path / "d").exists()
