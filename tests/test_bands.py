@@ -117,3 +117,49 @@ def test_bands_module_does_not_import_felupe_on_the_cheap_path():
             "assert 'felupe' not in sys.modules and 'skfem' not in sys.modules" % str(PAPER))
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
+
+
+BOARD = MINIMAL.replace('name = "t"', 'name = "board"') + """[guide]
+thickness_measured = true
+[mechanics]
+max_force_n = 5.0
+[calibration]
+v0_mm3 = 32.21
+a = -0.0086
+b = 0.4626
+area_convention = "d2/4"
+"""
+
+
+def test_identical_taxels_overlap_and_check_names_both(write_spec):
+    from matcad.rules import check
+    from tests.conftest import run_cli
+
+    s = spec_mod.from_dict(spec_mod.tomllib.loads(BOARD + "[array]\ncolumns = 2\npitch_x = 14.0\n"))
+    b1, b2 = bands.taxel_bands(s)
+    assert (b1.name, b1.x_mm, b2.name, b2.x_mm) == ("t1", -7.0, "t2", 7.0) and b1.loaded_hz == b2.loaded_hz
+    (f,) = [f for f in check(s) if f.id == "bands.overlap"]
+    width = b1.loaded_hz[1] - b1.loaded_hz[0]
+    assert f.level == "error" and f.value == pytest.approx(-width, abs=0.1)
+    assert "t1's loaded band" in f.message and "t2's loaded band" in f.message and f"overlap by {width:.0f} Hz" in f.message
+    code, out, _ = run_cli("check", write_spec(BOARD + "[array]\ncolumns = 2\npitch_x = 14.0\n"))
+    assert code == 1 and "bands.overlap" in out
+
+
+def test_a_taxel_at_twice_anothers_f0_breaks_the_harmonic_rule():
+    from matcad.design.solve import parse_vary, solve
+    from matcad.rules import check
+
+    one = spec_mod.from_dict(spec_mod.tomllib.loads(BOARD))
+    low = solve(one, 3000.0, parse_vary(one, ["cavity.length"])).spec.cavity.length
+    high = solve(one, 6000.0, parse_vary(one, ["neck.diameter"])).spec.neck.diameter
+    s = spec_mod.from_dict(spec_mod.tomllib.loads(
+        BOARD + f"[[taxel]]\nx = -7.0\ny = 0.0\ncavity_length = {low!r}\n"
+                f"[[taxel]]\nx = 7.0\ny = 0.0\nneck_diameter = {high!r}\n"))
+    b1, b2 = bands.taxel_bands(s)
+    assert b1.f0_hz == pytest.approx(3000.0, rel=1e-6) and b2.f0_hz == pytest.approx(6000.0, rel=1e-6)
+    assert b1.loaded_hz[1] < b2.loaded_hz[0]  # disjoint themselves
+    (f,) = [f for f in check(s) if f.id.startswith("bands.") and f.level == "error"]
+    assert f.id == "bands.harmonic" and "t1's harmonic 2f" in f.message and "t2's loaded band" in f.message
+    assert f.value == pytest.approx(max(2 * b1.loaded_hz[0], b2.loaded_hz[0]) - min(2 * b1.loaded_hz[1], b2.loaded_hz[1]),
+                                    abs=0.05)  # rounded to 0.1 Hz

@@ -11,7 +11,7 @@ from matcad.design.solve import FIELDS, get_field, parse_vary, solve
 from matcad.output import MANIFEST
 from matcad.parts.features import STOCK_ACRYLIC_MM
 from matcad.rules import check, errors
-from tests.conftest import PAPER, ROOT, run_cli
+from tests.conftest import MINIMAL, PAPER, ROOT, run_cli
 
 LASER = ROOT / "templates" / "mat-laser-only.toml"
 
@@ -101,3 +101,58 @@ def test_cli_rule_failure_exit_1(tmp_path):
     rc, stdout, err = run_cli("design", PAPER, "--target-hz", "4000", "--vary", "neck.diameter", "--out",
                               tmp_path / "d")
     assert rc == 1 and "laser.feature" in stdout and "nothing written" in err and not (tmp_path / "d").exists()
+
+
+ARRAY_BASE = MINIMAL.replace('name = "t"', 'name = "arr"') + """[plate]
+thickness_measured = true
+[outputs]
+end_cap_mold = false
+needle_mount = false
+assembly = false
+[mechanics]
+max_force_n = {force}
+[calibration]
+v0_mm3 = 32.21
+a = -0.0086
+b = 0.4626
+area_convention = "d2/4"
+"""
+"""A rigid-wall taxel on a calipered sheet, its load rise from the paper's Eq. 5 (no FElupe in these tests)."""
+
+
+def _array_base(write_spec, max_force="5.0"):
+    return write_spec(ARRAY_BASE.format(force=max_force))
+
+
+def test_taxels_bands_are_disjoint_inside_the_band_and_check_accepts(tmp_path, write_spec):
+    from matcad.acoustics.bands import conflicts, guard_hz, taxel_bands
+    from matcad.taxel import taxels
+
+    out = tmp_path / "arr"
+    code, stdout, err = run_cli("design", _array_base(write_spec), "--taxels", "3", "--band", "3500", "6500",
+                                "--out", out, "--json")
+    assert code == 0, err
+    data = json.loads(stdout)
+    written = spec_mod.load(out / f"{data['name']}.toml")
+    board = taxels(written)
+    assert len(board) == 3 and len({(t.x, t.y) for t in board}) == 3
+    assert len({t.neck.diameter for t in board}) == 3  # each taxel solved for its own band
+    bands = taxel_bands(written)  # recomputed from the written file, not the designer's numbers
+    assert conflicts(bands, guard_hz(written.microphone.sample_rate_hz)) == []
+    assert all(3500 <= b.loaded_hz[0] < b.loaded_hz[1] <= 6500 for b in bands)
+    assert [round(b.loaded_hz[1]) for b in bands] == [round(t["loaded_hz"][1]) for t in data["taxels"]]
+    code, stdout, err = run_cli("check", out / f"{data['name']}.toml", "--json")
+    assert code == 0, stdout + err
+    code, stdout, err = run_cli("predict", out / f"{data['name']}.toml", "--json")
+    assert code == 0, err
+    assert [t["name"] for t in json.loads(stdout)["taxels"]] == ["t1", "t2", "t3"]
+
+
+def test_taxels_that_do_not_fit_exit_2(tmp_path, write_spec):
+    code, _, err = run_cli("design", _array_base(write_spec, "20.0"), "--taxels", "4", "--band", "4000", "5000",
+                           "--out", tmp_path / "d")
+    assert code == 2 and "4 disjoint bands do not fit" in err and "Bands so far" in err
+    assert not (tmp_path / "d").exists()
+    code, _, err = run_cli("design", _array_base(write_spec), "--taxels", "2", "--band", "4000", "6000", "--vary",
+                           "neck.length", "--out", tmp_path / "d")
+    assert code == 2 and "shared by every taxel" in err

@@ -1,10 +1,9 @@
 """N taxels sharing one microphone: N disjoint bands in [LO, HI], one taxel solved for each, on a grid.
 
 Bands are placed upward from LO. For taxel k the allocation starts at ``start`` (LO, or the previous loaded band's
-top plus the guard, :func:`matcad.acoustics.bands.guard_hz`); its f0 target is ``start`` times the ratio f0 / loaded
-low of its band shape, solved by :func:`matcad.design.solve.solve` and its real band computed
-(:func:`matcad.acoustics.bands.taxel_band`: predicted band, rise to ``mechanics.max_force_n``), repeating while the
-band's shape changes with the geometry. A band that another taxel's 2f or 3f would land in is moved above that
+top plus the guard, :func:`matcad.acoustics.bands.guard_hz`); its f0 is the lowest target whose solved geometry
+(:func:`matcad.design.solve.solve`) has a loaded band (:func:`matcad.acoustics.bands.taxel_band`: predicted band,
+rise to ``mechanics.max_force_n``) starting at or above ``start``, found by bisection on the target. A band that another taxel's 2f or 3f would land in is moved above that
 harmonic (plus the guard). Every band must end at or below HI; otherwise the message says how far the N bands
 reach. The taxels go on a grid (columns = ceil(√N)) of [[taxel]] entries with the pitch of the largest cap flange
 plus the laser's smallest web, on a plate grown by the grid's extent. Frequencies Hz, lengths mm.
@@ -20,10 +19,10 @@ from dataclasses import dataclass
 from matcad.design import RulesFailed, Unreachable
 from matcad.design.solve import CONTINUOUS, solve
 
-SHAPE_ITERATIONS = 6
-"""Re-solves of one taxel while its band's shape (f0 / loaded low) settles; it moves by < 1e-3 after 2-3."""
-TARGET_MARGIN = 1e-4
-"""Aim each f0 this much above the allocation start so rounding never leaves a band a hair below it."""
+TARGET_MARGIN = 1e-3
+"""Relative precision of each taxel's f0 target (the bisection stops there: 5 Hz at 5 kHz)."""
+STEP_UP = 0.03
+"""Relative step up of the target while looking for a first band that clears its start."""
 PER_TAXEL = {"neck.diameter": "neck_diameter", "cavity.diameter": "cavity_diameter",
              "cavity.length": "cavity_length"}
 """Fields a [[taxel]] entry may set for itself (the neck length is the plate's sheet, shared)."""
@@ -57,17 +56,40 @@ def _harmonic_top(placed, band, guard: float) -> float | None:
     return max(c.band_hz[1] for c in hits) if hits else None
 
 
-def _one(base, name: str, start: float, vary, ratio: float):
-    """Solve one taxel so that its loaded band starts at or just above ``start`` (Hz): (solution, band)."""
+def _one(base, name: str, start: float, stop: float, vary, ratio: float):
+    """Solve one taxel so that its loaded band starts at or just above ``start`` (Hz): (solution, band). The
+    lowest target f0 whose band clears ``start`` is found by bisection on the target (the band's shape changes
+    with the geometry, so its low edge is not a fixed fraction of f0); a target whose solve fails counts as not
+    clearing. Raises the last failure when no target up to ``stop`` (Hz) works."""
     from matcad.acoustics.bands import taxel_band
 
-    for _ in range(SHAPE_ITERATIONS):
-        solution = solve(base, start * ratio * (1 + TARGET_MARGIN), vary)
-        band = taxel_band(solution.spec, name)
-        if band.loaded_hz[0] >= start:
-            return solution, band
-        ratio = band.f0_hz / band.loaded_hz[0]
-    return solution, band
+    def attempt(target):
+        try:
+            solution = solve(base, target, vary)
+        except (Unreachable, RulesFailed) as exc:
+            return exc, None
+        return solution, taxel_band(solution.spec, name, mechanics=False)  # the low edge needs no rise
+
+    low, high, found, failure = start, None, None, None
+    target = start * ratio * (1 + TARGET_MARGIN)
+    while high is None:  # step up from the shape estimate until a band clears the start
+        if target > stop:
+            raise failure or Unreachable(f"no f0 up to {stop:g} Hz gives a band above {start:.0f} Hz")
+        solution, band = attempt(target)
+        if band is not None and band.loaded_hz[0] >= start:
+            high, found = target, (solution, band)
+        else:
+            low, failure = target, solution if band is None else failure
+            target *= 1 + STEP_UP
+    while high / low - 1 > TARGET_MARGIN:
+        mid = (low * high) ** 0.5
+        solution, band = attempt(mid)
+        if band is not None and band.loaded_hz[0] >= start:
+            high, found = mid, (solution, band)
+        else:
+            low = mid
+    solution = found[0]
+    return solution, taxel_band(solution.spec, name)
 
 
 def grid(n: int, pitch: float) -> list[tuple[float, float]]:
@@ -78,21 +100,28 @@ def grid(n: int, pitch: float) -> list[tuple[float, float]]:
             for r in range(rows) for c in range(columns)][:n]
 
 
-def array_spec(base, solutions, name: str):
-    """An array spec: ``base``'s shared tables, one [[taxel]] per solution with its varied fields, on a grid
-    (pitch = widest cap flange + the laser's smallest web), the plate grown by the grid's extent (mm)."""
+def board_base(base, n: int):
+    """(the single-taxel spec every taxel is solved on, the n grid positions): the pitch is the cap flange plus
+    the laser's smallest web (the varied fields leave the cap's footprint alone: its outside is resolved), and the
+    plate grows by the grid's extent — before solving, because the mount mouth's end correction depends on the
+    plate (mm)."""
     from matcad.parts.features import cap_flange_diameter_mm
-    from matcad.spec import from_dict
-    from matcad.design.spec_toml import plain
-    from matcad.spec import to_dict
 
-    pitch = max(cap_flange_diameter_mm(s.spec) for s in solutions) + base.machine.laser_min_feature
-    points = grid(len(solutions), pitch)
+    points = grid(n, cap_flange_diameter_mm(base) + base.machine.laser_min_feature)
     xs, ys = [p[0] for p in points], [p[1] for p in points]
+    plate = dataclasses.replace(base.plate, width=base.plate.width + max(xs) - min(xs),
+                                depth=base.plate.depth + max(ys) - min(ys))
+    return dataclasses.replace(base, plate=plate), points
+
+
+def array_spec(base, points, solutions, name: str):
+    """An array spec: ``base``'s tables shared, one [[taxel]] per solution at ``points`` (mm) with its varied
+    fields."""
+    from matcad.design.spec_toml import plain
+    from matcad.spec import from_dict, to_dict
+
     data = plain(to_dict(base))
     data["name"] = name
-    data["plate"]["width"] = base.plate.width + max(xs) - min(xs)
-    data["plate"]["depth"] = base.plate.depth + max(ys) - min(ys)
     data["taxel"] = [{"name": f"t{i}", "x": round(x, 6), "y": round(y, 6)}
                      | {PER_TAXEL[k]: v[1] for k, v in s.fields.items()}
                      for i, ((x, y), s) in enumerate(zip(points, solutions), 1)]
@@ -116,7 +145,7 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     if bad:
         raise ValueError(f"--vary {bad[0]}: with --taxels only per-taxel fields vary: {', '.join(CONTINUOUS)} "
                          "(the neck length is the plate's sheet, shared by every taxel)")
-    base = taxel_spec(spec, taxels(spec)[0])
+    base, points = board_base(taxel_spec(spec, taxels(spec)[0]), n)
     guard = guard_hz(spec.microphone.sample_rate_hz)
     shape = taxel_band(base)
     ratio = shape.f0_hz / shape.loaded_hz[0]
@@ -124,9 +153,12 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     for k in range(1, n + 1):
         while True:
             try:
-                solution, band = _one(base, f"t{k}", start, vary, ratio)
+                solution, band = _one(base, f"t{k}", start, hi_hz, vary, ratio)
             except (Unreachable, RulesFailed) as exc:
                 raise type(exc)(*_fit_text(exc, k, n, lo_hz, hi_hz, placed)) from None
+            if band.loaded_hz[0] < start:  # the load lowered f somewhere below max force: start that much higher
+                start = 2 * start - band.loaded_hz[0]
+                continue
             top = _harmonic_top(placed, band, guard)
             if top is None:
                 break
@@ -137,7 +169,7 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
         solutions.append(solution)
         ratio = band.f0_hz / band.loaded_hz[0]
         start = band.loaded_hz[1] + guard
-    out = array_spec(base, solutions, name or f"{spec.name}-{n}taxels")
+    out = array_spec(base, points, solutions, name or f"{spec.name}-{n}taxels")
     findings = check(out)
     if errors(findings):
         bad = "; ".join(f"{f.id}: {f.message}" for f in errors(findings))

@@ -96,7 +96,8 @@ def parse_vary(spec, items, allowed=FIELDS) -> dict[str, tuple[float, float] | N
     for item in items:
         path, _, rng = item.partition("=")
         if path not in allowed:
-            raise ValueError(f"--vary {item}: field must be one of {', '.join(allowed)}")
+            why = f" ({SHEET} is the plate's sheet, shared by every taxel of a board)" if path == SHEET else ""
+            raise ValueError(f"--vary {item}: field must be one of {', '.join(allowed)}{why}")
         if path in out:
             raise ValueError(f"--vary {path} given twice")
         if not rng:

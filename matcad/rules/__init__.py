@@ -6,7 +6,7 @@ Levels: ``error`` (the part will not work or cannot be made: `build` refuses wit
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 LEVELS = ("error", "warning", "info")
 
@@ -27,17 +27,24 @@ class Finding:
 
 
 def check(spec, prediction=None) -> list[Finding]:
-    """Run every rule on ``spec``; ``prediction`` (from acoustics.predict) is computed when not given."""
+    """Run every rule on ``spec``; ``prediction`` (from acoustics.predict, of a single-taxel spec) is computed when
+    not given; a board's acoustic rules run on each taxel's own prediction."""
     from matcad.acoustics.predict import predict
     from matcad.rules import acoustic, bands, laser, printing, stack
 
-    prediction = prediction or predict(spec)
+    from matcad.taxel import taxel_spec, taxels
+
     findings: list[Finding] = []
     for module in (laser, printing, stack, bands):
         for rule in module.RULES:
             findings += rule(spec)
-    for rule in acoustic.RULES:
-        findings += rule(spec, prediction)
+    board = taxels(spec)
+    for taxel in board:  # the sound rules per taxel, on its own prediction; a board's messages name the taxel
+        one = taxel_spec(spec, taxel)
+        p = (prediction or predict(one)) if len(board) == 1 else predict(one)
+        for rule in acoustic.RULES:
+            findings += [f if len(board) == 1 else replace(f, message=f"{taxel.name}: {f.message}")
+                         for f in rule(one, p)]
     order = {level: i for i, level in enumerate(LEVELS)}
     return sorted(findings, key=lambda f: order[f.level])
 
