@@ -428,6 +428,8 @@ def cmd_sweep(args) -> int:
 
 def cmd_design(args) -> int:
     """Inverse design: one taxel onto --target-hz, or --taxels N disjoint bands in --band LO HI."""
+    import dataclasses
+
     from matcad.design import RulesFailed
     from matcad.design.spec_toml import write_design
 
@@ -443,8 +445,8 @@ def cmd_design(args) -> int:
             if not args.vary:
                 raise ValueError("--target-hz needs --vary FIELD [FIELD ...] (the fields the solver may change)")
             result = solve(spec, args.target_hz, parse_vary(spec, args.vary))
-            result = type(result)(**{**result.__dict__, "spec": _renamed(result.spec, args.name or
-                                                                          f"{spec.name}-{args.target_hz:.0f}hz")})
+            result = dataclasses.replace(result, spec=dataclasses.replace(
+                result.spec, name=args.name or f"{spec.name}-{args.target_hz:.0f}hz"))
         else:
             from matcad.design.allocate import allocate
             from matcad.design.solve import CONTINUOUS, parse_vary
@@ -469,12 +471,6 @@ def cmd_design(args) -> int:
         print(_format_design(result))
         print(f"  {result.spec.name}.toml and design.json in {target}/")
     return EXIT_OK
-
-
-def _renamed(spec, name: str):
-    import dataclasses
-
-    return dataclasses.replace(spec, name=name)
 
 
 def _format_design(result) -> str:

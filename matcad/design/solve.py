@@ -145,7 +145,6 @@ class _Route:
         self.spec, self.model, self.base = spec, model, base
         self.x0 = {p: get_field(spec, p) for p in ranges}
         self.evaluations = 0
-        f0 = self.f(self._point(0.0, {p: 0.0 for p in ranges}))
         grad = {}
         for p in ranges:  # ∂ln f/∂ln x by central differences (1e-4 in ln x)
             h = 1e-4
@@ -154,7 +153,6 @@ class _Route:
             grad[p] = (math.log(up) - math.log(down)) / (2 * h)
         norm = math.sqrt(sum(g * g for g in grad.values())) or 1.0
         self.g = {p: g / norm for p, g in grad.items()}
-        self.f_start = f0
         lo, hi = -math.inf, math.inf
         for p, (a, b) in ranges.items():  # every field stays inside its range
             g = self.g[p]
@@ -210,9 +208,14 @@ def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -
     from matcad.acoustics.predict import predict
     from matcad.rules import check, errors
 
+    from matcad.taxel import is_array
+
     start = time.perf_counter()
     if not (math.isfinite(target_hz) and target_hz > 0):
         raise ValueError(f"--target-hz {target_hz:g} invalid, must be a finite frequency > 0 Hz")
+    if is_array(spec):
+        raise ValueError("--target-hz solves one taxel: give a single-taxel spec (--taxels N --band LO HI designs a "
+                         "board)")
     model, base = chosen_model(spec)
     sheets = _stock_order(spec) if SHEET in vary else [spec.neck.length]
     continuous = {p: (r or default_range(spec, p)) for p, r in vary.items() if p != SHEET}

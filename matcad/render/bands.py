@@ -39,6 +39,7 @@ def band_chart(d: dict, path: Path) -> dict:
     g = d["guard_hz"]
     with figure(path, 7.6, 1.4 + 0.45 * len(rows)) as fig:
         ax = fig.add_subplot(1, 1, 1)
+        harmonic_drawn = False
         for y, t in enumerate(reversed(rows)):
             (ul, uh), (ll, lh) = t["unloaded_hz"], t["loaded_hz"]
             ax.barh(y, uh - ul, left=ul, height=0.5, color="#5b8fc7", label="unloaded band" if y == 0 else None)
@@ -51,12 +52,12 @@ def band_chart(d: dict, path: Path) -> dict:
                         linewidth=0.0, label="guard" if y == 0 and edge < ll else None)
             ax.plot([t["f0_hz"]], [y], marker="|", markersize=12, color="black")
             for n in d["harmonics"]:
-                a, b = n * ll, n * lh
-                if a < hi and b > lo:
-                    ax.barh(y - 0.32, min(b, hi) - max(a, lo), left=max(a, lo), height=0.14, color="#9b59b6",
-                            alpha=0.6, label=f"harmonics ({', '.join(f'{k}f' for k in d['harmonics'])})"
-                            if not any(h.get_label().startswith("harmonics") for h in ax.patches) else None)
-                    ax.text(max(a, lo), y - 0.32, f" {n}f", fontsize=6, va="center")
+                a, b = max(n * ll, lo), min(n * lh, hi)
+                if a < b:  # only where it falls on the chart, i.e. near the bands
+                    ax.barh(y - 0.32, b - a, left=a, height=0.14, color="#9b59b6", alpha=0.6,
+                            label=None if harmonic_drawn else "harmonics of the loaded band")
+                    ax.text(a, y - 0.32, f" {n}f", fontsize=6, va="center")
+                    harmonic_drawn = True
         for c in d["conflicts"]:  # where the two (guarded) bands meet
             a, b = sorted((max(c["band_hz"][0], c["other_hz"][0]), min(c["band_hz"][1], c["other_hz"][1])))
             ax.axvspan(a - g / 2, b + g / 2, color="#d62728", alpha=0.25,

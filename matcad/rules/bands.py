@@ -27,9 +27,9 @@ def band_separation(spec) -> list[Finding]:
     guard = guard_hz(spec.microphone.sample_rate_hz)
     out = [Finding("bands.overlap" if c.harmonic == 1 else "bands.harmonic", "error", round(c.gap_hz, 1),
                    round(guard, 1), c.describe(), FIX) for c in conflicts(bands, guard)]
+    listing = "; ".join(f"{b.name} {b.loaded_hz[0]:.0f}-{b.loaded_hz[1]:.0f} Hz" for b in bands)
     out.append(Finding("bands.allocation", "info", {b.name: [round(v) for v in b.loaded_hz] for b in bands},
-                       round(guard, 1), "loaded bands up to " f"{spec.mechanics.max_force_n:g} N: " + "; ".join(
-                           f"{b.name} {b.loaded_hz[0]:.0f}-{b.loaded_hz[1]:.0f} Hz" for b in bands)))
+                       round(guard, 1), f"loaded bands up to {spec.mechanics.max_force_n:g} N: {listing}"))
     return out
 
 
