@@ -102,12 +102,14 @@ def write_archive(folder: Path, name: str) -> None:
 
 def board_bands(spec) -> dict:
     """Every taxel's band as report data (:func:`matcad.acoustics.bands.summary`). An array's loaded bands take
-    the cap mechanics when it has no [calibration] (its rules need them anyway); a single taxel without one takes
-    the cheap path (no FElupe: the loaded rise is marked not computed, `matcad predict --load` gives it)."""
+    the cap mechanics when it has no [calibration] (its rules need them anyway); a single taxel takes the cheap
+    path (no FElupe) and never fails on its rise: without a calibration, or past where it holds, the loaded rise
+    is marked not computed and says why (`matcad predict --load` gives the mechanics curve)."""
     from matcad.acoustics.bands import summary, taxel_bands
     from matcad.taxel import is_array
 
-    return summary(spec, taxel_bands(spec, mechanics=is_array(spec)))
+    board = is_array(spec)
+    return summary(spec, taxel_bands(spec, mechanics=board, strict=board))
 
 
 def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:

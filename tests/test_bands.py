@@ -163,3 +163,13 @@ def test_a_taxel_at_twice_anothers_f0_breaks_the_harmonic_rule():
     assert f.id == "bands.harmonic" and "t1's harmonic 2f" in f.message and "t2's loaded band" in f.message
     assert f.value == pytest.approx(max(2 * b1.loaded_hz[0], b2.loaded_hz[0]) - min(2 * b1.loaded_hz[1], b2.loaded_hz[1]),
                                     abs=0.05)  # rounded to 0.1 Hz
+
+
+def test_single_taxel_build_bands_never_fail_on_the_rise():
+    from matcad.build import board_bands
+
+    s = spec_mod.load(PAPER)
+    s = dataclasses.replace(s, mechanics=dataclasses.replace(s.mechanics, max_force_n=30.0))
+    (t,) = board_bands(s)["taxels"]
+    assert t["rise"] == 1.0 and "not computed" in t["rise_source"] and "mechanics.max_force_n" in t["rise_source"]
+    assert t["loaded_hz"] == t["unloaded_hz"]

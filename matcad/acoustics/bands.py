@@ -158,34 +158,42 @@ def mechanics_rise(spec, f0_hz: float, max_force_n: float) -> tuple[float, float
 
 
 def taxel_band(spec, name: str = "t1", x_mm: float = 0.0, y_mm: float = 0.0, mechanics: bool = True,
-               prediction=None) -> TaxelBand:
+               prediction=None, strict: bool = True) -> TaxelBand:
     """The band of the single-taxel ``spec`` (see the module docstring). ``mechanics=False`` is the cheap path:
     without a [calibration] the rise is then not computed (``rise`` 1, ``rise_source`` says so) and FElupe is not
-    imported. ``prediction`` is ``predict(spec)`` when the caller has it."""
+    imported. A maximum force the rise's model does not reach raises SpecError, or with ``strict=False`` leaves the
+    rise not computed and says why. ``prediction`` is ``predict(spec)`` when the caller has it."""
     from matcad.acoustics.predict import predict, spec_calibration
+    from matcad.spec import SpecError
 
     p = prediction or predict(spec, mechanics=False)
     force = spec.mechanics.max_force_n
     cal = spec_calibration(spec)
-    if cal is not None:
-        low, high = eq5_rise(cal, force)
-        source = f"calibration {cal.name} (paper Eq. 5)"
-    elif mechanics:
-        low, high, source = mechanics_rise(spec, p.f0_hz, force)
-    else:
-        low, high = 1.0, 1.0
-        source = ("not computed (no [calibration]; the cap mechanics run was skipped: `matcad predict --load` or "
-                  "an array's `matcad check` runs it)")
+    try:
+        if cal is not None:
+            low, high = eq5_rise(cal, force)
+            source = f"calibration {cal.name} (paper Eq. 5)"
+        elif mechanics:
+            low, high, source = mechanics_rise(spec, p.f0_hz, force)
+        else:
+            low, high = 1.0, 1.0
+            source = ("not computed (no [calibration]; the cap mechanics run was skipped: `matcad predict --load` "
+                      "or an array's `matcad check` runs it)")
+    except SpecError as exc:
+        if strict:
+            raise
+        low, high, source = 1.0, 1.0, f"not computed ({exc})"
     lo, hi = p.band_hz
     return TaxelBand(name, p.f0_hz, (lo, hi), (lo * min(1.0, low), hi * high), p.model, force, high, source,
                      x_mm, y_mm)
 
 
-def taxel_bands(spec, mechanics: bool = True) -> list[TaxelBand]:
-    """One :class:`TaxelBand` per taxel of ``spec``, in :func:`matcad.taxel.taxels` order (Hz, mm)."""
+def taxel_bands(spec, mechanics: bool = True, strict: bool = True) -> list[TaxelBand]:
+    """One :class:`TaxelBand` per taxel of ``spec``, in :func:`matcad.taxel.taxels` order (Hz, mm); ``mechanics``
+    and ``strict`` as for :func:`taxel_band`."""
     from matcad.taxel import taxel_spec, taxels
 
-    return [taxel_band(taxel_spec(spec, t), t.name, t.x, t.y, mechanics) for t in taxels(spec)]
+    return [taxel_band(taxel_spec(spec, t), t.name, t.x, t.y, mechanics, strict=strict) for t in taxels(spec)]
 
 
 def summary(spec, bands) -> dict:
