@@ -654,9 +654,11 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--vary", action="append", required=True, metavar="FIELD=LO:HI:N",
                    help="vary a numeric spec field over N evenly spaced values (or FIELD=a,b,c); repeat for a "
                         "full grid (e.g. --vary cavity.length=3:6:7 --vary neck.diameter=1.5,2.1)")
-    w.add_argument("--model", help="model for every variant (default the spec's own choice; 'fem' adds the FEM)")
+    w.add_argument("--model", choices=model_choices(),
+                   help="model for every variant (default the spec's own choice; 'fem' adds the FEM)")
     w.add_argument("--fem-level", type=int, help="FEM mesh refinement with --model fem (default 8)")
-    w.add_argument("--workers", type=int, default=1, help="local processes for the per-variant work (default 1)")
+    w.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                   help="local processes for the per-variant work (default one per CPU; 1 = in this process)")
     w.add_argument("--scheduler", metavar="ADDRESS", help="run the per-variant work on this Dask scheduler "
                                                           "(tcp://host:8786; needs matcad[cluster])")
     w.add_argument("--no-rules", action="store_true", help="skip the design rules (fast-model sweeps then "

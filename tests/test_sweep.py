@@ -185,7 +185,10 @@ def test_grid_cap_and_bad_model(tmp_path):
                            "--out", tmp_path / "s")
     assert code == 2 and "40000 variants, at most 20000" in err
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--model", "lumpd", "--out", tmp_path / "s")
-    assert code == 2 and "--model 'lumpd' invalid" in err and "lumped" in err
+    assert code == 2 and "'lumpd'" in err and "lumped" in err
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--model", "elastic_wall",
+                           "--set", "wall.model=rigid", "--out", tmp_path / "s")
+    assert code == 2 and "--model 'elastic_wall' invalid" in err and "transmission_line" in err
     assert not list(tmp_path.iterdir())
 
 
@@ -228,7 +231,7 @@ def test_cli_two_axes_table_and_heat_maps_read_back(tmp_path):
 
 def test_cli_one_axis_line_maps(tmp_path, write_spec):
     out = tmp_path / "s1"
-    code, _, err = run_cli("sweep", write_spec(MINIMAL), "--vary", "neck.length=2:8:7", "--out", out)
+    code, _, err = run_cli("sweep", write_spec(MINIMAL), "--vary", "neck.length=2:8:7", "--out", out, "--workers", "1")
     assert code == 0, err
     with open(out / "sweep.csv", newline="") as f:
         rows = list(csv.DictReader(f))

@@ -14,14 +14,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.acoustics import models, uncertainty
+from matcad.acoustics import models, registry, uncertainty
 from matcad.acoustics.air import boundary_layer_shift, speed_of_sound_m_s
 from matcad.acoustics.predict import (LUMPED_END_CORRECTION_RATIO, LUMPED_NECK_AIR_RATIO, PANCAKE_L_OVER_D,
                                       PLANE_WAVE_CUTOFF_KA)
 from matcad.acoustics.resonator import as_built, evaluate
 
-VECTORISED = ("lumped", "end_corrected", "transmission_line")
-"""The rungs that are closed forms of the geometry (no wall modes, no reference, no FEM)."""
+VECTORISED = tuple(m.name for m in registry.MODELS if m.cheap and "rigid" in m.walls)
+"""The registered rungs that are closed forms of the geometry alone (no wall, no reference, no FEM): lumped,
+end_corrected, transmission_line."""
 FIELDS = ("cavity.diameter", "cavity.length", "neck.diameter", "neck.length", "mold.draft_deg", "air.temperature_c",
           "air.speed_of_sound", "spacer.height", "plate.width", "plate.depth")
 """The spec fields the closed-form rungs read; df0/dfield of any other field is exactly 0 for them."""

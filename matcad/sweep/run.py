@@ -74,11 +74,11 @@ class SweepResult:
 
 
 def allowed_models(spec) -> list[str]:
-    """Model names ``--model`` accepts for ``spec``: the cheap rungs, ``fem``, and ``relative`` with a
-    [reference]."""
-    from matcad.acoustics.resonator import CHEAP_MODELS
+    """Model names a sweep of ``spec`` accepts: the registered models evaluated for its wall
+    (:mod:`matcad.acoustics.registry`), and the derived ``relative`` when it has a [reference]."""
+    from matcad.acoustics.registry import DERIVED, MODELS
 
-    return [*CHEAP_MODELS, "fem", *(["relative"] if spec.reference is not None else [])]
+    return [m.name for m in MODELS if spec.wall.model in m.walls] + (list(DERIVED) if spec.reference else [])
 
 
 def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor: Executor = Executor(),
