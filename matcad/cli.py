@@ -100,13 +100,17 @@ def _format_load_curve(p) -> list[str]:
     return lines
 
 
-def cmd_predict(args) -> int:
-    from matcad.acoustics.predict import predict
-
+def _check_fem_level(args) -> None:
     if args.fem_level is not None and args.model != "fem":
         raise ValueError(f"--fem-level {args.fem_level} applies only with --model fem (it sets the FEM's mesh)")
     if args.fem_level is not None and not 1 <= args.fem_level <= 64:
         raise ValueError(f"--fem-level {args.fem_level} invalid, must be 1-64 elements across the neck radius")
+
+
+def cmd_predict(args) -> int:
+    from matcad.acoustics.predict import predict
+
+    _check_fem_level(args)
     if args.force_deprecated:
         print("matcad: note: predict --force is deprecated (it clashed with build --force); use --load",
               file=sys.stderr)
@@ -409,6 +413,7 @@ def cmd_sweep(args) -> int:
 
     if not 1 <= args.workers <= 256:
         raise ValueError(f"--workers {args.workers} invalid, must be 1-256 local processes")
+    _check_fem_level(args)
     axes = parse_axes(args.vary)
     data = apply_sets(read_spec_data(args.spec), args.set)
     _load_spec(args.spec, args)  # validates the base spec (exit 2 naming the field) and prints its notes
@@ -416,12 +421,14 @@ def cmd_sweep(args) -> int:
                    rules=not args.no_rules, cad=args.cad, fem_level=args.fem_level)
     target, files = write(result, args.out or Path("out") / f"{result.name}-sweep")
     counts = {s: sum(r["status"] == s for r in result.rows) for s in ("ok", "invalid", "failed")}
+    counts["rule_errors"] = sum(bool(r.get("rule_errors")) for r in result.rows)
     if args.json:
         _print_json({"out_dir": str(target), "written": files, "model": result.model, "variants": len(result.rows),
                      **counts, "seconds": round(result.seconds, 3)})
     else:
         print(f"{result.name}: {len(result.rows)} variants ({counts['ok']} ok, {counts['invalid']} invalid, "
-              f"{counts['failed']} failed) by {result.model} on {result.executor} in {result.seconds:.1f} s")
+              f"{counts['failed']} failed; {counts['rule_errors']} with design-rule errors) by {result.model} on "
+              f"{result.executor} in {result.seconds:.1f} s")
         print(f"  {', '.join(files)} in {target}/")
     return EXIT_OK
 

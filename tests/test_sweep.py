@@ -112,6 +112,12 @@ def test_per_variant_model_and_grid_slope():
     col = sensitivity_column(result.axes[0])
     assert result.rows[1][col] == pytest.approx((f0[2] - f0[0]) / 1.0)
     assert result.rows[0][col] == pytest.approx((f0[1] - f0[0]) / 0.5)
+    edge = sweep(data, parse_axes(["neck.diameter=1.8,2.4,3.3"]), rules=False)  # 3.3 mm > the 3.18 mm cavity
+    f0 = [r.get("f0_hz") for r in edge.rows]
+    assert edge.rows[2]["status"] == "invalid" and f0[2] is None
+    col = sensitivity_column(edge.axes[0])
+    assert edge.rows[1][col] == pytest.approx((f0[1] - f0[0]) / 0.6) == edge.rows[0][col]
+    assert col not in edge.rows[2]
 
 
 def test_failed_variant_is_recorded_not_fatal(monkeypatch):
@@ -189,6 +195,9 @@ def test_grid_cap_and_bad_model(tmp_path):
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--model", "elastic_wall",
                            "--set", "wall.model=rigid", "--out", tmp_path / "s")
     assert code == 2 and "--model 'elastic_wall' invalid" in err and "transmission_line" in err
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--fem-level", "99", "--model", "fem",
+                           "--out", tmp_path / "s")
+    assert code == 2 and "--fem-level 99 invalid" in err
     assert not list(tmp_path.iterdir())
 
 
@@ -209,7 +218,7 @@ def test_cli_two_axes_table_and_heat_maps_read_back(tmp_path):
                                 "--out", out, "--json")
     assert code == 0, err
     summary = json.loads(stdout)
-    assert summary["variants"] == 12 and summary["invalid"] == 4
+    assert summary["variants"] == 12 and summary["invalid"] == 4 and summary["rule_errors"] >= 1
     with open(out / "sweep.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == 12

@@ -106,7 +106,7 @@ def write_maps(result: SweepResult, folder: Path) -> list[str]:
             for i, j in zip(*np.nonzero(errors > 0)):
                 ax.add_patch(Rectangle((xe[j], ye[i]), xe[j + 1] - xe[j], ye[i + 1] - ye[i], fill=False,
                                        hatch="///", edgecolor="white", linewidth=0.0))
-            ax.set_title(f"{label}; hatched: design-rule errors")
+            ax.set_title(f"{label}\nhatched: design-rule errors; blank: invalid or failed", fontsize=10)
             y_label = _label(y_axis)
         ax.set_xlabel(_label(x_axis))
         ax.set_ylabel(y_label)

@@ -6,7 +6,7 @@ Frequencies Hz; sensitivities in Hz per the varied field's unit (Hz/mm for lengt
   df0/dfield is the model's own derivative (central difference at each variant).
 - Any other model (elastic_wall, soft_wall, relative, fem) runs :func:`matcad.acoustics.predict.predict` per
   variant on the executor; df0/dfield is then the slope of f0 along that axis of the grid (``numpy.gradient``:
-  central differences inside, one-sided at the ends; blank for an axis of one value or next to a failed variant).
+  central differences inside, one-sided at the ends and next to a failed variant; blank for an axis of one value).
 - df0/dF (Hz/N) is paper Eq. 5's slope at 0 N, f(0)·b/(2·V0), from the spec's [calibration] (blank without one):
   it follows the neck and the air, not the cavity, because V0 is the calibrated taxel's. The cap mechanics
   (FElupe, seconds per variant) is not run in a sweep.
@@ -139,13 +139,20 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
 
 
 def _grid_slopes(result: SweepResult) -> None:
-    """df0/dfield along each axis of the grid for the per-variant models (numpy.gradient on the axis values)."""
+    """df0/dfield along each axis of the grid for the per-variant models: numpy.gradient on the axis values
+    (second-order central inside, one-sided at the ends), one-sided next to an invalid or failed variant."""
     f0 = result.column("f0_hz")
     for k, axis in enumerate(result.axes):
-        name = sensitivity_column(axis)
         if len(axis.values) < 2:
             continue
-        slope = np.gradient(f0, np.array(axis.values), axis=k).ravel()
-        for row, s in zip(result.rows, slope):
+        x = np.array(axis.values)
+        f = np.moveaxis(f0, k, -1)
+        step = np.diff(f, axis=-1) / np.diff(x)
+        pad = np.full(f.shape[:-1] + (1,), np.nan)
+        forward, backward = np.concatenate([step, pad], axis=-1), np.concatenate([pad, step], axis=-1)
+        slope = np.gradient(f, x, axis=-1)
+        slope = np.where(np.isnan(slope), np.where(np.isnan(forward), backward, forward), slope)
+        name = sensitivity_column(axis)
+        for row, s in zip(result.rows, np.moveaxis(slope, -1, k).ravel()):
             if np.isfinite(s):
                 row[name] = float(s)
