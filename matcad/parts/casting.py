@@ -8,10 +8,14 @@ volumes in ml, temperatures in °C, times in minutes or hours as named.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 from matcad.materials import grade
 from matcad.parts.features import cap_volume_mm3
 from matcad.parts.mold_layout import layout
+
+if TYPE_CHECKING:
+    from matcad.spec import Spec
 
 MIN_BATCH_G = 10.0
 """Smallest mix worth weighing: on a 0.01 g kitchen/lab scale each part of a 1:1 mix is then weighed to ±0.2 %
@@ -19,18 +23,28 @@ MIN_BATCH_G = 10.0
 fraction. A 0.5 g mix is all cup residue and cannot be ratioed reliably (off-ratio platinum silicone stays
 tacky)."""
 
+
+@dataclass(frozen=True)
+class MoldMaterial:
+    """A printed mold's material: its name, the warmest cure it stands (°C) and why, and whether it inhibits a
+    platinum cure (empty when it does not)."""
+
+    label: str
+    max_cure_c: float
+    note: str
+    inhibition: str = ""
+
+
 MOLD_MATERIALS = {
-    "fdm": {"label": "PLA (FDM)", "max_cure_c": 45.0,
-            "note": "PLA softens near its glass transition (~55–60 °C): a warm cure must stay ≤ 45 °C or the core "
-                    "pins droop", "inhibition": ""},
-    "sla": {"label": "SLA resin", "max_cure_c": 45.0,
-            "note": "standard SLA resins soften from ~50 °C (heat deflection 50–70 °C): stay ≤ 45 °C unless the "
-                    "resin's data sheet allows more",
-            "inhibition": "platinum-cure silicone (Dragon Skin, Ecoflex, Sylgard 184) may stay tacky against SLA "
-                          "resin: uncured photoinitiator and monomer inhibit the platinum catalyst. Wash the mold "
-                          "in IPA, post-cure it fully (UV, then ~2 h at 45 °C or the resin maker's schedule), or "
-                          "seal it with a barrier coat (clear acrylic lacquer); cast a test drop first and check "
-                          "it cures tack-free where it touched the resin"},
+    "fdm": MoldMaterial("PLA (FDM)", 45.0, "PLA softens near its glass transition (~55–60 °C): a warm cure must "
+                        "stay ≤ 45 °C or the core pins droop"),
+    "sla": MoldMaterial("SLA resin", 45.0, "standard SLA resins soften from ~50 °C (heat deflection 50–70 °C): stay "
+                        "≤ 45 °C unless the resin's data sheet allows more",
+                        "platinum-cure silicone (Dragon Skin, Ecoflex, Sylgard 184) may stay tacky against SLA "
+                        "resin: uncured photoinitiator and monomer inhibit the platinum catalyst. Wash the mold "
+                        "in IPA, post-cure it fully (UV, then ~2 h at 45 °C or the resin maker's schedule), or "
+                        "seal it with a barrier coat (clear acrylic lacquer); cast a test drop first and check "
+                        "it cures tack-free where it touched the resin"),
 }
 """What the printed mold's material allows; keyed by ``machine.printer``."""
 
@@ -64,7 +78,7 @@ class CastingGuide:
         return asdict(self)
 
 
-def casting_guide(spec) -> CastingGuide:
+def casting_guide(spec: Spec) -> CastingGuide:
     """The pour for ``spec``: batch = max(cast volume × waste factor × density, :data:`MIN_BATCH_G`) (g)."""
     g = grade(spec.silicone.grade)
     mold = MOLD_MATERIALS[spec.machine.printer]
@@ -79,10 +93,10 @@ def casting_guide(spec) -> CastingGuide:
     lay = layout(spec)
     vents = len(lay.plan.inner) + len(lay.plan.outer)
     steps = (
-        f"Print the mold ({mold['label']}): end_cap_mold_base.stl and end_cap_mold_lid.stl, each as exported "
+        f"Print the mold ({mold.label}): end_cap_mold_base.stl and end_cap_mold_lid.stl, each as exported "
         f"(flat face down, no supports). Clear every vent with a {spec.mold.vent:g} mm drill or pin.",
         *(("SLA: post-cure the printed mold fully, or barrier-coat it, and cast a test drop (cure inhibition, "
-           "above).",) if mold["inhibition"] else ()),
+           "above).",) if mold.inhibition else ()),
         f"Release: {RELEASE_AGENT}.",
         f"Close the mold: lid on the base (the keys centre it), {len(lay.bolts)} x {spec.mold.bolt} bolts with nuts, "
         "finger-tight and even; set it level, fill ports up.",
@@ -91,8 +105,8 @@ def casting_guide(spec) -> CastingGuide:
         f"Fill each cap through its {spec.mold.fill_port:g} mm fill port with a syringe, slowly, one cap at a time: "
         "first the core-pin vent must show silicone (the closed end over the membrane is full), then every one of "
         f"the {vents} base-face vents; top the port up as the level settles.",
-        f"Cure {g.cure_h_room:g} h at room temperature (23 °C), or warm at most {mold['max_cure_c']:g} °C: "
-        f"{mold['note']}.",
+        f"Cure {g.cure_h_room:g} h at room temperature (23 °C), or warm at most {mold.max_cure_c:g} °C: "
+        f"{mold.note}.",
         "Demold: remove the bolts, lift the lid straight up (the core pins slide out of the cavities), then push "
         "each cap out of the base by its flange.",
     )
@@ -103,8 +117,8 @@ def casting_guide(spec) -> CastingGuide:
         "out with tweezers through the cavity opening or snip it flush with micro scissors: a stub changes the "
         "cavity volume and the membrane's stiffness",
     )
-    return CastingGuide(grade=g.label, mold_material=mold["label"], caps=caps, cast_volume_ml=cast_ml,
+    return CastingGuide(grade=g.label, mold_material=mold.label, caps=caps, cast_volume_ml=cast_ml,
                         needed_g=needed, batch_g=batch, batch_reason=reason, mix_ratio=g.mix_ratio,
-                        pot_life_min=g.pot_life_min, cure_h_room=g.cure_h_room, max_cure_c=mold["max_cure_c"],
-                        cure_note=mold["note"], release=RELEASE_AGENT, inhibition=mold["inhibition"],
+                        pot_life_min=g.pot_life_min, cure_h_room=g.cure_h_room, max_cure_c=mold.max_cure_c,
+                        cure_note=mold.note, release=RELEASE_AGENT, inhibition=mold.inhibition,
                         vents_per_cap=vents, steps=steps, trim=trim)

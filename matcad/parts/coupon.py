@@ -9,9 +9,14 @@ difference back (<sheet>.laser_kerf, fasteners fits).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Sequence
+
 from matcad.parts.features import bolt_clearance_mm, sheet_kerf_mm, sheet_thickness_mm
 from matcad.parts.flat import Engraving, Flat, Hole, engraving_outlines
 from matcad.parts.registry import Kind, PrintPose, parts
+
+if TYPE_CHECKING:
+    from matcad.spec import Spec
 
 NECK_SWEEP_MM = (-0.2, -0.15, -0.1, -0.05, 0.0, 0.05, 0.1, 0.15, 0.2)
 DOWEL_SWEEP_MM = (0.0, 0.05, 0.1, 0.15, 0.2)
@@ -35,11 +40,11 @@ SHEET_ROWS = {"plate": ("neck", "dowel"), "guide": ("dowel", "bolt"), "spacer": 
 """Which fits each sheet's coupon sweeps: the holes that sheet really carries."""
 
 
-def _row(sizes, y, pitch, purpose, x0):
+def _row(sizes: Sequence[float], y: float, pitch: float, purpose: str, x0: float) -> list[Hole]:
     return [Hole(x0 + i * pitch, y, size, purpose) for i, size in enumerate(sizes)]
 
 
-def _sweep(spec, purpose: str) -> list[float]:
+def _sweep(spec: Spec, purpose: str) -> list[float]:
     if purpose == "neck":
         return [spec.neck.diameter + dx for dx in NECK_SWEEP_MM]
     if purpose == "dowel":
@@ -47,13 +52,13 @@ def _sweep(spec, purpose: str) -> list[float]:
     return [bolt_clearance_mm(spec.fasteners.bolt, spec.fasteners.bolt_fit) + dx for dx in BOLT_SWEEP_MM]
 
 
-def coupon_sheets(spec) -> list[str]:
+def coupon_sheets(spec: Spec) -> list[str]:
     """The sheets (keys of features.SHEETS) the kit cuts: one laser coupon each."""
     sheets = [p.sheet for p in parts() if p.kind is Kind.LASER and (p.when is None or p.when(spec))]
     return list(dict.fromkeys(sheets))
 
 
-def laser_coupon(spec, sheet: str = "plate") -> Flat:
+def laser_coupon(spec: Spec, sheet: str = "plate") -> Flat:
     """Flat coupon cut from ``sheet`` with that sheet's kerf: a row per fit it carries, each hole engraved with
     its finished size (mm)."""
     rows = [_sweep(spec, purpose) for purpose in SHEET_ROWS[sheet]]
@@ -74,7 +79,7 @@ def laser_coupon(spec, sheet: str = "plate") -> Flat:
                 kerf=sheet_kerf_mm(spec, sheet), width=width, depth=depth, holes=tuple(holes), engrave=labels)
 
 
-def printed_coupon_holes(spec) -> list[Hole]:
+def printed_coupon_holes(spec: Spec) -> list[Hole]:
     """Needle bores and dowel holes of the printed coupon, ascending left to right (mm)."""
     needles = [spec.needle.outer_diameter + dx for dx in NEEDLE_SWEEP_MM]
     dowels = [spec.fasteners.dowel_diameter + dx for dx in PRINTED_DOWEL_SWEEP_MM]
@@ -84,14 +89,14 @@ def printed_coupon_holes(spec) -> list[Hole]:
     return _row(needles, row, pitch, "needle", x0) + _row(dowels, -row, pitch, "dowel", x0)
 
 
-def _drift_mm(spec) -> float:
+def _drift_mm(spec: Spec) -> float:
     """How far a needle bore at θ travels in x through the coupon bar (mm)."""
     import math
 
     return spec.mount.thickness / math.tan(math.radians(spec.needle.theta_deg))
 
 
-def printed_coupon_labels(spec) -> list[Engraving]:
+def printed_coupon_labels(spec: Spec) -> list[Engraving]:
     """Each printed hole's finished size (mm, 2 decimals), centred on the hole's mouth in the bar's top face:
     above the needle row, below the dowel row, :data:`LABEL_GAP_MM` clear of the widest hole, capitals
     :data:`PRINTED_LABEL_MM` tall."""
@@ -107,7 +112,7 @@ def printed_coupon_labels(spec) -> list[Engraving]:
     return labels
 
 
-def printed_coupon(spec, labelled: bool = True):
+def printed_coupon(spec: Spec, labelled: bool = True):
     """The printed coupon: a bar of mount thickness; needle bores at the needle's θ (as in the mount, so a bore
     that passes here passes there: a tilted printed bore comes out smaller than a vertical one), dowel holes
     vertical as in the mount; each size recessed :data:`PRINTED_ENGRAVE_MM` into the top face (printed face up,
@@ -153,7 +158,7 @@ at 60° and above (measured)."""
 NOTCH_MM = 1.0
 
 
-def theta_sweep_deg(spec) -> tuple[float, ...]:
+def theta_sweep_deg(spec: Spec) -> tuple[float, ...]:
     """θ values (deg) of the trial set: :data:`THETA_STEPS` evenly over the paper's window 30–75° (Sec. II), cut
     to what the spec's printer makes without support: an FDM bore's ceiling overhangs 90° − θ from vertical, and a
     slicer supports it below :data:`FDM_THETA_MIN_DEG` = 60°, so FDM spans 60–75°; SLA spans 30–75°."""
@@ -163,13 +168,14 @@ def theta_sweep_deg(spec) -> tuple[float, ...]:
     return tuple(round(lo + (hi - lo) * i / (THETA_STEPS - 1), 4) for i in range(THETA_STEPS))
 
 
-def needle_sweeps(spec) -> dict[str, tuple[tuple[float, ...], int]]:
+def needle_sweeps(spec: Spec) -> dict[str, tuple[tuple[float, ...], int]]:
     """The trial sets `matcad coupon` prints: needle field → (values, notch edge: +1 = +x, −1 = −x). y over
     :data:`Y_SWEEP_MM` at the spec's θ; θ over :func:`theta_sweep_deg` at the spec's y (mm, deg)."""
     return {"y": (Y_SWEEP_MM, 1), "theta_deg": (theta_sweep_deg(spec), -1)}
 
 
-def needle_sweep_mounts(spec, field: str, values, edge: int = 1) -> dict[str, tuple[float, object]]:
+def needle_sweep_mounts(spec: Spec, field: str, values: Sequence[float],
+                        edge: int = 1) -> dict[str, tuple[float, object]]:
     """A set of needle mounts, one per value of needle ``field`` (``"y"`` mm or ``"theta_deg"`` deg), the rest as
     in the spec, to print together and try on the same plate: file stem → (value, solid). Mount i carries i + 1
     notches on its ``edge`` × x edge (+1: +x, −1: −x), so neither a set's members nor the sets can be mixed up;

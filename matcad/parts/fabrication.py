@@ -6,9 +6,14 @@ names its sheet or file, so report.md/report.html read as a checklist.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.registry import Kind, wanted
+
+if TYPE_CHECKING:
+    from matcad.spec import Spec
 
 WHY_CALIPER = {
     "neck_plate": "its thickness is the neck length l, which sets f",
@@ -18,7 +23,7 @@ WHY_CALIPER = {
 }
 
 
-def sheets_to_caliper(spec) -> list[dict]:
+def sheets_to_caliper(spec: Spec) -> list[dict]:
     """Each laser sheet once: thickness, tolerance (mm), whether it is marked measured, and why it matters."""
     rows, seen = [], set()
     for flat in laser_parts(spec):
@@ -31,7 +36,7 @@ def sheets_to_caliper(spec) -> list[dict]:
     return rows
 
 
-def seal(spec) -> dict:
+def seal(spec: Spec) -> dict:
     """Flange squeeze over the guide sheet's tolerance (mm), as the rule ``seal.squeeze`` judges it."""
     from matcad.rules.stack import squeeze_range_mm
 
@@ -41,7 +46,7 @@ def seal(spec) -> dict:
             "squeeze_low_mm": lo, "squeeze_high_mm": hi}
 
 
-def fits(spec) -> list[dict]:
+def fits(spec: Spec) -> list[dict]:
     """The fits the kit relies on, as designed (mm): hole, what goes in it, and the clearance claimed (diametral;
     negative = interference). Each names the files a check reads it back from."""
     from matcad.parts.features import (SELF_TAP_PILOT_MM, bolt_nominal_mm, cap_flange_diameter_mm,
@@ -70,13 +75,13 @@ def fits(spec) -> list[dict]:
     return rows
 
 
-def steps(spec) -> list[dict]:
+def steps(spec: Spec) -> list[dict]:
     """The kit made and assembled in order: each step with what to do, on which sheet or machine, which files."""
     from matcad.parts.features import SHEETS, sheet_kerf_mm, sheet_thickness_mm
 
     o, out = spec.outputs, []
 
-    def step(where, files, do):
+    def step(where: str, files: list[str], do: str) -> None:
         out.append({"where": where, "files": files, "do": do})
 
     unmeasured = [c for c in sheets_to_caliper(spec) if not c["measured"]]
@@ -117,6 +122,6 @@ def steps(spec) -> list[dict]:
     return out
 
 
-def fabrication(spec) -> dict:
+def fabrication(spec: Spec) -> dict:
     """The report's fabrication section: sheets to caliper, the seal, the fits, the ordered steps."""
     return {"caliper": sheets_to_caliper(spec), "seal": seal(spec), "fits": fits(spec), "steps": steps(spec)}

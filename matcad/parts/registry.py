@@ -18,7 +18,10 @@ import re
 from dataclasses import dataclass, fields
 from enum import Enum
 from pathlib import Path
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
+
+if TYPE_CHECKING:
+    from matcad.spec import Spec
 
 
 class Kind(str, Enum):
@@ -73,13 +76,13 @@ class Part:
     name: str
     kind: Kind
     flag: str
-    make: Callable[[Any], Any]
+    make: Callable[[Spec], Any]
     order: int
     colour: str
     pose: PrintPose | None = None
     view: tuple[str, float, float] | None = None
     sheet: str | None = None
-    when: Callable[[Any], bool] | None = None
+    when: Callable[[Spec], bool] | None = None
     label: str = ""
 
     def __post_init__(self):
@@ -111,7 +114,7 @@ class Part:
     def section_label(self) -> str:
         return self.label or self.name.replace("_", " ")
 
-    def wanted(self, spec) -> bool:
+    def wanted(self, spec: Spec) -> bool:
         """Whether ``spec`` asks for this part: its ``[outputs]`` flag, and its condition if it has one."""
         return bool(getattr(spec.outputs, self.flag)) and (self.when is None or bool(self.when(spec)))
 
@@ -151,6 +154,6 @@ def part(name: str) -> Part:
     return by_name[name]
 
 
-def wanted(spec, kind: Kind | None = None) -> list[Part]:
+def wanted(spec: Spec, kind: Kind | None = None) -> list[Part]:
     """The parts ``spec`` asks for (of ``kind`` only, if given), in kit order."""
     return [p for p in parts() if p.wanted(spec) and (kind is None or p.kind is kind)]

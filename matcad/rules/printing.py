@@ -131,7 +131,7 @@ def sla_inhibition(spec) -> list[Finding]:
     if not (spec.outputs.end_cap_mold and spec.machine.printer == "sla"):
         return []
     return [Finding("mold.cure_inhibition", "warning", "sla", "post-cured or barrier-coated",
-                    MOLD_MATERIALS["sla"]["inhibition"], "post-cure the SLA mold fully, or barrier-coat it; "
+                    MOLD_MATERIALS["sla"].inhibition, "post-cure the SLA mold fully, or barrier-coat it; "
                     "cast a test drop")]
 
 
