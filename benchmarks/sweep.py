@@ -106,7 +106,7 @@ def dask_overhead(tasks: int) -> None:
 def main() -> None:
     quick = "--quick" in sys.argv
     vectorised(100_000 if quick else 1_000_000, 3 if quick else 5)
-    fem(2 if quick else 6)
+    fem(2 if quick else 16)
     dask_overhead(200 if quick else 1000)
 
 

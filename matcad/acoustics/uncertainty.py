@@ -13,7 +13,6 @@ lows and highs add in quadrature separately, in ln f (relative shifts), which ke
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -62,6 +61,31 @@ def _replace(spec, section: str, **values):
     return variant(spec, section, **values)  # a perturbation may leave the user's ranges; it is not input
 
 
+def tolerance_ends(neck_diameter, neck_length, cavity_diameter, cavity_length, draft_deg, temperature_c,
+                   neck_diameter_tol, sheet_tol, cavity_diameter_tol) -> dict[str, tuple]:
+    """The two ends of each fabrication and air tolerance, clamped to stay physical (mm, deg, °C; scalars or
+    arrays of variants): {dotted field: (low end, high end)}. A neck smaller than its tolerance is a
+    design-rule matter, so here it may at most halve; a sheet keeps 5 % of its thickness; the cavity stays at
+    least the neck; draft stays within [0, 99 % of what closes the cavity]; air stays above -273 °C."""
+    d, t, big_d = neck_diameter, neck_length, cavity_diameter
+    max_draft = np.degrees(np.arctan(big_d / (2 * cavity_length))) * 0.99
+    return {
+        "neck.diameter": (np.maximum(d - neck_diameter_tol, d / 2), np.minimum(d + neck_diameter_tol, big_d)),
+        "neck.length": (np.maximum(t - sheet_tol, 0.05 * t), t + sheet_tol),
+        "cavity.diameter": (np.maximum(big_d - cavity_diameter_tol, d), big_d + cavity_diameter_tol),
+        "mold.draft_deg": (np.maximum(draft_deg - DRAFT_TOL_DEG, 0.0), np.minimum(draft_deg + DRAFT_TOL_DEG,
+                                                                                  max_draft)),
+        "air.temperature_c": (np.maximum(temperature_c - TEMPERATURE_TOL_C, -273.0),
+                              temperature_c + TEMPERATURE_TOL_C),
+    }
+
+
+def model_error_share(error: dict, valid):
+    """The model's relative error for the band: its max |error| over the benchmark geometries where its checks
+    pass, or over all of them where ``valid`` (bool or array) is False."""
+    return np.where(valid, error["max_abs"], error.get("max_abs_all", error["max_abs"]))
+
+
 def budget(spec, res, model: str, f0_hz: float, valid: bool = True) -> list[BudgetLine]:
     """Every source's contribution for ``model`` at ``f0_hz``; ``res`` is ``resonator(spec)``; ``valid`` False
     (the model's own checks fail) takes its error over every benchmark case, not only the valid ones."""
@@ -91,39 +115,32 @@ def budget(spec, res, model: str, f0_hz: float, valid: bool = True) -> list[Budg
         lines.append(BudgetLine("model", f"{model}: error not measured yet (run benchmarks/error_vs_runtime.py)",
                                 0.0, 0.0))
     else:
-        worst, cases, where = error["max_abs"], error["cases"], "geometries where its checks pass"
+        worst, cases, where = float(model_error_share(error, valid)), error["cases"], "geometries where its checks pass"
         if not valid and "max_abs_all" in error:
-            worst, cases, where = error["max_abs_all"], error["of"], "geometries, checks failing included"
+            cases, where = error["of"], "geometries, checks failing included"
         lines.append(BudgetLine("model", f"{model}: max |error| {100 * worst:.2f} % vs FEM over {cases} {where}",
                                 -worst * f0_hz, worst * f0_hz))
     drilled = spec.plate.neck_pilot
-    tol = NECK_DIAMETER_TOL_MM["drilled" if drilled else "laser"]
-    d = spec.neck.diameter
-    # a neck smaller than the tolerance is a design-rule matter; here it may at most halve
-    d_variants = [_replace(spec, "neck", diameter=x) for x in (max(d - tol, d / 2), min(d + tol, spec.cavity.diameter))]
-    lines.append(BudgetLine("neck diameter", f"+-{tol:g} mm ({'drilled' if drilled else 'laser cut'})",
-                            *shifts(d_variants)))
-    t = spec.neck.length
-    tol = sheet_tolerance_mm(t, spec.plate.thickness_measured)
+    d_tol = NECK_DIAMETER_TOL_MM["drilled" if drilled else "laser"]
+    sheet_tol = sheet_tolerance_mm(spec.neck.length, spec.plate.thickness_measured)
+    cav_tol = CAVITY_DIAMETER_TOL_MM[spec.machine.printer]
+    ends = tolerance_ends(spec.neck.diameter, spec.neck.length, spec.cavity.diameter, spec.cavity.length,
+                          spec.mold.draft_deg, spec.air.temperature_c, d_tol, sheet_tol, cav_tol)
+
+    def moved(field):
+        section, name = field.split(".")
+        return shifts([_replace(spec, section, **{name: float(x)}) for x in ends[field]])
+
     what = "measured" if spec.plate.thickness_measured else "ISO 7823-1 cast sheet"
-    lines.append(BudgetLine("neck length (sheet)", f"+-{tol:.3g} mm ({what})",
-                            *shifts([_replace(spec, "neck", length=max(t - tol, 0.05 * t)),
-                                     _replace(spec, "neck", length=t + tol)])))
-    tol = CAVITY_DIAMETER_TOL_MM[spec.machine.printer]
-    D = spec.cavity.diameter
-    lines.append(BudgetLine("cavity diameter (core pin)", f"+-{tol:g} mm ({spec.machine.printer})",
-                            *shifts([_replace(spec, "cavity", diameter=max(D - tol, d)),
-                                     _replace(spec, "cavity", diameter=D + tol)])))
-    draft = spec.mold.draft_deg
-    max_draft = math.degrees(math.atan(D / (2 * spec.cavity.length))) * 0.99
-    lines.append(BudgetLine("core-pin draft", f"{draft:g} +-{DRAFT_TOL_DEG:g} deg",
-                            *shifts([_replace(spec, "mold", draft_deg=max(draft - DRAFT_TOL_DEG, 0.0)),
-                                     _replace(spec, "mold", draft_deg=min(draft + DRAFT_TOL_DEG, max_draft))])))
+    lines += [BudgetLine("neck diameter", f"+-{d_tol:g} mm ({'drilled' if drilled else 'laser cut'})",
+                         *moved("neck.diameter")),
+              BudgetLine("neck length (sheet)", f"+-{sheet_tol:.3g} mm ({what})", *moved("neck.length")),
+              BudgetLine("cavity diameter (core pin)", f"+-{cav_tol:g} mm ({spec.machine.printer})",
+                         *moved("cavity.diameter")),
+              BudgetLine("core-pin draft", f"{spec.mold.draft_deg:g} +-{DRAFT_TOL_DEG:g} deg", *moved("mold.draft_deg"))]
     if spec.air.speed_of_sound is None:
-        temp = spec.air.temperature_c
-        lines.append(BudgetLine("air temperature", f"{temp:g} +-{TEMPERATURE_TOL_C:g} C",
-                                *shifts([_replace(spec, "air", temperature_c=max(temp - TEMPERATURE_TOL_C, -273.0)),
-                                         _replace(spec, "air", temperature_c=temp + TEMPERATURE_TOL_C)])))
+        lines.append(BudgetLine("air temperature", f"{spec.air.temperature_c:g} +-{TEMPERATURE_TOL_C:g} C",
+                                *moved("air.temperature_c")))
     drop = boundary_layer_drop(f0_hz, spec.neck.diameter / 2)
     lines.append(BudgetLine("boundary layers", f"viscous + thermal, not in the lossless models: -{100 * drop:.1f} %",
                             -drop * f0_hz, 0.0))
@@ -148,8 +165,13 @@ def budget(spec, res, model: str, f0_hz: float, valid: bool = True) -> list[Budg
 def total(lines: list[BudgetLine], f0_hz: float) -> tuple[float, float]:
     """Lows and highs combined root-sum-square in ln f, as offsets from ``f0_hz`` (Hz): the same as a plain
     root-sum-square of small shifts, and never below zero frequency when shifts are large."""
-    def rss(shifts):
-        return math.sqrt(sum(math.log1p(x / f0_hz) ** 2 for x in shifts))
+    low, high = combine([x.low_hz for x in lines], [x.high_hz for x in lines], f0_hz)
+    return float(low), float(high)
 
-    return (f0_hz * (math.exp(-rss(x.low_hz for x in lines)) - 1.0),
-            f0_hz * (math.exp(rss(x.high_hz for x in lines)) - 1.0))
+
+def combine(lows, highs, f0_hz):
+    """:func:`total` on shifts that may be arrays of variants (Hz): (low, high) offsets from ``f0_hz``."""
+    def rss(shifts):
+        return np.sqrt(sum(np.log1p(np.asarray(x) / f0_hz) ** 2 for x in shifts))
+
+    return f0_hz * np.expm1(-rss(lows)), f0_hz * np.expm1(rss(highs))

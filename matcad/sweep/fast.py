@@ -112,44 +112,31 @@ def valid(v: Variants, model: str, f0) -> np.ndarray:
 
 
 def band_hz(v: Variants, model: str, f0, ok) -> tuple[np.ndarray, np.ndarray]:
-    """(low, high) band edges (Hz): :func:`matcad.acoustics.uncertainty.budget` line by line on the arrays, each
-    tolerance moved to both ends with the same clamps, combined root-sum-square in ln f as
-    :func:`~matcad.acoustics.uncertainty.total` does. ``ok`` is :func:`valid` (it picks the model-error line)."""
+    """(low, high) band edges (Hz): :func:`matcad.acoustics.uncertainty.budget` line by line on the arrays: the
+    model's measured error (``ok`` is :func:`valid`), each tolerance moved to both of its
+    :func:`~matcad.acoustics.uncertainty.tolerance_ends`, boundary layers; combined root-sum-square in ln f by
+    :func:`~matcad.acoustics.uncertainty.combine`."""
     f0 = np.asarray(f0, dtype=float)
     x = v.values
     lows, highs = [], []
-
-    def line(lo, hi):
-        lows.append(lo)
-        highs.append(hi)
-
-    def shifts(field, *ends):
-        fs = [f0_hz(v.with_value(field, end), model) - f0 for end in ends]
-        return np.minimum(np.minimum(*fs), 0.0), np.maximum(np.maximum(*fs), 0.0)
-
     error = uncertainty.model_errors().get(model)
     if error is not None:
-        worst = np.where(ok, error["max_abs"], error.get("max_abs_all", error["max_abs"]))
-        line(-worst * f0, worst * f0)
-    d, t, big_d, draft = x["neck.diameter"], x["neck.length"], x["cavity.diameter"], x["mold.draft_deg"]
-    line(*shifts("neck.diameter", np.maximum(d - v.neck_diameter_tol, d / 2),
-                 np.minimum(d + v.neck_diameter_tol, big_d)))
-    line(*shifts("neck.length", np.maximum(t - v.sheet_tol, 0.05 * t), t + v.sheet_tol))
-    line(*shifts("cavity.diameter", np.maximum(big_d - v.cavity_diameter_tol, d), big_d + v.cavity_diameter_tol))
-    max_draft = np.degrees(np.arctan(big_d / (2 * x["cavity.length"]))) * 0.99
-    line(*shifts("mold.draft_deg", np.maximum(draft - uncertainty.DRAFT_TOL_DEG, 0.0),
-                 np.minimum(draft + uncertainty.DRAFT_TOL_DEG, max_draft)))
-    temp, by_temperature = x["air.temperature_c"], np.isnan(x["air.speed_of_sound"])
-    lo, hi = shifts("air.temperature_c", np.maximum(temp - uncertainty.TEMPERATURE_TOL_C, -273.0),
-                    temp + uncertainty.TEMPERATURE_TOL_C)
-    line(np.where(by_temperature, lo, 0.0), np.where(by_temperature, hi, 0.0))
-    eps = boundary_layer_shift(f0, d / 2)
-    line(-eps / (1.0 + eps) * f0, np.zeros_like(f0))
-
-    def rss(shifts):
-        return np.sqrt(sum(np.log1p(s / f0) ** 2 for s in shifts))
-
-    return f0 + f0 * np.expm1(-rss(lows)), f0 + f0 * np.expm1(rss(highs))
+        worst = uncertainty.model_error_share(error, ok)
+        lows.append(-worst * f0)
+        highs.append(worst * f0)
+    ends = uncertainty.tolerance_ends(x["neck.diameter"], x["neck.length"], x["cavity.diameter"], x["cavity.length"],
+                                      x["mold.draft_deg"], x["air.temperature_c"], v.neck_diameter_tol, v.sheet_tol,
+                                      v.cavity_diameter_tol)
+    by_temperature = np.isnan(x["air.speed_of_sound"])  # an explicit speed of sound has no temperature line
+    for field, (low_end, high_end) in ends.items():
+        fs = [f0_hz(v.with_value(field, end), model) - f0 for end in (low_end, high_end)]
+        applies = by_temperature if field == "air.temperature_c" else True
+        lows.append(np.where(applies, np.minimum(np.minimum(*fs), 0.0), 0.0))
+        highs.append(np.where(applies, np.maximum(np.maximum(*fs), 0.0), 0.0))
+    eps = boundary_layer_shift(f0, x["neck.diameter"] / 2)
+    lows.append(-eps / (1.0 + eps) * f0)
+    low, high = uncertainty.combine(lows, highs, f0)
+    return f0 + low, f0 + high
 
 
 def sensitivity(v: Variants, model: str, field: str) -> np.ndarray:
