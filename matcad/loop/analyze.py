@@ -178,10 +178,14 @@ class Framer:
 
 
 class BandTracker:
-    """One taxel's tone in one band, frame by frame: floor, comb removal, ridge, voicing, segments.
+    """One taxel's tone in one band, block by block: floor, comb removal, ridge, voicing, segments.
 
     ``push(times, power)`` takes frames from a :class:`Framer`; ``finish()`` returns the :class:`Analysis`.
-    The arrays kept grow by five numbers per frame (~0.1 MB per minute of audio); the plot is max-pooled to at
+    Everything but the Viterbi recursion (one vector step per frame) and the voicing state machine (a few scalar
+    operations per frame) works on whole blocks of frames: the floor is one running median over the block's rows
+    laid end to end, the fixed-lag decisions of a block are one vectorised backtrack, peak refinement and the
+    harmonic test act on all decided frames at once. Frames whose bin is not yet decided (≤ LAG_FRAMES) are kept;
+    the arrays kept grow by seven numbers per frame (~0.1 MB per minute of audio); the plot is max-pooled to at
     most 2·PLOT_COLUMNS columns. ``on_frame`` (optional) is called with (time s, frequency Hz or NaN, excess dB)
     as each frame's voicing becomes final, for live output.
     """
@@ -204,32 +208,39 @@ class BandTracker:
         self.freqs = freqs
         self.on_frame = on_frame
         nb = len(self.in_band)
-        self._score = np.zeros(nb)
-        self._back: list[np.ndarray] = []
-        self._pending: list[_Frame] = []  # frames whose bin is not yet decided (≤ LAG_FRAMES)
-        self._pending_rows: list[tuple] = []
-        self._run: list[int] = []  # indices of the current candidate run
-        self._first = True
+        steps = np.arange(-MAX_STEP_BINS, MAX_STEP_BINS + 1)
+        src = np.arange(nb)[None, :] - steps[:, None]  # bin a state comes from, per step
+        self._src = np.clip(src, 0, nb - 1)
+        self._cost = np.where((src >= 0) & (src < nb), JUMP_PENALTY_DB * steps[:, None].astype(float) ** 2, np.inf)
+        self._score = None
+        # frames not yet decided: time, band log power, band excess, band lines, slab lines, back pointers and the
+        # best state of each frame's score
+        self._p_times = np.zeros(0)
+        self._p_log = np.zeros((0, nb))
+        self._p_excess = np.zeros((0, nb))
+        self._p_lines = np.zeros((0, nb))
+        self._p_slab_lines = np.zeros((0, len(self.slab)))
+        self._p_back = np.zeros((0, nb), dtype=np.intp)
+        self._p_best = np.zeros(0, dtype=np.intp)
         self.times, self.track, self.excess, self.state, self.other_bin, self.other_excess = [], [], [], [], [], []
-        self.other_level = []
+        self.other_level, self.harmonic = [], []
+        self._run_start, self._run_max, self._marked = -1, -np.inf, 0  # current candidate run (none: start −1)
         self._voice_done = 0  # frames whose voicing is final
         self._plot_cols: list[np.ndarray] = []
         self._plot_times: list[float] = []
         self._pool = 1
         self._pool_acc: list[np.ndarray] = []
-        self._steps = np.arange(-MAX_STEP_BINS, MAX_STEP_BINS + 1)
-        self._step_cost = JUMP_PENALTY_DB * self._steps.astype(float) ** 2
         self.band_peak_power = np.zeros(nb)
 
     # --- per block --------------------------------------------------------------------------------------------
     def push(self, times: np.ndarray, power: np.ndarray) -> None:
         if len(times) == 0:
             return
-        from scipy.ndimage import maximum_filter1d, median_filter
+        from scipy.ndimage import maximum_filter1d
 
         tiny = np.finfo(float).tiny
         slab = power[:, self.slab]
-        floor = median_filter(slab, size=(1, FLOOR_BINS), mode="nearest")
+        floor = _running_median_rows(slab, FLOOR_BINS)
         excess_slab = 10 * np.log10((slab + tiny) / (floor + tiny))
         log_slab = 10 * np.log10(slab + tiny)
         nb = len(self.in_band)
@@ -243,9 +254,48 @@ class BandTracker:
         band_lines = np.where(comb_zone[:, band], -np.inf, lines[:, band])
         self.band_peak_power += slab[:, band].sum(axis=0)
         self._plot(times, log_slab[:, band])
-        for i in range(len(times)):
-            self._step(float(times[i]), emit[i], log_slab[i, band], excess_slab[i, band], band_lines[i],
-                       lines[i])
+        back, best = self._forward(emit)
+        self._p_times = np.concatenate([self._p_times, times])
+        self._p_log = np.concatenate([self._p_log, log_slab[:, band]])
+        self._p_excess = np.concatenate([self._p_excess, excess_slab[:, band]])
+        self._p_lines = np.concatenate([self._p_lines, band_lines])
+        self._p_slab_lines = np.concatenate([self._p_slab_lines, lines])
+        self._p_back = np.concatenate([self._p_back, back])
+        self._p_best = np.concatenate([self._p_best, best])
+        ready = len(self._p_times) - LAG_FRAMES  # pending frame j is decided once frame j + LAG_FRAMES is in
+        if ready > 0:
+            # fixed lag: frame j's bin is the best path ending at frame j + LAG, traced back LAG steps
+            states = self._p_best[LAG_FRAMES:LAG_FRAMES + ready].copy()
+            rows = np.arange(ready)
+            for s in range(LAG_FRAMES, 0, -1):
+                states = self._p_back[rows + s, states]
+            self._decide(ready, states)
+
+    def _forward(self, emit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Viterbi recursion over a block's emissions (frames × bins, dB): back pointers and each frame's best
+        state. Moving Δ ≤ MAX_STEP_BINS bins costs JUMP_PENALTY_DB·Δ², any jump JUMP_COST_DB from the best state;
+        the score is renormalised to a maximum of 0 every frame."""
+        n, nb = emit.shape
+        back = np.empty((n, nb), dtype=np.intp)
+        best = np.empty(n, dtype=np.intp)
+        cols = np.arange(nb)
+        score = self._score
+        for i in range(n):
+            if score is None:
+                score = emit[i].copy()
+                back[i] = cols
+            else:
+                cand = score[self._src] - self._cost
+                pick = np.argmax(cand, axis=0)
+                local = cand[pick, cols]
+                jump_from = int(np.argmax(score))
+                far = score[jump_from] - JUMP_COST_DB
+                back[i] = np.where(local >= far, self._src[pick, cols], jump_from)
+                score = np.maximum(local, far) + emit[i]
+                score -= score.max()
+            best[i] = np.argmax(score)
+        self._score = score
+        return back, best
 
     def _mains_comb(self, lines: np.ndarray) -> np.ndarray:
         """Lines (frames × slab bins) that sit on a mains grid m·S (S = 50, 60, 100, 120 Hz) which hosts lines at
@@ -284,94 +334,84 @@ class BandTracker:
                     self._plot_times = self._plot_times[1::2]
                     self._pool *= 2
 
-    def _step(self, time, emit, log_row, excess_row, line_row, slab_lines):
-        nb = len(emit)
-        if self._first:
-            self._score = emit.copy()
-            self._back.append(np.arange(nb))
-            self._first = False
-        else:
-            idx = np.arange(nb)
-            src = idx[None, :] - self._steps[:, None]
-            valid = (src >= 0) & (src < nb)
-            cand = np.where(valid, self._score[np.clip(src, 0, nb - 1)] - self._step_cost[:, None], -np.inf)
-            best = np.argmax(cand, axis=0)
-            local = cand[best, idx]
-            far = float(np.max(self._score)) - JUMP_COST_DB
-            jump_from = int(np.argmax(self._score))
-            back = np.where(local >= far, src[best, idx], jump_from)
-            self._score = np.maximum(local, far) + emit
-            self._score -= self._score.max()
-            self._back.append(back)
-        self._pending_rows.append((time, log_row, excess_row, line_row, slab_lines))
-        if len(self._pending_rows) > LAG_FRAMES:
-            state = int(np.argmax(self._score))
-            for back in reversed(self._back[1:]):
-                state = int(back[state])
-            self._decide(state)
-
-    def _decide(self, state):
-        """The oldest pending frame's ridge bin is ``state``: refine it and pass it to voicing."""
-        time, log_row, excess_row, line_row, slab_lines = self._pending_rows.pop(0)
-        self._back.pop(0)
-        nb = len(log_row)
-        lo, hi = max(0, state - 1), min(nb, state + 2)
-        peak = int(np.clip(lo + np.argmax(log_row[lo:hi]), 1, nb - 2))
-        l, m, r = log_row[peak - 1], log_row[peak], log_row[peak + 1]
+    def _decide(self, count: int, states: np.ndarray) -> None:
+        """The oldest ``count`` pending frames' ridge bins are ``states``: refine each to the highest of its ±1
+        bins with a parabolic peak (dB), note the strongest other line, test harmonicity, pass them to voicing."""
+        nb = self._p_log.shape[1]
+        rows = np.arange(count)
+        log = self._p_log[:count]
+        near = states[:, None] + np.arange(-1, 2)[None, :]
+        level = np.where((near >= 0) & (near < nb), log[rows[:, None], np.clip(near, 0, nb - 1)], -np.inf)
+        peak = np.clip(near[rows, np.argmax(level, axis=1)], 1, nb - 2)
+        l, m, r = log[rows, peak - 1], log[rows, peak], log[rows, peak + 1]
         denom = l - 2 * m + r
-        delta = float(np.clip(0.5 * (l - r) / denom, -0.5, 0.5)) if denom < 0 else 0.0
-        freq = float(self.freqs[self.in_band[0]] + (peak + delta) * self.df)
-        masked = line_row.copy()
-        masked[max(0, peak - EXCLUDE_BINS): peak + EXCLUDE_BINS + 1] = -np.inf
-        other = int(np.argmax(masked))
-        self.times.append(time)
-        self.track.append(freq)
-        self.excess.append(float(excess_row[peak]))
-        self.state.append(0)
-        self.other_bin.append(other)
-        self.other_excess.append(float(masked[other]))
-        self.other_level.append(float(log_row[other] - log_row[peak]) if np.isfinite(masked[other]) else -np.inf)
-        harmonic = _in_harmonic_comb(slab_lines, peak + self.offset, self.df)
-        self._voice(len(self.track) - 1, harmonic)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            delta = np.where(denom < 0, np.clip(0.5 * (l - r) / denom, -0.5, 0.5), 0.0)
+        freq = self.freqs[self.in_band[0]] + (peak + delta) * self.df
+        masked = np.where(np.abs(np.arange(nb)[None, :] - peak[:, None]) <= EXCLUDE_BINS, -np.inf,
+                          self._p_lines[:count])
+        other = np.argmax(masked, axis=1)
+        other_excess = masked[rows, other]
+        other_level = np.where(np.isfinite(other_excess), log[rows, other] - m, -np.inf)
+        harmonic = _in_harmonic_comb(self._p_slab_lines[:count], peak + self.offset, self.df)
+        excess = self._p_excess[rows, peak]
+        first = len(self.track)
+        self.times.extend(self._p_times[:count].tolist())
+        self.track.extend(freq.tolist())
+        self.excess.extend(excess.tolist())
+        self.state.extend([0] * count)
+        self.other_bin.extend(other.tolist())
+        self.other_excess.extend(other_excess.tolist())
+        self.other_level.extend(other_level.tolist())
+        self.harmonic.extend(harmonic.tolist())
+        for name in ("_p_times", "_p_log", "_p_excess", "_p_lines", "_p_slab_lines", "_p_back", "_p_best"):
+            setattr(self, name, getattr(self, name)[count:])
+        for i in range(first, first + count):
+            self._voice(i)
 
-    def _voice(self, i, harmonic):
+    def _voice(self, i):
         """Voicing state machine: candidate runs qualify by strength or by length and stability; a frame whose
         line is one of a harmonic comb is no candidate."""
-        e = -np.inf if harmonic else self.excess[i]
-        stable = bool(self._run) and abs(self._bin_of(i) - self._bin_of(self._run[-1])) <= STABLE_BINS
-        if e >= WEAK_DB and (not self._run or stable):
-            self._run.append(i)
+        e = -np.inf if self.harmonic[i] else self.excess[i]
+        start = self._run_start
+        stable = start >= 0 and abs(self._bin_of(i) - self._bin_of(i - 1)) <= STABLE_BINS
+        if e >= WEAK_DB and (start < 0 or stable):
+            if start < 0:
+                start, self._run_max = i, e
+            else:
+                self._run_max = max(self._run_max, e)
         else:
-            self._run = []
-            if e >= WEAK_DB:
-                self._run = [i]
-        if self._run and (len(self._run) >= MIN_RUN or max(self.excess[j] for j in self._run) >= STRONG_DB):
-            for j in self._run:
+            start = i if e >= WEAK_DB else -1
+            self._run_max = e
+        self._run_start = start
+        if start >= 0 and (i - start + 1 >= MIN_RUN or self._run_max >= STRONG_DB):
+            for j in range(max(start, self._marked), i + 1):
                 self.state[j] = 1
-        if not self._run:
-            self._emit_until(i + 1)
-        elif self.state[self._run[0]] == 1:
+            self._marked = i + 1
+        if start < 0 or self.state[start] == 1:
             self._emit_until(i + 1)
         else:
-            self._emit_until(self._run[0])
+            self._emit_until(start)
 
     def _bin_of(self, i):
         return (self.track[i] - self.freqs[self.in_band[0]]) / self.df
 
     def _emit_until(self, stop):
-        for j in range(self._voice_done, stop):
-            if self.on_frame is not None:
+        if self.on_frame is not None:
+            for j in range(self._voice_done, stop):
                 self.on_frame(self.times[j], self.track[j] if self.state[j] else float("nan"), self.excess[j])
         self._voice_done = max(self._voice_done, stop)
 
     # --- end of input ---------------------------------------------------------------------------------------
     def finish(self, duration_s: float, full_mean_power: np.ndarray | None = None) -> Analysis:
-        while self._pending_rows:
-            state = int(np.argmax(self._score))
-            for back in reversed(self._back[1:]):
-                state = int(back[state])
-            self._decide(state)
-        self._run = []
+        count = len(self._p_times)
+        if count:  # the rest: one backtrack from the best final state
+            states = np.empty(count, dtype=np.intp)
+            states[-1] = self._p_best[-1]
+            for j in range(count - 1, 0, -1):
+                states[j - 1] = self._p_back[j, states[j]]
+            self._decide(count, states)
+        self._run_start = -1
         self._emit_until(len(self.track))
         if self._pool_acc:
             self._plot_cols.append(np.max(self._pool_acc, axis=0))
@@ -467,20 +507,33 @@ def _segments(times, track, state, df) -> list[Segment]:
     return out
 
 
-def _in_harmonic_comb(lines: np.ndarray, p: int, df: float) -> bool:
-    """True when the line at bin ``p`` has lines (within ±2 bins, ≥ HARMONIC_LINE_DB and ≥ its level −
-    COMB_LEVEL_DB) at 3 of ±Δ, ±2Δ for some Δ in HARMONIC_SPACING_HZ: one harmonic of a voice (or of any periodic
-    sound), not a taxel. White noise: ~1e-5 of frames per Δ trips it."""
-    level = lines[p]
-    if not np.isfinite(level):
-        return False
-    need = max(HARMONIC_LINE_DB, level - COMB_LEVEL_DB)
-    strong = np.concatenate([[False, False], lines >= need, [False, False]])
-    near = strong[:-4] | strong[1:-3] | strong[2:-2] | strong[3:-1] | strong[4:]  # a line within ±2 bins
-    n = len(lines)
+def _running_median_rows(rows: np.ndarray, width: int) -> np.ndarray:
+    """Median over ``width`` (odd) neighbouring columns of each row, edges continued by their end values (the
+    same numbers as scipy's median_filter(size=(1, width), mode='nearest')). The rows are laid end to end, each
+    padded by its own edge values, and filtered in one 1-D pass: ~15× faster than the 2-D filter."""
+    from scipy.ndimage import median_filter
+
+    half = width // 2
+    padded = np.pad(rows, ((0, 0), (half, half)), mode="edge")
+    return median_filter(padded.ravel(), size=width, mode="nearest").reshape(padded.shape)[:, half:-half]
+
+
+def _in_harmonic_comb(lines: np.ndarray, p: np.ndarray, df: float) -> np.ndarray:
+    """Per frame (rows of ``lines``, dB over the floor, −inf where no line): True when the line at bin ``p`` has
+    lines (within ±2 bins, ≥ HARMONIC_LINE_DB and ≥ its level − COMB_LEVEL_DB) at 3 of ±Δ, ±2Δ for some Δ in
+    HARMONIC_SPACING_HZ: one harmonic of a voice (or of any periodic sound), not a taxel. White noise: ~1e-5 of
+    frames per Δ trips it."""
+    from scipy.ndimage import maximum_filter1d
+
+    k, n = lines.shape
+    rows = np.arange(k)
+    level = lines[rows, p]
+    need = np.maximum(HARMONIC_LINE_DB, level - COMB_LEVEL_DB)
+    near = maximum_filter1d((lines >= need[:, None]).astype(np.uint8), 5, axis=1, mode="constant") > 0
     d = np.arange(int(HARMONIC_SPACING_HZ[0] / df), int(HARMONIC_SPACING_HZ[1] / df) + 1)
-    hits = sum(near[np.clip(p + k * d, 0, n - 1)] & (p + k * d >= 0) & (p + k * d < n) for k in (-2, -1, 1, 2))
-    return bool(np.any(hits >= 3))
+    at = p[:, None, None] + np.array([-2, -1, 1, 2])[None, :, None] * d[None, None, :]
+    hit = near[rows[:, None, None], np.clip(at, 0, n - 1)] & (at >= 0) & (at < n)
+    return np.isfinite(level) & np.any(hit.sum(axis=1) >= 3, axis=1)
 
 
 def _second_sources(other_bin, other_excess, other_level, band_freqs) -> list[Source]:
