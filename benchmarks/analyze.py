@@ -6,10 +6,13 @@
 2. Realistic recordings (matcad.loop.synth: a noise-driven self-sustained oscillator whose pitch follows Eq. 5,
    pink noise, reverb RT60 0.3–0.5 s, tablet microphone AGC and clipping, hum/buzz, speech, a neighbouring taxel,
    presses, taps, gaps, an overblown stretch): a table per case over seeds.
-3. Memory and time of `matcad analyze` on 10 s, 10 min and 60 min WAV files (peak RSS from /usr/bin/time -v, or
+3. Voicing false alarms on noise (white, pink, brown; many minutes): voiced frames against frames and frame×bins
+   tested, with the one-sided 95 % upper bound of the per-frame rate (Clopper–Pearson), and the per-bin tail of
+   the excess over the floor against the exponential law.
+4. Memory and time of `matcad analyze` on 10 s, 10 min and 60 min WAV files (peak RSS from /usr/bin/time -v, or
    resource.getrusage of the child when it is missing).
 
-Run: /work/venv/bin/python benchmarks/analyze.py [--quick] [--memory-only | --no-memory]
+Run: /work/venv/bin/python benchmarks/analyze.py [--quick] [--memory-only | --no-memory] [--noise-minutes N]
 """
 
 import argparse
@@ -156,6 +159,53 @@ def realistic_table(seeds, seconds):
               f"{np.mean(get('time')):.2f} |")
 
 
+def false_alarm_table(minutes):
+    """Voiced frames in pure noise: the detector's false-alarm rate per frame, bounded at 95 % (one-sided)."""
+    from scipy.stats import beta
+
+    from matcad.loop.analyze import STRONG_DB, BandTracker, Framer, _running_median_rows, FLOOR_BINS, analyze_stream
+
+    print(f"\nVoicing false alarms: {minutes:g} min of each noise at 44.1 kHz, band {BAND[0]:.0f}-{BAND[1]:.0f} Hz "
+          "(per-bin tail: fraction of frame×bins over x dB; exponential law exp(-ln2·10^(x/10)) for a known "
+          "median):\n")
+    print("| noise | frames | frame×bins | voiced frames | 95 % upper bound per frame | frames with a ridge >= "
+          f"{STRONG_DB:g} dB | per-bin P(>12 dB) | P(>15 dB) | time [s] |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    law = [np.exp(-np.log(2) * 10 ** (x / 10)) for x in (12.0, 15.0)]
+    totals = [0, 0, 0]
+    for alpha, name in ((0.0, "white"), (1.0, "pink"), (2.0, "brown")):
+        frames = voiced = strong = bins = 0
+        over = np.zeros(2)
+        t0 = time.perf_counter()
+        for k in range(int(minutes)):
+            x = synth.coloured_noise(int(60 * FS), FS, 1000 + 100 * int(alpha) + k, alpha, 0.1)
+            got = []
+            try:
+                analyze_stream((x[i:i + 65536] for i in range(0, len(x), 65536)), FS, [BAND],
+                               lambda _, t, f, e: got.append((f, e)))
+            except LoopError:
+                pass
+            f, e = np.array(got).T
+            frames += len(f)
+            voiced += int(np.sum(np.isfinite(f)))
+            strong += int(np.sum(e >= STRONG_DB))
+            framer = Framer(FS)
+            power = framer.feed(x)[1]
+            tracker = BandTracker(framer.freqs, FS, BAND)
+            slab = power[:, tracker.slab]
+            excess = (10 * np.log10(slab / _running_median_rows(slab, FLOOR_BINS)))[:, tracker.offset:
+                                                                                    tracker.offset + len(tracker.in_band)]
+            over += [np.sum(excess > 12.0), np.sum(excess > 15.0)]
+            bins += excess.size
+        bound = float(beta.ppf(0.95, voiced + 1, frames - voiced))
+        totals = [totals[0] + frames, totals[1] + bins, totals[2] + voiced]
+        print(f"| {name} | {frames} | {bins:.3g} | {voiced} | {bound:.2g} | {strong} | {over[0] / bins:.2g} "
+              f"(law {law[0]:.1g}) | {over[1] / bins:.2g} (law {law[1]:.1g}) | {time.perf_counter() - t0:.0f} |")
+    frames, bins, voiced = totals
+    print(f"| all | {frames} | {bins:.3g} | {voiced} | {float(beta.ppf(0.95, voiced + 1, frames - voiced)):.2g} | "
+          "| | | |")
+
+
 def write_long_wav(path, minutes):
     """A long 16-bit recording written 10 s at a time (never held whole): the 'presses' case repeated."""
     block = synth.scenario("presses", 10.0, 0)
@@ -198,6 +248,8 @@ def main():
     parser.add_argument("--quick", action="store_true", help="2 seeds, 5 s cases, no 60 min file")
     parser.add_argument("--memory-only", action="store_true")
     parser.add_argument("--no-memory", action="store_true", help="skip the long files")
+    parser.add_argument("--noise-minutes", type=float, default=10.0,
+                        help="minutes of each noise for the false-alarm table (0 skips it)")
     args = parser.parse_args()
     durations = [("10 s", 1 / 6), ("10 min", 10), ("60 min", 60)]
     if args.quick:
@@ -205,6 +257,8 @@ def main():
     if not args.memory_only:
         clean_tone_table()
         realistic_table(2 if args.quick else 3, 5.0 if args.quick else 10.0)
+        if args.noise_minutes > 0:
+            false_alarm_table(1 if args.quick else args.noise_minutes)
     if not args.no_memory:
         memory_table(durations)
 

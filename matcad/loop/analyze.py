@@ -6,7 +6,10 @@ The paper used MATLAB spectrogram + tfridge and a pspectrum peak in 4–5.5 kHz.
 1. *Strength over the local floor.* Each bin's power is divided by the running median of the power over
    ±:data:`FLOOR_BINS`/2 bins (≈ ±170 Hz) around it: the excess in dB. The median follows coloured noise (pink,
    brown, a speech or fan hump) where a band-wide mean would not. Under white or smoothly coloured noise a bin's
-   power is exponential, its median μ·ln 2, so P(excess > x dB) = exp(−ln 2 · 10^(x/10)) per bin.
+   power is exponential; with a *known* median the tail would be exp(−ln 2 · 10^(x/10)) per bin, but the floor is
+   itself estimated from ~30 independent bins, so the measured tail is far heavier: 1.2e-4 over 12 dB (law 2e-5),
+   ~8e-7 over 15 dB (law 3e-10) per bin (benchmarks/analyze.py; the order-statistic law for a median of 31–41
+   bins brackets it within ×2). Over ~300 band bins a lone frame ≥ 15 dB therefore comes every ~4000 noise frames.
 2. *Mains combs removed.* A line with lines of similar level (within :data:`COMB_LEVEL_DB`) at ±Δ and ±2Δ
    (Δ = 50, 60, 100 or 120 Hz; 3 of the 4 places) belongs to hum or buzz, not to a taxel, whose neighbours are
    not a comb: its bins are removed before tracking.
@@ -14,11 +17,13 @@ The paper used MATLAB spectrogram + tfridge and a pspectrum peak in 4–5.5 kHz.
    :data:`JUMP_PENALTY_DB`·Δ² up to :data:`MAX_STEP_BINS`, any larger jump a flat :data:`JUMP_COST_DB` — so the
    ridge follows a slow wobble smoothly, re-acquires after a gap and follows a press that jumps 300 Hz between
    frames. Decisions are made with a fixed lag of :data:`LAG_FRAMES` frames (~1 s), which bounds memory.
-4. *Voicing.* A frame is voiced (the tone is there) when the ridge stands ≥ :data:`STRONG_DB` over the floor
-   (white noise: P(false alarm) < 1e-7 per frame by the exponential law; measured 0 in tests/test_loop.py), or ≥ :data:`WEAK_DB` in a
-   run of ≥ :data:`MIN_RUN` frames whose ridge stays within ±:data:`STABLE_BINS` bins (a narrow stable line:
-   speech harmonics at 4–6 kHz glide and smear, noise peaks do not persist). The threshold is a strength and a
-   stability, never a fraction of the file: 1 s of clear tone in a 10 min file is found.
+4. *Voicing.* A frame is voiced (the tone is there) when it belongs to a run of frames whose ridge stays within
+   ±:data:`STABLE_BINS` bins and stands ≥ :data:`WEAK_DB` over the floor, and the run is either
+   ≥ :data:`MIN_RUN` frames long or ≥ :data:`STRONG_RUN` frames with one ≥ :data:`STRONG_DB` (a lone strong frame
+   is not enough: see 1). A line that is one of a harmonic comb (:func:`_in_harmonic_comb`: a voice) is no
+   candidate. Measured false alarms: 0 voiced frames in white, pink and brown noise (frames × bins and the 95 %
+   upper bound per frame in benchmarks/analyze.py and docs), speech alone ~2 % of frames. The threshold is a
+   strength and a stability, never a fraction of the file: 1 s of clear tone in a 10 min file is found.
 5. *Segments.* Voiced frames are cut into steady segments at gaps and at steps larger than :data:`STEP_HZ`
    between frames; a segment that sits more than :data:`MODE_JUMP_RATIO` above or below the one before it,
    without a ramp in between, cannot be a press (Eq. 5 spans ~+11 % from 0 to 25 N): it is flagged as a mode
@@ -52,6 +57,9 @@ LAG_FRAMES = 20
 STRONG_DB = 15.0
 """White noise: P(excess > 15 dB) = exp(−ln2·31.6) ≈ 3e-10 per bin, < 1e-7 per frame over ~280 bins."""
 WEAK_DB = 8.0
+STRONG_RUN = 2
+"""A run qualifies by strength (≥ STRONG_DB) once it has this many frames: a lone strong frame is a noise or speech
+peak as often as a tone (measured: benchmarks/analyze.py, voicing false alarms)."""
 MIN_RUN = 5
 STABLE_BINS = 2
 COMB_SPACINGS_HZ = (50.0, 60.0, 100.0, 120.0)
@@ -59,8 +67,9 @@ COMB_LEVEL_DB = 10.0
 COMB_GRID_FRACTION = 0.6
 COMB_ZONE_BINS = 3
 HARMONIC_SPACING_HZ = (80.0, 400.0)
-HARMONIC_LINE_DB = 8.0
-"""Speech pitch range: a line with lines of similar level at ±Δ and ±2Δ for Δ in this range is a harmonic."""
+HARMONIC_TESTS = (((-2, -1, 1, 2), 3, 2, 8.0), ((-4, -3, -2, -1, 1, 2, 3, 4), 5, 1, 6.0))
+"""(multiples of Δ, how many must hold a line, within ± bins, line level dB): a line with such neighbours, Δ in
+the speech pitch range HARMONIC_SPACING_HZ, is a harmonic (see :func:`_in_harmonic_comb`)."""
 LINE_DB = 6.0
 """A local maximum this far over the floor counts as a line in the comb and second-source tests."""
 STEP_HZ = 12.0
@@ -384,7 +393,8 @@ class BandTracker:
             start = i if e >= WEAK_DB else -1
             self._run_max = e
         self._run_start = start
-        if start >= 0 and (i - start + 1 >= MIN_RUN or self._run_max >= STRONG_DB):
+        length = i - start + 1
+        if start >= 0 and (length >= MIN_RUN or (length >= STRONG_RUN and self._run_max >= STRONG_DB)):
             for j in range(max(start, self._marked), i + 1):
                 self.state[j] = 1
             self._marked = i + 1
@@ -519,21 +529,27 @@ def _running_median_rows(rows: np.ndarray, width: int) -> np.ndarray:
 
 
 def _in_harmonic_comb(lines: np.ndarray, p: np.ndarray, df: float) -> np.ndarray:
-    """Per frame (rows of ``lines``, dB over the floor, −inf where no line): True when the line at bin ``p`` has
-    lines (within ±2 bins, ≥ HARMONIC_LINE_DB and ≥ its level − COMB_LEVEL_DB) at 3 of ±Δ, ±2Δ for some Δ in
-    HARMONIC_SPACING_HZ: one harmonic of a voice (or of any periodic sound), not a taxel. White noise: ~1e-5 of
-    frames per Δ trips it."""
+    """Per frame (rows of ``lines``, dB over the floor, −inf where no line): True when the line at bin ``p`` is one
+    of a harmonic comb of spacing Δ in HARMONIC_SPACING_HZ (a voice, or any periodic sound), not a taxel. Two
+    tests (:data:`HARMONIC_TESTS`): lines ≥ 8 dB within ±2 bins at 3 of ±Δ, ±2Δ (resolved harmonics), or lines
+    ≥ 6 dB within ±1 bin at 5 of ±Δ … ±4Δ (a wider comb of weaker, partly smeared harmonics). Each neighbour must
+    also be within COMB_LEVEL_DB of the line. A taxel's own skirt (jet noise through the resonator, ~±100 Hz)
+    reaches ±Δ, not ±3Δ."""
     from scipy.ndimage import maximum_filter1d
 
     k, n = lines.shape
     rows = np.arange(k)
     level = lines[rows, p]
-    need = np.maximum(HARMONIC_LINE_DB, level - COMB_LEVEL_DB)
-    near = maximum_filter1d((lines >= need[:, None]).astype(np.uint8), 5, axis=1, mode="constant") > 0
     d = np.arange(int(HARMONIC_SPACING_HZ[0] / df), int(HARMONIC_SPACING_HZ[1] / df) + 1)
-    at = p[:, None, None] + np.array([-2, -1, 1, 2])[None, :, None] * d[None, None, :]
-    hit = near[rows[:, None, None], np.clip(at, 0, n - 1)] & (at >= 0) & (at < n)
-    return np.isfinite(level) & np.any(hit.sum(axis=1) >= 3, axis=1)
+    found = np.zeros(k, dtype=bool)
+    for orders, hits, tolerance, line_db in HARMONIC_TESTS:
+        need = np.maximum(line_db, level - COMB_LEVEL_DB)
+        near = maximum_filter1d((lines >= need[:, None]).astype(np.uint8), 2 * tolerance + 1, axis=1,
+                                mode="constant") > 0
+        at = p[:, None, None] + np.array(orders)[None, :, None] * d[None, None, :]
+        hit = near[rows[:, None, None], np.clip(at, 0, n - 1)] & (at >= 0) & (at < n)
+        found |= np.any(hit.sum(axis=1) >= hits, axis=1)
+    return np.isfinite(level) & found
 
 
 def _second_sources(other_bin, other_excess, other_level, band_freqs) -> list[Source]:
