@@ -275,6 +275,9 @@ def cmd_analyze(args) -> int:
     from matcad.loop.analyze import analyze_stream, plot, write_segments_csv, write_track_csv
     from matcad.output import staged_output
 
+    board = _board_bands(args)
+    if board is not None:
+        return _analyze_board(args, board)
     band = _band(args)
     blocks, fs, name = _recording_blocks(args)
     result = analyze_stream(blocks, fs, [band])[0]
@@ -295,6 +298,63 @@ def cmd_analyze(args) -> int:
         _print_segments(result)
         for w in result.warnings:
             print(f"  warning: {w}")
+        print(f"  track.csv, segments.csv, spectrogram.png, report.json in {target}/")
+    return EXIT_OK
+
+
+def _board_bands(args):
+    """(name, listening band Hz) per taxel when ``--spec`` names an array (and no --band is given), else None."""
+    if not getattr(args, "spec", None) or getattr(args, "band", None):
+        return None
+    from matcad.taxel import is_array
+
+    spec = _load_spec(args.spec, args)
+    if not is_array(spec):
+        return None
+    from matcad.loop.board import board_bands
+
+    return board_bands(spec)
+
+
+def _board_summary(tracks, readings=None) -> None:
+    for t in tracks:
+        if t.analysis is None:
+            print(f"  {t.name} ({t.band_hz[0]:.0f}-{t.band_hz[1]:.0f} Hz): {t.reason}")
+            continue
+        a = t.analysis
+        line = (f"  {t.name} ({t.band_hz[0]:.0f}-{t.band_hz[1]:.0f} Hz): mean {a.mean_hz:.2f} Hz, sd {a.std_hz:.2f} Hz, "
+                f"tone {100 * a.tone_fraction:.0f} %, {len(a.segments)} segments")
+        r = (readings or {}).get(t.name)
+        if r is not None and r.force_n == r.force_n:
+            line += f"; F = {r.force_n:.3f} N (95 %: {r.force_interval_n[0]:.3f} .. {r.force_interval_n[1]:.3f})"
+        elif r is not None:
+            line += f"; {r.reason}"
+        elif readings is not None:
+            line += "; no calibration: frequency only"
+        print(line)
+        _print_segments(a, r.segments_n if r is not None else None)
+        for w in list(a.warnings) + (list(r.warnings) if r is not None else []):
+            print(f"    warning: {w}")
+
+
+def _analyze_board(args, named_bands) -> int:
+    from matcad.loop import board
+    from matcad.output import staged_output
+
+    blocks, fs, name = _recording_blocks(args)
+    tracks = board.analyze_board(blocks, fs, named_bands)
+    target = _loop_output(args, "analyze", name)
+    report = {"recording": name, "taxels": [t.to_dict() for t in tracks]}
+    with staged_output(target) as tmp:
+        board.write_track_csv(tracks, tmp / "track.csv")
+        board.write_segments_csv(tracks, tmp / "segments.csv")
+        board.plot(tracks, tmp / "spectrogram.png")
+        _write_json(tmp / "report.json", report)
+    if args.json:
+        _print_json({**report, "out_dir": str(target)})
+    else:
+        print(f"{name}: {len(tracks)} taxels, each in its own band")
+        _board_summary(tracks)
         print(f"  track.csv, segments.csv, spectrogram.png, report.json in {target}/")
     return EXIT_OK
 
@@ -345,7 +405,13 @@ def cmd_sense(args) -> int:
     from matcad.output import staged_output
     from matcad.spec import load_calibration
 
-    cal = SensorCalibration.from_spec_calibration(load_calibration(args.calibration))
+    board = _board_bands(args)
+    if board is not None:
+        return _sense_board(args, board)
+    if len(args.calibration) != 1:
+        raise ValueError(f"--calibration given {len(args.calibration)} times: several calibrations need --spec "
+                         "naming an array, one NAME=FILE per taxel")
+    cal = SensorCalibration.from_spec_calibration(load_calibration(args.calibration[0]))
     cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
     f_lo, f_hi = cal.frequency_range_hz()
     blocks, fs, name = _recording_blocks(args)
@@ -373,7 +439,7 @@ def cmd_sense(args) -> int:
                 rows.append(",".join(cells))
             (tmp / "forces.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
             plot(result, tmp / "force.png", (reading.frames_n, *reading.frames_interval_n.T))
-            _write_json(tmp / "report.json", {"recording": name, "calibration": str(args.calibration),
+            _write_json(tmp / "report.json", {"recording": name, "calibration": str(args.calibration[0]),
                                               **reading.to_dict(), "analysis": result.to_dict(),
                                               "segment_forces_n": [[None if not np.isfinite(v) else float(v)
                                                                     for v in row] for row in reading.segments_n]})
@@ -403,6 +469,53 @@ def cmd_sense(args) -> int:
         if target is not None:
             print(f"  forces.csv, segments.csv, force.png, report.json in {target}/")
     require_in_range(reading)
+    return EXIT_OK
+
+
+def _sense_board(args, named_bands) -> int:
+    import numpy as np
+
+    from matcad.loop import board
+    from matcad.loop.sense import SensorCalibration, force_with_interval
+    from matcad.output import staged_output
+    from matcad.spec import load_calibration
+
+    names = [n for n, _ in named_bands]
+    files = board.parse_calibrations(args.calibration, names)
+    cals = {n: SensorCalibration.from_spec_calibration(load_calibration(f)) for n, f in files.items()}
+    for cal in cals.values():
+        cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
+    blocks, fs, name = _recording_blocks(args)
+    on_frame = None
+    if args.live:
+        def on_frame(k, time_s, freq, _excess):
+            taxel, text = names[k], "no tone"
+            if freq == freq:
+                text = f"{freq:9.2f} Hz"
+                if taxel in cals:
+                    force, half = force_with_interval(cals[taxel], [freq], temperature_c=args.temperature_c)
+                    text += (f"  F = {force[0]:.3f} +- {half[0]:.3f} N" if np.isfinite(force[0])
+                             else "  outside the calibrated range")
+            print(f"{time_s:9.3f} s  {taxel}  {text}", flush=True)
+    tracks = board.analyze_board(blocks, fs, named_bands, on_frame)
+    readings = board.sense_board(tracks, cals, args.temperature_c)
+    report = {"recording": name, "calibrations": files,
+              "taxels": [{**t.to_dict(), **({"reading": readings[t.name].to_dict()} if t.name in readings else {})}
+                         for t in tracks]}
+    target = _loop_output(args, "sense", name) if not (args.live and args.out is None) else None
+    if target is not None:
+        with staged_output(target) as tmp:
+            board.write_segments_csv(tracks, tmp / "segments.csv", readings)
+            board.write_forces_csv(tracks, readings, tmp / "forces.csv")
+            board.plot(tracks, tmp / "force.png", readings)
+            _write_json(tmp / "report.json", report)
+    if args.json:
+        _print_json({**report, "out_dir": None if target is None else str(target)})
+    else:
+        print(f"{name}: {len(tracks)} taxels, {len(readings)} with a calibration and a tone")
+        _board_summary(tracks, readings)
+        if target is not None:
+            print(f"  forces.csv, segments.csv, force.png, report.json in {target}/")
     return EXIT_OK
 
 
@@ -644,7 +757,11 @@ def _parser() -> argparse.ArgumentParser:
     n = command("sense", cmd_sense, "force from a recording through a calibration, with 95 %% intervals",
                 "out/sense-<recording>-<hash>")
     n.add_argument("recording", help="WAV file, or '-' for standard input (WAV, or raw PCM with --format --rate)")
-    n.add_argument("--calibration", required=True, help="calibration.toml from `matcad calibrate`, or a spec")
+    n.add_argument("--calibration", required=True, action="append", metavar="[NAME=]FILE",
+                   help="calibration.toml from `matcad calibrate`, or a spec; with --spec naming an array, one "
+                        "NAME=FILE per taxel (repeat the option; a taxel without one gets frequencies only)")
+    n.add_argument("--spec", help="spec TOML of an array: every taxel tracked in its own (loaded) band")
+    n.add_argument("--set", action="append", metavar="KEY=VALUE", help="override one field of --spec (TOML value)")
     n.add_argument("--temperature-c", type=float, help="air temperature now (degC): frequencies are scaled by "
                                                        "sqrt(T_cal/T) to the calibration's temperature")
     n.add_argument("--live", action="store_true", help="print each frame's force as it is decided (~1 s lag); "

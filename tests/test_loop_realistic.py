@@ -24,8 +24,9 @@ def _scored(name, seconds=6.0, seed=0):
 
 @pytest.mark.parametrize("name", ["white-noise", "brown-noise", "buzz-only"])
 def test_no_tone_in_noise_or_buzz(name):
-    """No frame of white, brown noise or 60 Hz buzz (with room and AGC) qualifies, over 4 seeds (≈ 850 frames)."""
-    for seed in range(4):
+    """No frame of white, brown noise or 60 Hz buzz (with room and AGC) qualifies, over 5 seeds (≈ 1070 frames);
+    seed 7 holds a lone frame 15.1 dB over the floor, which voiced before strong frames needed a partner."""
+    for seed in (0, 1, 2, 3, 7):
         rec = synth.scenario(name, 10.0, seed)
         with pytest.raises(LoopError, match="no tone"):
             analyze(rec.x, rec.fs, rec.band_hz)
@@ -39,7 +40,7 @@ def test_speech_is_rarely_taken_for_a_tone():
             voiced.append(analyze(rec.x, rec.fs, rec.band_hz).tone_fraction)
         except LoopError:
             voiced.append(0.0)
-    assert np.mean(voiced) < 0.1, voiced
+    assert np.mean(voiced) < 0.05, voiced  # 2.6 % measured (4.2 % before the wider comb test)
 
 
 @pytest.mark.parametrize("name", ["steady", "buzz+tone", "speech+tone"])

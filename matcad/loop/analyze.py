@@ -413,7 +413,10 @@ class BandTracker:
         self._voice_done = max(self._voice_done, stop)
 
     # --- end of input ---------------------------------------------------------------------------------------
-    def finish(self, duration_s: float, full_mean_power: np.ndarray | None = None) -> Analysis:
+    def finish(self, duration_s: float, full_mean_power: np.ndarray | None = None, others=()) -> Analysis:
+        """The :class:`Analysis` of everything pushed. ``full_mean_power`` (the whole spectrum's mean) lets a
+        stronger tone outside the band be reported; one inside another taxel's band (``others``, Hz) is that
+        taxel's, not reported here."""
         count = len(self._p_times)
         if count:  # the rest: one backtrack from the best final state
             states = np.empty(count, dtype=np.intp)
@@ -431,7 +434,7 @@ class BandTracker:
         lo, hi = self.band
         loudest = ""
         if full_mean_power is not None and len(times):
-            loudest = _strongest_outside(self.freqs, full_mean_power, lo, hi,
+            loudest = _strongest_outside(self.freqs, full_mean_power, [(lo, hi), *others],
                                          float(self.band_peak_power.max() / len(times)))
         hint = f"; {loudest}" if loudest else ""
         if len(track) == 0:
@@ -569,10 +572,13 @@ def _second_sources(other_bin, other_excess, other_level, band_freqs) -> list[So
     return [Source(float(band_freqs[int(round(centre))]), rel, float(np.sum(close) / len(other_bin)))]
 
 
-def _strongest_outside(f, mean_spectrum, lo, hi, in_band_peak) -> str:
-    """'a stronger tone near … Hz outside the band (… dB above …)' if one exists above 20 Hz, else ''."""
+def _strongest_outside(f, mean_spectrum, bands, in_band_peak) -> str:
+    """'a stronger tone near … Hz outside the band (… dB above …)' if one exists above 20 Hz outside every band of
+    ``bands`` (Hz; the first is this taxel's, the others its neighbours'), else ''."""
     df = f[1] - f[0]
-    outside = ((f < lo - 2 * df) | (f > hi + 2 * df)) & (f > 20.0)  # below 20 Hz: drift, not a tone
+    outside = f > 20.0  # below 20 Hz: drift, not a tone
+    for lo, hi in bands:
+        outside &= (f < lo - 2 * df) | (f > hi + 2 * df)
     if not np.any(outside):
         return ""
     i = int(np.argmax(np.where(outside, mean_spectrum, 0.0)))
@@ -582,7 +588,7 @@ def _strongest_outside(f, mean_spectrum, lo, hi, in_band_peak) -> str:
     a, b, c = 10 * np.log10(mean_spectrum[i - 1:i + 2] + np.finfo(float).tiny)
     delta = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c < 0 else 0.0
     where = f[i] + float(np.clip(delta, -0.5, 0.5)) * df
-    return (f"a stronger tone near {where:.0f} Hz outside the band "
+    return (f"a stronger tone near {where:.0f} Hz outside the band{'s of every taxel' if len(bands) > 1 else ''} "
             f"({10 * np.log10(mean_spectrum[i] / in_band_peak):.1f} dB above the in-band peak)")
 
 
@@ -592,12 +598,10 @@ def band_from_prediction(band_hz: tuple[float, float]) -> tuple[float, float]:
     return band_hz[0] * 0.9, band_hz[1] * 1.25
 
 
-def analyze_stream(blocks, fs: float, bands, on_frame=None) -> list[Analysis]:
-    """One :class:`Analysis` per band (Hz) from an iterable of sample blocks at ``fs`` (Hz), in one pass.
-
-    Several bands are the plug-in point for a board of taxels: each band is tracked on its own. ``on_frame`` is
-    called as (band index, time s, frequency Hz or NaN, excess dB) as frames become final.
-    """
+def run_trackers(blocks, fs: float, bands, on_frame=None) -> tuple[list[BandTracker], float, np.ndarray]:
+    """Feed an iterable of sample blocks at ``fs`` (Hz) to one :class:`BandTracker` per band (Hz), in one pass:
+    (trackers, duration s, mean power spectrum). ``on_frame`` is called as (band index, time s, frequency Hz or
+    NaN, excess dB) as frames become final."""
     framer = Framer(fs)
     trackers = [BandTracker(framer.freqs, fs, band,
                             None if on_frame is None else (lambda *a, k=k: on_frame(k, *a)))
@@ -611,8 +615,16 @@ def analyze_stream(blocks, fs: float, bands, on_frame=None) -> list[Analysis]:
             total += power.sum(axis=0)
             for tr in trackers:
                 tr.push(times, power)
-    frames = max(1, framer.frames)
-    return [tr.finish(samples / fs, total / frames) for tr in trackers]
+    return trackers, samples / fs, total / max(1, framer.frames)
+
+
+def analyze_stream(blocks, fs: float, bands, on_frame=None) -> list[Analysis]:
+    """One :class:`Analysis` per band (Hz) from an iterable of sample blocks at ``fs`` (Hz), in one pass
+    (:func:`run_trackers`); raises LoopError when any band has no tone. A board of taxels whose silent members
+    must not stop the others is :func:`matcad.loop.board.analyze_board`."""
+    trackers, duration, mean_power = run_trackers(blocks, fs, bands, on_frame)
+    return [tr.finish(duration, mean_power, [b for j, b in enumerate(bands) if j != k])
+            for k, tr in enumerate(trackers)]
 
 
 def analyze(x: np.ndarray, fs: float, band_hz: tuple[float, float]) -> Analysis:

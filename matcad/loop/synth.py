@@ -262,3 +262,56 @@ def scenario(name: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) ->
 
 CASES = ("steady", "presses", "tapping", "gaps", "short-tone", "buzz-only", "buzz+tone", "speech-only",
          "speech+tone", "neighbour", "overblown", "white-noise", "brown-noise")
+
+
+# --- a board: several taxels heard by one microphone ---------------------------------------------------------------
+
+@dataclass(frozen=True)
+class BoardRecording:
+    """Samples of several taxels at once and the truth behind them: per taxel (rows, in ``names`` order) the
+    per-sample frequency (Hz, NaN when silent) and force (N), and each taxel's listening band (Hz)."""
+
+    x: np.ndarray = field(repr=False)
+    fs: float
+    names: tuple[str, ...]
+    truth_hz: np.ndarray = field(repr=False)
+    force_n: np.ndarray = field(repr=False)
+    bands_hz: tuple[tuple[float, float], ...]
+
+    def truth_at(self, k: int, times_s) -> np.ndarray:
+        """Taxel ``k``'s frequency (Hz, NaN when silent) at each time (s)."""
+        i = np.clip((np.asarray(times_s) * self.fs).astype(int), 0, self.truth_hz.shape[1] - 1)
+        return self.truth_hz[k, i]
+
+
+BOARD_F0_HZ = (3600.0, 4050.0, 4550.0, 5100.0)
+"""Unloaded pitches of the four-taxel board: loaded bands (0-15 N by Eq. 5, +7.4 %) ~60 Hz apart, no 2f or 3f of one
+inside another's band."""
+
+
+def board_band_hz(f0_hz: float, max_force_n: float = 15.0) -> tuple[float, float]:
+    """A taxel's listening band (Hz): 2 % below its unloaded pitch to 1 % above its Eq. 5 pitch at
+    ``max_force_n`` (N) — what matcad.acoustics.bands' loaded band is for a well-predicted taxel."""
+    rise = float(frequency_of_force(max_force_n) / frequency_of_force(0.0))
+    return 0.98 * f0_hz, 1.01 * rise * f0_hz
+
+
+def board_scenario(seconds: float = 10.0, seed: int = 0, fs: float = FS, f0_hz=BOARD_F0_HZ,
+                   pressed=(1, 3), amplitudes=(0.1, 0.3, 0.1, 0.15)) -> BoardRecording:
+    """Four taxels singing at once in a room (pink noise, reverb RT60 0.4 s, tablet microphone): the ``pressed``
+    ones (0-based) pressed 2 → 12 N for 0.8 s every 2 s (0.15 s ramps, the two out of phase), the others held at
+    4 N; amplitudes differ (taxel 2 is 10 dB louder than taxel 1, its lower neighbour)."""
+    n = int(seconds * fs)
+    forces, freqs = [], []
+    for k, f0 in enumerate(f0_hz):
+        if k in pressed:
+            starts = np.arange(1.0 + 1.0 * (pressed.index(k) % 2), seconds - 1.0, 2.0)
+            force = press_profile(seconds, fs, [(s, s + 0.8, 12.0) for s in starts], ramp_s=0.15)
+        else:
+            force = np.full(n, 4.0)
+        forces.append(force)
+        freqs.append(frequency_of_force(force, EQ5[0] * f0**2))
+    x = sum(taxel(f, fs, seed + 11 * k, amplitude=a) for k, (f, a) in enumerate(zip(freqs, amplitudes)))
+    x = _room(x, fs, seed, rt60=0.4)
+    return BoardRecording(x, fs, tuple(f"t{k + 1}" for k in range(len(f0_hz))), np.array(freqs), np.array(forces),
+                          tuple(board_band_hz(f0) for f0 in f0_hz))
