@@ -9,7 +9,10 @@
 3. Voicing false alarms on noise (white, pink, brown; many minutes): voiced frames against frames and frame×bins
    tested, with the one-sided 95 % upper bound of the per-frame rate (Clopper–Pearson), and the per-bin tail of
    the excess over the floor against the exponential law.
-4. Memory and time of `matcad analyze` on 10 s, 10 min and 60 min WAV files (peak RSS from /usr/bin/time -v, or
+4. A board: four taxels singing at once (synth.board_scenario; t2 and t4 pressed 2 → 12 N), each tracked in its
+   own band — per taxel the mean per-frame error, track RMS, frames wrong and voiced; and issue 11's neighbour case
+   with the louder neighbour in its own band.
+5. Memory and time of `matcad analyze` on 10 s, 10 min and 60 min WAV files (peak RSS from /usr/bin/time -v, or
    resource.getrusage of the child when it is missing).
 
 Run: /work/venv/bin/python benchmarks/analyze.py [--quick] [--memory-only | --no-memory] [--noise-minutes N]
@@ -206,6 +209,59 @@ def false_alarm_table(minutes):
           "| | | |")
 
 
+def _board_rows(rec, tracks):
+    hop = 0.0464
+    rows = []
+    for k, t in enumerate(tracks):
+        a = t.analysis
+        truth = rec.truth_at(k, a.times_s) if hasattr(rec, "names") else (
+            rec.truth_at(a.times_s) + (300.0 if k else 0.0))
+        at = (lambda d: rec.truth_at(k, a.times_s + d)) if hasattr(rec, "names") else (lambda d: truth)
+        steady = np.fmax(*[np.abs(at(d) - truth) for d in (-hop, hop)]) <= WRONG_HZ
+        ok = a.voiced & steady
+        err = a.track_hz[ok] - truth[ok]
+        rows.append((t.name, np.mean(err), np.sqrt(np.mean(err ** 2)),
+                     (np.sum(np.abs(err) > WRONG_HZ) + np.sum(~a.voiced & steady)) / max(steady.sum(), 1),
+                     a.tone_fraction, len(a.segments), len(a.warnings)))
+    return rows
+
+
+def board_table(seeds, seconds):
+    from matcad.loop.board import analyze_board
+
+    print(f"\nA board of four taxels in one recording ({seconds:g} s, {seeds} seeds; t2 and t4 pressed 2 -> 12 N; "
+          "t2 10 dB louder than t1; frames whose window spans a ramp not scored):\n")
+    print("| taxel | band [Hz] | mean per-frame error [Hz] | track RMS [Hz] | frames wrong | tone fraction | "
+          "segments | warnings | analyze time, 4 bands [s] |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|")
+    per, spent = [], []
+    for seed in range(seeds):
+        rec = synth.board_scenario(seconds, seed)
+        t0 = time.perf_counter()
+        tracks = analyze_board([rec.x], rec.fs, list(zip(rec.names, rec.bands_hz)))
+        spent.append(time.perf_counter() - t0)
+        per.append(_board_rows(rec, tracks))
+    for k, name in enumerate(rec.names):
+        col = np.array([p[k][1:] for p in per], dtype=float)
+        lo, hi = rec.bands_hz[k]
+        print(f"| {name} | {lo:.0f}-{hi:.0f} | {np.mean(col[:, 0]):+.3f} (worst {np.max(np.abs(col[:, 0])):.3f}) | "
+              f"{np.mean(col[:, 1]):.2f} | {100 * np.mean(col[:, 2]):.1f} % | {np.mean(col[:, 3]):.2f} | "
+              f"{np.mean(col[:, 4]):.1f} | {np.mean(col[:, 5]):.0f} | {np.mean(spent):.2f} |")
+    print("\nIssue 11's neighbour case (a taxel 10 dB louder, 300 Hz above) with the neighbour in its own band:\n")
+    print("| taxel | band [Hz] | mean per-frame error [Hz] | track RMS [Hz] | frames wrong | tone fraction | "
+          "segments | warnings |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|")
+    ours = synth.board_band_hz(4400.0)
+    bands = [("taxel", ours), ("neighbour", (ours[1] + 50.0, ours[1] + 450.0))]
+    per = [_board_rows(rec, analyze_board([rec.x], rec.fs, bands))
+           for rec in (synth.scenario("neighbour", seconds, seed) for seed in range(seeds))]
+    for k, (name, (lo, hi)) in enumerate(bands):
+        col = np.array([p[k][1:] for p in per], dtype=float)
+        print(f"| {name} | {lo:.0f}-{hi:.0f} | {np.mean(col[:, 0]):+.3f} (worst {np.max(np.abs(col[:, 0])):.3f}) | "
+              f"{np.mean(col[:, 1]):.2f} | {100 * np.mean(col[:, 2]):.1f} % | {np.mean(col[:, 3]):.2f} | "
+              f"{np.mean(col[:, 4]):.1f} | {np.mean(col[:, 5]):.0f} |")
+
+
 def write_long_wav(path, minutes):
     """A long 16-bit recording written 10 s at a time (never held whole): the 'presses' case repeated."""
     block = synth.scenario("presses", 10.0, 0)
@@ -248,15 +304,20 @@ def main():
     parser.add_argument("--quick", action="store_true", help="2 seeds, 5 s cases, no 60 min file")
     parser.add_argument("--memory-only", action="store_true")
     parser.add_argument("--no-memory", action="store_true", help="skip the long files")
+    parser.add_argument("--board-only", action="store_true", help="only the board table")
     parser.add_argument("--noise-minutes", type=float, default=10.0,
                         help="minutes of each noise for the false-alarm table (0 skips it)")
     args = parser.parse_args()
     durations = [("10 s", 1 / 6), ("10 min", 10), ("60 min", 60)]
     if args.quick:
         durations = durations[:2]
+    if args.board_only:
+        board_table(3, 10.0)
+        return
     if not args.memory_only:
         clean_tone_table()
         realistic_table(2 if args.quick else 3, 5.0 if args.quick else 10.0)
+        board_table(2 if args.quick else 3, 5.0 if args.quick else 10.0)
         if args.noise_minutes > 0:
             false_alarm_table(1 if args.quick else args.noise_minutes)
     if not args.no_memory:
