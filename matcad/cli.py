@@ -739,7 +739,8 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("recording", help="WAV file (mono/stereo; 8-32-bit integer or float; any sample rate), or "
                                      "'-' for standard input")
     group = a.add_mutually_exclusive_group()
-    group.add_argument("--spec", help="spec TOML: analyse its predicted band (-10 %% / +25 %% for load)")
+    group.add_argument("--spec", help="spec TOML: analyse its predicted band (-10 %% / +25 %% for load); an array "
+                                      "spec: every taxel at once, each in its loaded band, per-taxel columns")
     group.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="analysis band in Hz")
     a.add_argument("--set", action="append", metavar="KEY=VALUE", help="override one field of --spec (TOML value)")
 

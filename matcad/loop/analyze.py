@@ -674,8 +674,10 @@ def plot(analysis: Analysis, path, forces=None) -> None:
                   vmin=np.percentile(db, 5), vmax=db.max())
     ax.plot(analysis.times_s, np.where(analysis.voiced, analysis.track_hz, np.nan), color="cyan", lw=1,
             label="voiced track")
-    for s in analysis.segments:
-        ax.hlines(s.mean_hz, s.start_s, s.end_s, color="red" if s.flag else "white", lw=2)
+    segs = analysis.segments
+    if segs:  # one call for all segments: a 60 min file has thousands
+        ax.hlines([s.mean_hz for s in segs], [s.start_s for s in segs], [s.end_s for s in segs],
+                  colors=["red" if s.flag else "white" for s in segs], lw=2)
     ax.set(ylabel="frequency [Hz]",
            title=f"mean {analysis.mean_hz:.2f} Hz over {100 * analysis.tone_fraction:.0f} % of frames (voiced), "
                  f"{len(analysis.segments)} segments")
