@@ -126,3 +126,71 @@ def test_calibration_names():
     for bad, match in ((["a.toml"], "NAME=FILE"), (["t9=a.toml"], "t9"), (["t1=a", "t1=b"], "twice")):
         with pytest.raises(ValueError, match=match):
             parse_calibrations(bad, ["t1", "t2"])
+
+
+BOARD_TAXELS = """
+[[taxel]]
+name = "low"
+x = -6.0
+y = 0.0
+cavity_length = 10.0
+
+[[taxel]]
+name = "high"
+x = 6.0
+y = 0.0
+cavity_length = 3.0
+"""
+
+
+def test_cli_analyze_and_sense_an_array_spec(tmp_path):
+    """`analyze` and `sense` with a two-taxel spec: each taxel heard in its loaded band (matcad.acoustics.bands),
+    the low one pressed 2 → 10 N; per-taxel columns; a calibration per taxel given as NAME=FILE."""
+    import json
+
+    from scipy.io import wavfile
+
+    from matcad import spec as spec_mod
+    from matcad.loop.board import board_bands
+    from tests.conftest import ROOT, run_cli
+
+    path = tmp_path / "board.toml"
+    path.write_text((ROOT / "templates" / "mat-paper.toml").read_text() + BOARD_TAXELS)
+    bands = board_bands(spec_mod.load(path))
+    assert [n for n, _ in bands] == ["low", "high"] and bands[0][1][1] < bands[1][1][0]
+    fs, seconds = 44100.0, 5.0
+    n = int(fs * seconds)
+    # each taxel sings at the middle of its band's unloaded part, the low one pressed 2 -> 10 N
+    f0 = [0.5 * (lo + hi) / 1.04 for _, (lo, hi) in bands]
+    k_hz2 = [synth.EQ5[0] * f**2 for f in f0]
+    force = [synth.press_profile(seconds, fs, [(1.0, 2.5, 10.0), (3.2, 4.2, 10.0)]), np.full(n, 4.0)]
+    x = sum(synth.taxel(synth.frequency_of_force(F, k), fs, 5 + i) for i, (F, k) in enumerate(zip(force, k_hz2)))
+    x = synth._room(x, fs, 3)
+    wavfile.write(tmp_path / "rec.wav", int(fs), np.round(x / np.max(np.abs(x)) * 30000).astype(np.int16))
+    code, out, err = run_cli("analyze", tmp_path / "rec.wav", "--spec", path, "--json", "--out", tmp_path / "a")
+    assert code == 0, err
+    data = json.loads(out)
+    assert [t["taxel"] for t in data["taxels"]] == ["low", "high"]
+    high = data["taxels"][1]
+    assert abs(high["mean_hz"] - synth.frequency_of_force(4.0, k_hz2[1])) < 1.0
+    assert len(data["taxels"][0]["segments"]) >= 4  # held, pressed, held, pressed, held
+    head = (tmp_path / "a" / "track.csv").read_text().splitlines()[0]
+    assert head == ("time_s,low_frequency_hz,low_snr_db,low_voiced,high_frequency_hz,high_snr_db,high_voiced")
+    assert (tmp_path / "a" / "spectrogram.png").read_bytes()[:4] == b"\x89PNG"
+    # sense: the low taxel calibrated, the high one not (frequencies only)
+    forces = np.linspace(0.0, 15.0, 11)
+    cal = tmp_path / "low.toml"
+    cal.write_text(fit(forces, synth.frequency_of_force(forces, k_hz2[0]), k_hz2[0]).to_toml())
+    code, out, err = run_cli("sense", tmp_path / "rec.wav", "--spec", path, "--calibration", f"low={cal}",
+                             "--json", "--out", tmp_path / "s")
+    assert code == 0, err
+    data = json.loads(out)
+    low = data["taxels"][0]["reading"]
+    assert low["frames_with_force"] > 0 and "reading" not in data["taxels"][1]
+    rows = (tmp_path / "s" / "forces.csv").read_text().splitlines()
+    names = rows[0].split(",")
+    pressed = [float(r.split(",")[names.index("low_force_n")]) for r in rows[1:]
+               if r.split(",")[names.index("low_force_n")]]
+    assert max(pressed) == pytest.approx(10.0, abs=0.7) and min(pressed) == pytest.approx(2.0, abs=0.7)
+    code, _, err = run_cli("sense", tmp_path / "rec.wav", "--spec", path, "--calibration", f"mid={cal}")
+    assert code == 2 and "'mid' invalid, must be one of low, high" in err
