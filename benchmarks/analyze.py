@@ -80,12 +80,14 @@ def clean_tone_table():
         path = Path(tmp) / "tone.wav"
         wavfile.write(path, FS, (x * 30000).astype(np.int16))
         analyze(*read_mono(path), BAND)  # warm imports
-        times = []
+        times, cpu = [], []
         for _ in range(5):
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             analyze(*read_mono(path), BAND)
             times.append(time.perf_counter() - t0)
-    print(f"read + analyze, 10 s at 44.1 kHz: median {statistics.median(times) * 1e3:.0f} ms\n")
+            cpu.append(time.process_time() - c0)
+    print(f"read + analyze, 10 s at 44.1 kHz: median {statistics.median(times) * 1e3:.0f} ms wall, "
+          f"{statistics.median(cpu) * 1e3:.0f} ms CPU (wall depends on the machine's load: {os.getloadavg()[0]:.1f})\n")
     methods = {"matcad ridge (voiced frames)": ridge, "Welch peak": welch_peak, "power centroid": centroid}
     print("| method | " + " | ".join(f"RMS error at {s:+d} dB [Hz]" for s in SNRS) + " |")
     print("|---|" + "---:|" * len(SNRS))
