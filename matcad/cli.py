@@ -364,7 +364,7 @@ def cmd_calibrate(args) -> int:
     from matcad.output import staged_output
     from matcad.plausibility import frequency_notes
 
-    spec = _load_spec(args.spec, args)
+    spec = _one_taxel(_load_spec(args.spec, args), args.taxel)
     if args.temperature_c is not None and not -60.0 <= args.temperature_c <= 100.0:
         raise ValueError(f"--temperature-c {args.temperature_c:g} invalid, must be -60 to 100 degC")
     if args.cycle_std_n is not None and not 0.0 <= args.cycle_std_n <= 100.0:
@@ -395,6 +395,23 @@ def cmd_calibrate(args) -> int:
             print(f"  note: {note}")
         print(f"  calibration.toml, residuals.png in {target}/")
     return EXIT_OK
+
+
+def _one_taxel(spec, name):
+    """The single-taxel spec of taxel ``name`` of an array (a calibration is one taxel's); a one-taxel spec as is."""
+    from matcad.taxel import taxel_spec, taxels
+
+    board = taxels(spec)
+    names = ", ".join(t.name for t in board)
+    if name is None:
+        if len(board) > 1:
+            raise ValueError(f"{spec.name} has {len(board)} taxels: calibrate one at a time with --taxel NAME, NAME "
+                             f"one of {names}")
+        return spec
+    match = [t for t in board if t.name == name]
+    if not match:
+        raise ValueError(f"--taxel {name!r} invalid, must be one of {names}")
+    return taxel_spec(spec, match[0])
 
 
 def cmd_sense(args) -> int:
@@ -750,6 +767,8 @@ def _parser() -> argparse.ArgumentParser:
                                 "cycles give the between-cycle variance)")
     spec_arg(c, "--spec", required=True)
     c.add_argument("--k-free", action="store_true", help="fix V0 to the as-built cavity and fit K instead")
+    c.add_argument("--taxel", metavar="NAME", help="with an array spec: the taxel DATA was measured on (its own "
+                                                   "geometry sets K or V0); give the result to sense as NAME=FILE")
     c.add_argument("--temperature-c", type=float, help="air temperature during calibration (degC; default the "
                                                        "spec's [air] temperature_c), recorded for `sense`")
     c.add_argument("--cycle-std-n", type=float, help="between-cycle (hysteresis) sd in N assumed when DATA holds "

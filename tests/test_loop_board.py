@@ -194,3 +194,27 @@ def test_cli_analyze_and_sense_an_array_spec(tmp_path):
     assert max(pressed) == pytest.approx(10.0, abs=0.7) and min(pressed) == pytest.approx(2.0, abs=0.7)
     code, _, err = run_cli("sense", tmp_path / "rec.wav", "--spec", path, "--calibration", f"mid={cal}")
     assert code == 2 and "'mid' invalid, must be one of low, high" in err
+
+
+def test_calibrate_one_taxel_of_an_array(tmp_path):
+    """`calibrate --taxel NAME` fits with that taxel's geometry; an array spec without --taxel is exit 2."""
+    import json
+
+    from tests.conftest import ROOT, run_cli
+
+    path = tmp_path / "board.toml"
+    path.write_text((ROOT / "templates" / "mat-paper.toml").read_text() + BOARD_TAXELS)
+    data = tmp_path / "cal.csv"
+    forces = np.linspace(0.0, 15.0, 11)
+    data.write_text("force_n,frequency_hz\n" + "".join(f"{a},{b}\n" for a, b in
+                                                        zip(forces, synth.frequency_of_force(forces))))
+    code, _, err = run_cli("calibrate", data, "--spec", path, "--out", tmp_path / "x")
+    assert code == 2 and "--taxel NAME" in err and "low, high" in err
+    # with --k-free V0 is the taxel's own as-built cavity (π/4·D²·L, L = 10 and 3 mm), not the shared table's
+    for name, length in (("low", 10.0), ("high", 3.0)):
+        code, out, err = run_cli("calibrate", data, "--spec", path, "--taxel", name, "--k-free", "--json",
+                                 "--out", tmp_path / f"{name}-free")
+        assert code == 0, err
+        assert json.loads(out)["v0_mm3"] == pytest.approx(np.pi / 4 * 3.18**2 * length, rel=0.05)
+    code, _, err = run_cli("calibrate", data, "--spec", path, "--taxel", "mid")
+    assert code == 2 and "'mid' invalid, must be one of low, high" in err
