@@ -112,20 +112,28 @@ def board_bands(spec) -> dict:
     return summary(spec, taxel_bands(spec, mechanics=board, strict=board))
 
 
+def board_report(spec, board, predictions) -> list[dict]:
+    """Per taxel of a board: name, position (mm), its own geometry and prediction, and where its needle is."""
+    from dataclasses import asdict
+
+    from matcad.parts.features import needle_tip_mm
+
+    return [{"name": t.name, "x_mm": t.x, "y_mm": t.y, "cavity": asdict(t.cavity), "neck": asdict(t.neck),
+             "end_cap": asdict(t.end_cap), "needle": asdict(t.needle), "needle_tip_mm": list(needle_tip_mm(t)),
+             "prediction": p.to_dict()} for t, p in zip(board, predictions)]
+
+
 def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:
     """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
     from matcad.render.bands import BANDS_PNG, band_chart
     from matcad.render.kit import render_figures
     from matcad.report import KIT_ARCHIVE, make_report, write_report
-    from matcad.spec import SpecError
     from matcad.taxel import taxel_spec, taxels
 
     board = taxels(spec)
-    if len(board) > 1 or (board[0].x, board[0].y) != (0.0, 0.0):  # board parts are not built yet: refuse rather
-        raise SpecError("taxel", f"{len(board)} taxels", "build makes one taxel at the plate centre so far")
-    spec = taxel_spec(spec, board[0])
-    prediction = predict(spec)
-    findings = check(spec, prediction)
+    predictions = [predict(taxel_spec(spec, t)) for t in board]
+    prediction = predictions[0]
+    findings = check(spec, prediction if len(board) == 1 else None)
     blocking = [f for f in errors(findings) if not force or f.id in UNFORCEABLE]
     if blocking:
         raise DesignRuleFailure(findings)
@@ -136,6 +144,8 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
         meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
         figures = render_figures(spec, prediction, tmp, meshes) + [band_chart(bands, tmp / BANDS_PNG)]
         report = make_report(spec, prediction, findings, holes, meshes, tmp) | {"figures": figures, "bands": bands}
+        if len(board) > 1:
+            report["taxels"] = board_report(spec, board, predictions)
         write_report(report, tmp)
         write_archive(tmp, KIT_ARCHIVE)
     files = tuple(sorted(p.name for p in target.iterdir() if p.name != MANIFEST))

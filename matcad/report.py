@@ -91,10 +91,17 @@ def casting(spec) -> dict | None:
     from matcad.parts.mold_layout import layout
 
     plan = layout(spec).plan
-    return casting_guide(spec).to_dict() | {"venting": {
+    out = casting_guide(spec).to_dict() | {"venting": {
         "vent_reach_mm": spec.mold.vent_reach, "base_face_reach_mm": plan.reach_base_mm,
         "pin_end_reach_mm": plan.reach_tip_mm, "base_face_vents_per_cap": len(plan.inner) + len(plan.outer),
         "pin_vents_per_cap": 1, "vent_diameter_mm": spec.mold.vent}}
+    from matcad.taxel import is_array, taxels
+
+    if is_array(spec):  # which caps each mold holds, and how many pours (or molds) one board takes
+        from matcad.parts.mold_layout import pours_per_board
+
+        out["molds"] = pours_per_board(taxels(spec), spec.mold.count)
+    return out
 
 
 def needle_bom(spec) -> dict:
@@ -105,7 +112,9 @@ def needle_bom(spec) -> dict:
     gauge, od = nearest_needle_gauge(spec.needle.outer_diameter)
     sin_t = math.sin(math.radians(spec.needle.theta_deg))
     through = (needle_tip_mm(spec)[2] + spec.spacer.height + spec.mount.thickness) / sin_t
-    return {"count": 1, "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
+    from matcad.taxel import taxels
+
+    return {"count": len(taxels(spec)), "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
             "y_mm": spec.needle.y, "gauge": gauge, "gauge_od_mm": od, "hub": "Luer-lock hub, blunt (dispensing) tip",
             "min_length_mm": through + HUB_CLEARANCE_MM, "protrusion_mm": needle_protrusion_mm(spec),
             "note": f"nearest standard: {gauge} G ({od:.3f} mm, ISO 9626); measure yours and enter "

@@ -11,7 +11,7 @@ from matcad.parts.end_cap import end_cap
 from matcad.parts.features import cap_flange_thickness_mm, plate_bolt_positions_mm
 from matcad.parts.guide import guide
 from matcad.parts.neck_plate import neck_plate
-from matcad.parts.needle_mount import needle, needle_mount
+from matcad.parts.needle_mount import needle, needle_mount, taxel_needle
 from matcad.parts.registry import parts as registered_parts
 from matcad.parts.solid import flat_solid
 from matcad.parts.spacer import spacer
@@ -26,31 +26,49 @@ def section_colours() -> dict[str, str]:
     return {p.name: p.colour for p in registered_parts()} | {"needle": NEEDLE_COLOUR}
 
 
-def drilled(plate, neck_diameter: float):
-    """The neck plate as assembled: a pilot-cut neck drilled to its finished diameter (mm)."""
+def drilled(plate, neck_diameters: tuple[float, ...]):
+    """The neck plate as assembled: the pilot-cut necks (in board order) drilled to their finished diameters
+    (mm)."""
     import dataclasses
 
-    holes = tuple(dataclasses.replace(h, diameter=neck_diameter, purpose="neck") if h.purpose == "neck_pilot" else h
-                  for h in plate.holes)
+    finished = iter(neck_diameters)
+    holes = tuple(dataclasses.replace(h, diameter=next(finished), purpose="neck") if h.purpose == "neck_pilot"
+                  else h for h in plate.holes)
     return dataclasses.replace(plate, holes=holes)
 
 
 def assembled_parts(spec) -> dict[str, object]:
-    """Name → solid in the assembly frame (mm). Spacers are numbered when laser-cut."""
+    """Name → solid in the assembly frame (mm). Spacers are numbered when laser-cut; a board's caps and needles
+    are named after their taxels (end_cap_t1, needle_t1, ...)."""
+    from matcad.taxel import taxel_spec, taxels
+
+    board = taxels(spec)
     plate_t = spec.neck.length
     parts = {
-        "neck_plate": flat_solid(drilled(neck_plate(spec), spec.neck.diameter)),
+        "neck_plate": flat_solid(drilled(neck_plate(spec), tuple(t.neck.diameter for t in board))),
         "guide_locator": flat_solid(guide(spec, "locator"), plate_t),
         "guide_clamp": flat_solid(guide(spec, "clamp"), plate_t + cap_flange_thickness_mm(spec)),
-        "end_cap": Pos(0, 0, plate_t) * end_cap(spec),
-        "needle_mount": needle_mount(spec),
-        "needle": needle(spec),
     }
+    if len(board) == 1:
+        parts |= {"end_cap": Pos(0, 0, plate_t) * end_cap(spec), "needle_mount": needle_mount(spec),
+                  "needle": needle(spec)}
+    else:
+        parts |= {f"end_cap_{t.name}": Pos(t.x, t.y, plate_t) * end_cap(taxel_spec(spec, t)) for t in board}
+        parts["needle_mount"] = needle_mount(spec)
+        parts |= {f"needle_{t.name}": taxel_needle(t) for t in board}
     if spec.spacer.style == "laser":
         one = flat_solid(spacer(spec), -spec.spacer.height)
         for i, (x, y) in enumerate(plate_bolt_positions_mm(spec), 1):
             parts[f"spacer_{i}"] = Pos(x, y, 0) * one
     return parts
+
+
+def layer_of(name: str) -> str:
+    """The section layer (registered part or needle) of an assembled solid's name (spacer_2, end_cap_t3, ...)."""
+    for numbered in ("spacer", "end_cap", "needle"):
+        if name.startswith(numbered + "_") and name != "needle_mount":
+            return numbered
+    return name
 
 
 def assembly(spec, parts=None) -> Compound:
@@ -62,20 +80,35 @@ def assembly(spec, parts=None) -> Compound:
     return Compound(label=spec.name, children=children)
 
 
+def section_plane(spec):
+    """The section's plane: XZ through the first taxel's neck axis (a row of necks, and the needles' plane:
+    every needle is tilted in its own XZ plane) (mm)."""
+    from matcad.taxel import taxels
+
+    y = taxels(spec)[0].y
+    return Plane.XZ if y == 0.0 else Plane(origin=(0, y, 0), x_dir=(1, 0, 0), z_dir=(0, -1, 0))
+
+
 def write_section_svg(spec, path, parts=None) -> None:
-    """Section of the assembly through the neck axis in the XZ plane (needle plane), to scale in mm, with part
-    labels and the design's dimensions (:func:`matcad.render.section.annotate_section`)."""
+    """Section of the assembly through the first taxel's row of necks in the XZ plane (the needles' plane), to
+    scale in mm, with part labels and, for a single taxel, the design's dimensions
+    (:func:`matcad.render.section.annotate_section`; a board's section carries the labels only)."""
+    from matcad.taxel import is_array
+
     parts = parts or assembled_parts(spec)
+    plane = section_plane(spec)
     svg = ExportSVG(margin=2.0, line_weight=0.05)
     layers, colours = set(), section_colours()
     for name, solid in parts.items():
-        cut = solid & Plane.XZ
+        cut = solid & plane
         if not cut or not cut.faces():
             continue
-        layer = name.rsplit("_", 1)[0] if name.startswith("spacer_") else name
+        layer = layer_of(name)
         if layer not in layers:
             svg.add_layer(layer, fill_color=colours[layer], line_color="#000000")
             layers.add(layer)
+        if plane.origin.Y:
+            cut = Pos(0, -plane.origin.Y, 0) * cut
         svg.add_shape(Rot(-90, 0, 0) * cut, layer=layer)  # XZ plane → drawing plane, z up
     svg.write(str(path))
-    annotate_section(spec, path)
+    annotate_section(spec, path, dimensions=not is_array(spec))

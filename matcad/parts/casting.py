@@ -80,17 +80,20 @@ class CastingGuide:
 
 def casting_guide(spec: Spec) -> CastingGuide:
     """The pour for ``spec``: batch = max(cast volume × waste factor × density, :data:`MIN_BATCH_G`) (g)."""
+    from matcad.taxel import taxel_spec
+
     g = grade(spec.silicone.grade)
     mold = MOLD_MATERIALS[spec.machine.printer]
     caps = spec.mold.count
-    cast_ml = cap_volume_mm3(spec) * caps / 1000
+    lay = layout(spec)
+    volumes = [cap_volume_mm3(taxel_spec(spec, t)) for t in lay.slots]
+    cast_ml = (volumes[0] * caps if len(set(volumes)) == 1 else sum(volumes)) / 1000
     needed = cast_ml * spec.silicone.waste_factor * spec.silicone.density_g_cm3
     batch = max(needed, MIN_BATCH_G)
     reason = (f"the caps need {needed:.2f} g (x{spec.silicone.waste_factor:g} for cup, sprues and vents); mix at "
               f"least {MIN_BATCH_G:g} g so the ratio can be weighed on a 0.01 g scale and cup residue does not eat "
               "the batch" if needed < MIN_BATCH_G else f"the caps need {needed:.2f} g with x{spec.silicone.waste_factor:g} "
               "for cup, sprues and vents")
-    lay = layout(spec)
     vents = len(lay.plan.inner) + len(lay.plan.outer)
     steps = (
         f"Print the mold ({mold.label}): end_cap_mold_base.stl and end_cap_mold_lid.stl, each as exported "

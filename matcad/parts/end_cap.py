@@ -35,6 +35,22 @@ def end_cap(spec):
     return cap_envelope(spec) - core_pin(spec)
 
 
-PARTS = (Part("end_cap", Kind.CAST, flag="end_cap_mold", make=end_cap, order=50, colour="#f0a050",
+def board_caps(spec):
+    """The board's distinct end caps (one per group of identical caps), side by side along x with the mold's
+    spacing; a single taxel's cap at the origin (mm). The reference shape of what the mold casts."""
+    from build123d import Compound, Pos
+
+    from matcad.parts.features import cap_flange_diameter_mm
+    from matcad.parts.mold_layout import cap_x_mm, cap_groups
+    from matcad.taxel import taxel_spec, taxels
+
+    caps = [taxel_spec(spec, g[0]) for g in cap_groups(taxels(spec))]
+    if len(caps) == 1:
+        return end_cap(caps[0])
+    xs = cap_x_mm([cap_flange_diameter_mm(c) for c in caps], spec.mold.wall)
+    return Compound([Pos(x, 0, 0) * end_cap(c) for x, c in zip(xs, caps)])
+
+
+PARTS = (Part("end_cap", Kind.CAST, flag="end_cap_mold", make=board_caps, order=50, colour="#f0a050",
               pose=PrintPose(0.0, "base (the sealing face), cavity opening down: cast, not printed", printed=False),
               view=("from below: the cavity's open end", -90.0, -90.0), label="silicone end cap"),)

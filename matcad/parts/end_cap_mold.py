@@ -31,6 +31,13 @@ def _key(spec, grow: float, x: float, y: float):
     return frustum_up(r + grow, r * KEY_TOP_RATIO + grow, m.key_height + grow, x, y, 0.0)
 
 
+def _slot_specs(spec, lay: MoldLayout) -> list[tuple[float, object]]:
+    """(x, single-taxel spec of the cap it casts) for every cap position of the mold (mm)."""
+    from matcad.taxel import taxel_spec
+
+    return [(x, taxel_spec(spec, t)) for x, t in zip(lay.cap_x, lay.slots)]
+
+
 def _upside_down(shape, x: float):
     from build123d import Pos, Rot
 
@@ -47,7 +54,7 @@ def mold_base(spec):
     bolt_r = bolt_clearance_mm(spec.mold.bolt, "normal") / 2
     block = Box(lay.block_x, lay.block_y, lay.base_height, align=TOP)
     block = block.fuse(*(_key(spec, 0.0, x, y) for x, y in lay.keys))
-    return block.cut(*[_upside_down(cap_envelope(spec), x) for x in lay.cap_x],
+    return block.cut(*[_upside_down(cap_envelope(s), x) for x, s in _slot_specs(spec, lay)],
                      *[cylinder_up(bolt_r, lay.base_height, x, y, -lay.base_height) for x, y in lay.bolts])
 
 
@@ -61,19 +68,20 @@ def mold_lid(spec):
     lay = layout(spec)
     m = spec.mold
     lid = Box(lay.block_x, lay.block_y, m.lid_thickness, align=BOTTOM)
-    lid = lid.fuse(*(_upside_down(core_pin(spec), x) for x in lay.cap_x))
+    slots = _slot_specs(spec, lay)
+    lid = lid.fuse(*(_upside_down(core_pin(s), x) for x, s in slots))
     holes = ([(x, y, m.fill_port / 2) for x, y in lay.fill_ports]
              + [(x, y, m.vent / 2) for x, y in lay.vents]
              + [(x, y, bolt_clearance_mm(m.bolt, "normal") / 2) for x, y in lay.bolts])
     return lid.cut(*[_key(spec, spec.machine.key_clearance, x, y) for x, y in lay.keys],
                    *[cylinder_up(r, m.lid_thickness, x, y, 0.0) for x, y, r in holes],
-                   *[cylinder_up(m.vent / 2, spec.cavity.length + m.lid_thickness, x, y, -spec.cavity.length)
-                     for x, y in lay.pin_vents])
+                   *[cylinder_up(m.vent / 2, s.cavity.length + m.lid_thickness, x, y, -s.cavity.length)
+                     for (x, y), (_, s) in zip(lay.pin_vents, slots)])
 
 
 def cast_caps(spec):
     """The caps as they sit in the closed mold (for checks: they must touch, not cut, the mold) (mm)."""
-    return [_upside_down(end_cap(spec), x) for x in layout(spec).cap_x]
+    return [_upside_down(end_cap(s), x) for x, s in _slot_specs(spec, layout(spec))]
 
 
 PARTS = (Part("end_cap_mold_base", Kind.PRINTED, flag="end_cap_mold", make=mold_base, order=60, colour="#e0c090",

@@ -106,7 +106,7 @@ def plate_dowel_positions_mm(spec) -> list[tuple[float, float]]:
 
 
 def cap_flange_diameter_mm(spec) -> float:
-    """Diameter of the end cap's base flange, which the locator guide surrounds (mm)."""
+    """Diameter of the end cap's base flange, which the locator guide surrounds (mm); ``spec`` may be a Taxel."""
     return spec.end_cap.outer_diameter + 2 * spec.end_cap.flange_width
 
 
@@ -139,17 +139,19 @@ def needle_axis_mm(spec) -> tuple[tuple[float, float, float], tuple[float, float
     the plane of the plate's underside (the neck's mouth) at (−d/2 − y, 0, 0): ``needle.y`` is the distance,
     measured in that plane, from that point to the nearest edge of the neck opening (−d/2, 0, 0) — the
     paper's "distance between air supply and nearest edge of cavity opening" (Fig. 2).
-    Returns (point on the mouth plane, unit direction).
+    Returns (point on the mouth plane, unit direction). ``spec`` may be a Spec or a
+    :class:`matcad.taxel.Taxel`: a taxel's axis is moved to its neck at (taxel.x, taxel.y).
     """
     import math
 
     t = math.radians(spec.needle.theta_deg)
-    return (-spec.neck.diameter / 2 - spec.needle.y, 0.0, 0.0), (math.cos(t), 0.0, math.sin(t))
+    x0, y0 = getattr(spec, "x", 0.0), getattr(spec, "y", 0.0)
+    return (x0 - spec.neck.diameter / 2 - spec.needle.y, y0, 0.0), (math.cos(t), 0.0, math.sin(t))
 
 
 def needle_tip_mm(spec) -> tuple[float, float, float]:
     """Centre of the needle's end face: back along the axis until the face's highest point sits
-    ``needle.tip_clearance`` below the plate underside (mm)."""
+    ``needle.tip_clearance`` below the plate underside (mm). ``spec``: a Spec or a Taxel (at its position)."""
     import math
 
     (px, py, pz), (ux, uy, uz) = needle_axis_mm(spec)

@@ -15,22 +15,29 @@ BODY_CLEARANCE_MM = 0.2
 ROLES = ("locator", "clamp")
 
 
-def guide(spec, role: str) -> Flat:
-    """Guide layer ``role`` ('locator' or 'clamp'): same outline and stack holes as the neck plate (mm)."""
+def cap_holes(board, role: str) -> tuple[Hole, ...]:
+    """Guide layer ``role``'s hole for every taxel's cap, at the taxel's position: the locator around its flange
+    (:func:`cap_flange_diameter_mm`), the clamp around its body (outer diameter +
+    :data:`BODY_CLEARANCE_MM`) (mm)."""
     if role == "locator":
-        cap_hole = Hole(0.0, 0.0, cap_flange_diameter_mm(spec), "cap")
-    elif role == "clamp":
-        cap_hole = Hole(0.0, 0.0, spec.end_cap.outer_diameter + BODY_CLEARANCE_MM, "cap")
-    else:
-        raise ValueError(f"role {role!r} invalid, must be one of {ROLES}")
-    holes = (cap_hole, *laser_stack_holes(spec))
+        return tuple(Hole(t.x, t.y, cap_flange_diameter_mm(t), "cap") for t in board)
+    if role == "clamp":
+        return tuple(Hole(t.x, t.y, t.end_cap.outer_diameter + BODY_CLEARANCE_MM, "cap") for t in board)
+    raise ValueError(f"role {role!r} invalid, must be one of {ROLES}")
+
+
+def guide(spec, role: str) -> Flat:
+    """Guide layer ``role`` ('locator' or 'clamp'): same outline and stack holes as the neck plate, one cap hole
+    per taxel (mm)."""
+    from matcad.taxel import taxels
+
+    holes = (*cap_holes(taxels(spec), role), *laser_stack_holes(spec))
     return Flat(name=f"guide_{role}", thickness=spec.guide.thickness,
                 thickness_measured=spec.guide.thickness_measured, kerf=sheet_kerf_mm(spec, "guide"),
                 width=spec.plate.width,
                 depth=spec.plate.depth, holes=holes,
                 engrave=edge_label(f"{role.upper()} {spec.guide.thickness:g}", spec.plate.width, spec.plate.depth,
                                    holes))
-
 
 PARTS = (Part("guide_locator", Kind.LASER, flag="guides", make=functools.partial(guide, role="locator"), order=20,
               colour="#c4e0fa", sheet="guide", label="locator guide"),

@@ -46,6 +46,7 @@ class MoldLayout:
     """Where things are in the mold frame (mm)."""
 
     cap_x: tuple[float, ...]
+    slots: tuple  # the taxel whose cap each position casts (:func:`mold_slots`)
     block_x: float
     block_y: float
     keys: tuple[tuple[float, float], ...]
@@ -54,7 +55,12 @@ class MoldLayout:
     vents: tuple[tuple[float, float], ...]  # ring vents over the base face
     pin_vents: tuple[tuple[float, float], ...]  # one along each core pin's axis
     base_height: float
-    plan: VentPlan
+    plans: tuple[VentPlan, ...]  # per slot
+
+    @property
+    def plan(self) -> VentPlan:
+        """The slot whose base face vents worst (every slot's, for a mold of identical caps)."""
+        return max(self.plans, key=lambda p: (not p.feasible, p.reach_base_mm, p.reach_tip_mm))
 
 
 def fill_radius_mm(spec) -> float:
@@ -132,25 +138,78 @@ def _plan(cavity_d: float, outer_d: float, flange_d: float, tip_r: float, fill_p
     return best
 
 
+def cap_groups(board) -> list[list]:
+    """The taxels of ``board`` grouped by identical cap (cavity and end cap), in order of first appearance."""
+    groups: dict[tuple, list] = {}
+    for t in board:
+        groups.setdefault((t.cavity, t.end_cap), []).append(t)
+    return list(groups.values())
+
+
+def mold_slots(board, count: int) -> tuple:
+    """The taxel whose cap each of a mold's ``count`` positions casts: the board's caps taken in turn, group by
+    group (a mold of ``count`` >= the board's taxels casts a whole board per pour, spares of the first caps
+    after it), then ordered so identical caps sit side by side."""
+    groups = cap_groups(board)
+    order = [t for g in groups for t in g]
+    slots = [order[i % len(order)] for i in range(count)]
+    rank = {id(g[0]): i for i, g in enumerate(groups)}
+    first = {id(t): id(g[0]) for g in groups for t in g}
+    return tuple(sorted(slots, key=lambda t: rank[first[id(t)]]))
+
+
+def pours_per_board(board, count: int) -> dict:
+    """How many pours of one mold (or how many molds poured at once) cast one cap for every taxel of ``board``:
+    per cap group, its taxels over the slots it has; 0 slots means the mold cannot cast that cap at all."""
+    slots = mold_slots(board, count)
+    rows = []
+    for g in cap_groups(board):
+        have = sum(1 for s in slots if (s.cavity, s.end_cap) == (g[0].cavity, g[0].end_cap))
+        rows.append({"taxels": [t.name for t in g], "slots_per_mold": have,
+                     "pours": -(-len(g) // have) if have else None})
+    pours = [r["pours"] for r in rows]
+    return {"caps_per_mold": count, "groups": rows,
+            "molds_per_board": None if None in pours else max(pours)}
+
+
+def cap_x_mm(flanges: list[float], wall: float) -> tuple[float, ...]:
+    """Centres along x of caps with these flange diameters in a row, ``wall`` apart, centred on 0 (mm)."""
+    n = len(flanges)
+    if len(set(flanges)) == 1:  # identical caps: an even pitch (the single-taxel layout, bit for bit)
+        pitch = flanges[0] + wall
+        return tuple((i - (n - 1) / 2) * pitch for i in range(n))
+    x = [-(sum(flanges) + (n - 1) * wall) / 2 + flanges[0] / 2]
+    for a, b in zip(flanges, flanges[1:]):
+        x.append(x[-1] + (a + b) / 2 + wall)
+    return tuple(x)
+
+
 def layout(spec) -> MoldLayout:
-    """Positions of caps, keys, bolts, fill ports and vents in the mold frame (mm)."""
+    """Positions of caps, keys, bolts, fill ports and vents in the mold frame (mm): ``mold.count`` caps of the
+    board (:func:`mold_slots`) in a row, each slot with its own flange, fill radius and vent plan."""
+    from matcad.taxel import taxel_spec, taxels
+
     m = spec.mold
-    flange_d = cap_flange_diameter_mm(spec)
-    pitch = flange_d + m.wall
-    cap_x = tuple((i - (m.count - 1) / 2) * pitch for i in range(m.count))
+    slots = mold_slots(taxels(spec), m.count)
+    specs = [taxel_spec(spec, t) for t in slots]
+    flanges = [cap_flange_diameter_mm(s) for s in specs]
+    cap_x = cap_x_mm(flanges, m.wall)
     feature = max(m.key_diameter + 2 * spec.machine.key_clearance, bolt_clearance_mm(m.bolt, "normal"))
     end_zone = feature + m.wall
-    block_x = m.count * pitch + m.wall + 2 * end_zone
-    block_y = max(flange_d + 2 * m.wall, 2 * feature + 3 * m.wall)
+    if len(set(flanges)) == 1:
+        block_x = m.count * (flanges[0] + m.wall) + m.wall + 2 * end_zone
+    else:
+        block_x = sum(flanges) + (m.count + 1) * m.wall + 2 * end_zone
+    block_y = max(max(flanges) + 2 * m.wall, 2 * feature + 3 * m.wall)
     xe = block_x / 2 - end_zone / 2
     ye = block_y / 4
-    plan = plan_vents(spec)
+    plans = tuple(plan_vents(s) for s in specs)
 
     def at(x, r, a):
         return (x + r * math.cos(math.radians(a)), r * math.sin(math.radians(a)))
 
-    fill = tuple(at(x, fill_radius_mm(spec), 0.0) for x in cap_x)
-    vents = tuple(at(x, r, a) for x in cap_x for r, a in plan.inner + plan.outer)
-    return MoldLayout(cap_x, block_x, block_y, keys=((xe, ye), (-xe, -ye)), bolts=((xe, -ye), (-xe, ye)),
+    fill = tuple(at(x, fill_radius_mm(s), 0.0) for x, s in zip(cap_x, specs))
+    vents = tuple(at(x, r, a) for x, p in zip(cap_x, plans) for r, a in p.inner + p.outer)
+    return MoldLayout(cap_x, slots, block_x, block_y, keys=((xe, ye), (-xe, -ye)), bolts=((xe, -ye), (-xe, ye)),
                       fill_ports=fill, vents=vents, pin_vents=tuple((x, 0.0) for x in cap_x),
-                      base_height=cap_height_mm(spec) + m.floor, plan=plan)
+                      base_height=max(cap_height_mm(s) for s in specs) + m.floor, plans=plans)

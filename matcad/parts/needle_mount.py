@@ -18,24 +18,38 @@ def needle_bore_diameter_mm(spec) -> float:
     return pin_hole_diameter_mm(spec.needle.outer_diameter, spec.machine.printer, spec.needle.fit)
 
 
-def _on_needle_axis(spec, start, radius: float, length: float):
-    """Cylinder of ``radius`` on the needle axis, from point ``start`` on it back ``length`` mm (mm)."""
+def _on_needle_axis(taxel, start, radius: float, length: float):
+    """Cylinder of ``radius`` on ``taxel``'s needle axis, from point ``start`` on it back ``length`` mm (mm)."""
     from matcad.parts.solid import tilted_cylinder
 
-    return tilted_cylinder(radius, length, start, spec.needle.theta_deg)
+    return tilted_cylinder(radius, length, start, taxel.needle.theta_deg)
+
+
+def taxel_needle(taxel):
+    """One taxel's needle, ``needle.length`` long, ending at its tip under the taxel's neck (mm)."""
+    return _on_needle_axis(taxel, needle_tip_mm(taxel), taxel.needle.outer_diameter / 2, taxel.needle.length)
 
 
 def needle(spec):
-    """The needle itself, ``needle.length`` long, ending at its tip (for collision checks and assembly)."""
-    return _on_needle_axis(spec, needle_tip_mm(spec), spec.needle.outer_diameter / 2, spec.needle.length)
+    """The needle of a single-taxel spec (for collision checks and assembly), at the plate centre (mm)."""
+    return taxel_needle(spec)
+
+
+def needle_bore(taxel, bore_diameter: float, reach: float):
+    """The bore for ``taxel``'s needle: ``bore_diameter`` wide, along its axis from the plate-underside plane back
+    ``reach`` mm, so wherever the tip stands the jet's path to its neck is open (mm)."""
+    mouth_point, _ = needle_axis_mm(taxel)
+    return _on_needle_axis(taxel, mouth_point, bore_diameter / 2, reach)
 
 
 def needle_mount(spec):
     """The mount solid in the assembly frame (mm): block, fixing ears, standoffs (if printed), bolt pilots,
-    dowel holes, the needle bore."""
+    dowel holes, one needle bore per taxel (at its θ and y, aimed at its own neck). No manifold: each needle
+    takes its own air line."""
     from build123d import Box, Pos
 
     from matcad.parts.solid import BOTTOM, TOP, cylinder_up
+    from matcad.taxel import taxels
 
     gap, thick = spec.spacer.height, spec.mount.thickness
     top = -gap
@@ -49,18 +63,18 @@ def needle_mount(spec):
     pilot = SELF_TAP_PILOT_MM[spec.fasteners.bolt] / 2
     dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
                                  spec.fasteners.dowel_fit_printed) / 2
-    # the bore runs along the whole axis, from the plate-underside plane back through the block: wherever
-    # the tip stands, the jet's path to the neck is open
-    mouth_point, _ = needle_axis_mm(spec)
-    reach = (thick + gap + spec.plate.width + spec.plate.depth) / max(math.sin(math.radians(
-        spec.needle.theta_deg)), 1e-3)
+    bores = []
+    for t in taxels(spec):
+        reach = (thick + gap + spec.plate.width + spec.plate.depth) / max(math.sin(math.radians(
+            t.needle.theta_deg)), 1e-3)
+        bore = pin_hole_diameter_mm(t.needle.outer_diameter, spec.machine.printer, t.needle.fit)
+        bores.append(needle_bore(t, bore, reach))
     holes = ([cylinder_up(pilot, thick + gap, x, y, top - thick) for x, y in plate_bolt_positions_mm(spec)]
              + [cylinder_up(dowel, thick, x, y, top - thick) for x, y in plate_dowel_positions_mm(spec)]
-             + [_on_needle_axis(spec, mouth_point, needle_bore_diameter_mm(spec) / 2, reach)]
+             + bores
              + [cylinder_up(bolt_clearance_mm(FIXING_BOLT, "normal") / 2, EAR_THICKNESS_MM, x, y, top - thick)
                 for x, y in ear_holes_mm(spec)])
     return body.cut(*holes)
-
 
 PARTS = (Part("needle_mount", Kind.PRINTED, flag="needle_mount", make=needle_mount, order=80, colour="#b4b4b4",
               pose=PrintPose(0.0, "flat underside; standoffs and the needle bore's mouth face up"),

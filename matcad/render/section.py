@@ -150,14 +150,13 @@ def _labels(spec, present: set[str], draw: _Drawing) -> None:
         draw.text(x_text, z_text, names[name], anchor="end")
 
 
-def annotate_section(spec, path: Path) -> None:
+def annotate_section(spec, path: Path, dimensions: bool = True) -> None:
     """Add part labels and the design's dimensions (mm) to the section SVG at ``path``, growing its canvas; each
     layer's paths are put in a fixed order so the same spec always gives the same bytes."""
     ET.register_namespace("", SVG_NS)
     tree = ET.parse(path)
     root = tree.getroot()
-    present = {g.get("id").rsplit("_", 1)[0] if g.get("id", "").startswith("spacer_") else g.get("id")
-               for g in root.iter(f"{{{SVG_NS}}}g") if g.get("id")}
+    present = {g.get("id") for g in root.iter(f"{{{SVG_NS}}}g") if g.get("id")}
     for g in root.iter(f"{{{SVG_NS}}}g"):  # the kernel's path order varies run to run; one layer's order is moot
         paths = [el for el in g if el.tag == f"{{{SVG_NS}}}path"]
         for el in paths:
@@ -166,7 +165,8 @@ def annotate_section(spec, path: Path) -> None:
     x, y, w, h = (float(v) for v in root.get("viewBox").split())
     draw = _Drawing(font=max(0.5, 0.03 * max(w, h)))
     draw.box = [x, y, x + w, y + h]
-    _dimensions(spec, draw)
+    if dimensions:
+        _dimensions(spec, draw)
     _labels(spec, present, draw)
     draw.text(0.0, -draw.box[3] - 1.2 * draw.font, "section through the neck and needle axes; mm")
     group = ET.SubElement(root, f"{{{SVG_NS}}}g", {"id": "dimensions"})
