@@ -826,7 +826,7 @@ def _parser() -> argparse.ArgumentParser:
     i = command("init", cmd_init, "start a new spec from a shipped template (never overwrites)")
     i.add_argument("name", help="design name (also the file name NAME.toml and the build folder out/NAME)")
     i.add_argument("--from", dest="template", default="mat-paper",
-                   help="template: mat-paper (default), mat-laser-only, mat-sla-array")
+                   help="template: mat-paper (default), mat-laser-only, mat-sla-array, mat-array-4")
     i.add_argument("--out", type=Path, help="spec file to write (default NAME.toml)")
 
     sh = sub.add_parser("completion", help="print a shell completion script (bash; zsh via bashcompinit)")

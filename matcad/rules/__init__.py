@@ -30,15 +30,21 @@ def check(spec, prediction=None) -> list[Finding]:
     """Run every rule on ``spec``; ``prediction`` (from acoustics.predict, of a single-taxel spec) is computed when
     not given; a board's acoustic rules run on each taxel's own prediction."""
     from matcad.acoustics.predict import predict
-    from matcad.rules import acoustic, bands, laser, printing, stack
+    from matcad.rules import acoustic, bands, board as board_rules, laser, printing, stack
 
     from matcad.taxel import taxel_spec, taxels
 
-    findings: list[Finding] = []
-    for module in (laser, printing, stack, bands):
-        for rule in module.RULES:
-            findings += rule(spec)
     board = taxels(spec)
+    findings: list[Finding] = []
+    per_taxel = [rule for module in (printing, stack) for rule in module.TAXEL_RULES] if len(board) > 1 else []
+    for module in (laser, printing, stack, bands, board_rules):
+        for rule in module.RULES:
+            if rule not in per_taxel:
+                findings += rule(spec)
+    for taxel in board if per_taxel else ():  # a board's one-taxel geometry rules, on each taxel's own geometry
+        one = taxel_spec(spec, taxel)
+        for rule in per_taxel:
+            findings += [replace(f, message=f"{taxel.name}: {f.message}") for f in rule(one)]
     for taxel in board:  # the sound rules per taxel, on its own prediction; a board's messages name the taxel
         one = taxel_spec(spec, taxel)
         p = (prediction or predict(one)) if len(board) == 1 else predict(one)

@@ -136,3 +136,5 @@ def sla_inhibition(spec) -> list[Finding]:
 
 
 RULES = (printable_walls, key_clearance, fill_and_vents, cap_wall, silicone_batch, sla_inhibition, bore_overhang)
+TAXEL_RULES = (fill_and_vents, cap_wall, bore_overhang)
+"""The rules that read one taxel's own geometry: a board runs them on each taxel (:func:`matcad.rules.check`)."""

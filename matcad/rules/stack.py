@@ -32,21 +32,27 @@ def needle_clearance(spec) -> list[Finding]:
 
 
 def needle_bore(spec) -> list[Finding]:
-    """The needle axis must pass through the mount block, or the printed mount has no bore and holds no
-    needle (θ near 0, or |y| beyond the block). The axis meets the block's top face (z = −spacer.height) at
-    x_top and its underside at x_bot; the block spans |x| <= plate.width/2 (mm)."""
+    """Every needle axis must pass through the mount block, or the printed mount has no bore and holds that
+    needle (θ near 0, or |y| beyond the block). A taxel's axis meets the block's top face (z = −spacer.height) at
+    x_top and its underside at x_bot; the block spans |x| <= plate.width/2 and |y| <= plate.depth/2 (mm)."""
     from matcad.parts.features import needle_axis_mm
+    from matcad.taxel import taxels
 
-    (px, _, _), (ux, _, uz) = needle_axis_mm(spec)
+    board = taxels(spec)
     gap, thick, half = spec.spacer.height, spec.mount.thickness, spec.plate.width / 2
-    run = ux / uz if uz > 0 else float("inf")  # x travelled per mm of descent along the axis
-    x_top, x_bot = px - gap * run, px - (gap + thick) * run
-    if uz > 0 and x_bot <= half and x_top >= -half:
-        return []
-    return [Finding("needle.bore", "error", [spec.needle.theta_deg, spec.needle.y], f"axis through |x| <= {half:g} mm",
-                    f"the needle axis (theta = {spec.needle.theta_deg:g} deg, y = {spec.needle.y:g} mm) misses "
-                    "the mount block: the mount would have no bore and hold no needle",
-                    "raise needle.theta_deg or bring needle.y within the plate")]
+    out = []
+    for t in board:
+        (px, py, _), (ux, _, uz) = needle_axis_mm(t if len(board) > 1 else spec)
+        run = ux / uz if uz > 0 else float("inf")  # x travelled per mm of descent along the axis
+        x_top, x_bot = px - gap * run, px - (gap + thick) * run
+        if uz > 0 and x_bot <= half and x_top >= -half and abs(py) <= spec.plate.depth / 2:
+            continue
+        who = f"{t.name}: " if len(board) > 1 else ""
+        out.append(Finding("needle.bore", "error", [t.needle.theta_deg, t.needle.y], f"axis through |x| <= {half:g} mm",
+                           f"{who}the needle axis (theta = {t.needle.theta_deg:g} deg, y = {t.needle.y:g} mm) misses "
+                           "the mount block: the mount would have no bore and hold no needle",
+                           "raise needle.theta_deg or bring needle.y within the plate"))
+    return out
 
 
 def needle_window(spec) -> list[Finding]:
@@ -105,3 +111,5 @@ def printed_fits(spec) -> list[Finding]:
 
 
 RULES = (needle_clearance, needle_bore, needle_window, seal_squeeze, printed_fits)
+TAXEL_RULES = (needle_clearance, needle_window, seal_squeeze)
+"""The rules that read one taxel's own geometry: a board runs them on each taxel (:func:`matcad.rules.check`)."""

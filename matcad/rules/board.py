@@ -1,0 +1,184 @@
+"""Rules for a board of taxels on one neck plate: every cap on the plate, neighbours apart, each needle's jet
+clear of its neighbours' necks, the plate's ligaments. Lengths in mm.
+
+A single taxel has no neighbours: these rules return nothing for it, so its findings are those of the per-part
+rules alone (laser webs, stack, printing), as before boards existed. Sources and limits: docs/arrays.md.
+"""
+
+from __future__ import annotations
+
+import math
+
+from matcad.parts.features import (bolt_clearance_mm, cap_flange_diameter_mm, needle_axis_mm, needle_tip_mm,
+                                   pin_hole_diameter_mm, plate_bolt_positions_mm, plate_dowel_positions_mm)
+from matcad.rules import Finding
+
+JET_HALF_ANGLE_DEG = 12.0
+"""Opening half-angle of the needle's free jet, to where its speed falls to ~10 % of the centre line's. A round
+turbulent jet's half-speed radius grows as r½ = S x with S ≈ 0.094-0.10 (Pope, *Turbulent Flows*, 2000, Table 5.1;
+Hussein, Capp & George 1994); with its near-Gaussian profile the 10 % edge lies at 1.82 r½, so tan α ≈ 0.17-0.18
+(α ≈ 10°). We take 12° for margin: the needle's laminar exit at these flows spreads less, not more."""
+LIGAMENT_PER_SHEET = 1.0
+"""Least acrylic between two holes of the neck plate, in sheet thicknesses: the sheet-cutting rule of thumb of
+about one material thickness between cut features (laser and sheet-cutting design guides, e.g. Xometry's
+"Distance Between Features"). Below it a bolted or drilled cast-acrylic plate may crack between the holes; it is
+a rule of thumb, not a measured strength, so its finding is a warning."""
+JET_SAMPLES = 72
+"""Points around each neighbour's neck mouth tested against the jet."""
+
+
+def _board(spec):
+    from matcad.taxel import taxels
+
+    board = taxels(spec)
+    return board if len(board) > 1 else ()
+
+
+def _position_fields(spec) -> str:
+    return "the [[taxel]] x, y" if spec.taxel else "array.pitch_x, array.pitch_y"
+
+
+def _stack_holes(spec) -> list[tuple[str, float, float, float]]:
+    """(what, x, y, diameter) of the plate's bolt and dowel holes (mm)."""
+    bolt = bolt_clearance_mm(spec.fasteners.bolt, spec.fasteners.bolt_fit)
+    dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, "laser", spec.fasteners.dowel_fit_laser)
+    return ([("bolt", x, y, bolt) for x, y in plate_bolt_positions_mm(spec)]
+            + [("dowel", x, y, dowel) for x, y in plate_dowel_positions_mm(spec)])
+
+
+def plate_fit(spec) -> list[Finding]:
+    """Every cap's flange (the locator's hole) inside the plate outline and clear of every bolt and dowel hole:
+    an error per taxel and problem, naming plate.width / plate.depth / plate.bolt_inset and the taxel's position."""
+    out = []
+    w, d = spec.plate.width, spec.plate.depth
+    holes = _stack_holes(spec)
+    for t in _board(spec):
+        r = cap_flange_diameter_mm(t) / 2
+        edge = min(w / 2 - abs(t.x), d / 2 - abs(t.y)) - r
+        if edge < 0:
+            out.append(Finding("board.outside", "error", round(edge, 4), ">= 0",
+                               f"{t.name} at ({t.x:g}, {t.y:g}): its cap flange (Ø{2 * r:g}) reaches {-edge:.2f} mm "
+                               f"past the {w:g} x {d:g} mm plate",
+                               f"enlarge plate.width / plate.depth or move {t.name} in ({_position_fields(spec)})"))
+        for what, x, y, size in holes:
+            gap = math.hypot(t.x - x, t.y - y) - r - size / 2
+            if gap < 0:
+                out.append(Finding("board.on_fastener", "error", round(gap, 4), ">= 0",
+                                   f"{t.name}'s cap flange overlaps the {what} hole at ({x:.2f}, {y:.2f}) by "
+                                   f"{-gap:.2f} mm: the locator guide would have no wall between them",
+                                   "enlarge plate.width / plate.depth (the bolts sit plate.bolt_inset from the "
+                                   f"corners) or move {t.name} ({_position_fields(spec)})"))
+    return out
+
+
+def spacing(spec) -> list[Finding]:
+    """Neighbouring caps apart: the locator guide's web between two flanges (and so the clamp's between two
+    bodies) at least ``machine.laser_min_feature``; overlapping flanges are an error. The mold needs no check
+    here: it lays its caps ``mold.wall`` apart whatever the plate does (print.wall checks that wall)."""
+    out = []
+    limit = spec.machine.laser_min_feature
+    board = _board(spec)
+    for i, a in enumerate(board):
+        for b in board[i + 1:]:
+            web = math.hypot(a.x - b.x, a.y - b.y) - (cap_flange_diameter_mm(a) + cap_flange_diameter_mm(b)) / 2
+            if web < limit:
+                out.append(Finding("board.spacing", "error" if web <= 0 else "warning", round(web, 4), limit,
+                                   f"{a.name} and {b.name}: the locator guide keeps {web:.2f} mm between their cap "
+                                   f"flanges (< machine.laser_min_feature = {limit:g} mm)",
+                                   f"move them apart ({_position_fields(spec)}) or narrow end_cap.flange_width"))
+    return out
+
+
+def jet_clearance_mm(jet, neck) -> tuple[float, str]:
+    """How far the neck mouth of taxel ``neck`` stays outside the jet of taxel ``jet``'s needle (negative: inside),
+    and where: the free jet, a cone of half-angle :data:`JET_HALF_ANGLE_DEG` from the needle's tip along its axis
+    up to the plate underside; then, past its own neck, the jet deflected along the plate in its axis' direction
+    (+x), still widening at that angle with the distance travelled (mm)."""
+    tip = needle_tip_mm(jet)
+    mouth, u = needle_axis_mm(jet)
+    spread = math.tan(math.radians(JET_HALF_ANGLE_DEG))
+    r0 = jet.needle.outer_diameter / 2
+    s_plate = sum((m - p) * c for m, p, c in zip(mouth, tip, u))
+    best, where = math.inf, ""
+    for k in range(JET_SAMPLES):
+        a = 2 * math.pi * k / JET_SAMPLES
+        q = (neck.x + neck.neck.diameter / 2 * math.cos(a), neck.y + neck.neck.diameter / 2 * math.sin(a), 0.0)
+        rel = [qi - ti for qi, ti in zip(q, tip)]
+        s = sum(r * c for r, c in zip(rel, u))
+        if 0 < s <= s_plate:
+            perp = math.sqrt(max(sum(r * r for r in rel) - s * s, 0.0))
+            gap = perp - (r0 + s * spread)
+            if gap < best:
+                best, where = gap, f"in the free jet {s:.1f} mm from the tip"
+        along = q[0] - mouth[0]
+        if along > 0:
+            gap = abs(q[1] - mouth[1]) - (r0 + (s_plate + along) * spread)
+            if gap < best:
+                best, where = gap, f"in the jet along the plate {along:.1f} mm past where it meets it"
+    return best, where
+
+
+def jet_interference(spec) -> list[Finding]:
+    """No needle's jet may reach another taxel's neck: inside the free jet (it blows straight across the
+    neighbour's mouth) is an error; inside the jet deflected along the plate is a warning (a wall jet decays with
+    distance, but it still sweeps that mouth and can make it sound or shift its tone). The caps sit above the plate,
+    out of the jet's way; only the necks open into it. Half-angle :data:`JET_HALF_ANGLE_DEG`."""
+    out = []
+    board = _board(spec)
+    for a in board:
+        for b in board:
+            if a is b:
+                continue
+            gap, where = jet_clearance_mm(a, b)
+            if gap < 0:
+                free = where.startswith("in the free")
+                out.append(Finding("board.jet", "error" if free else "warning", round(gap, 3), ">= 0",
+                                   f"{a.name}'s needle jet (±{JET_HALF_ANGLE_DEG:g}°) covers {b.name}'s neck "
+                                   f"mouth by {-gap:.2f} mm, {where}",
+                                   f"offset {b.name} in y from {a.name} (the jets blow toward +x), or move them "
+                                   f"apart ({_position_fields(spec)})"))
+    return out
+
+
+def plate_ligaments(spec) -> list[Finding]:
+    """Acrylic between two neck holes, and between a neck and a bolt or dowel hole, at least
+    :data:`LIGAMENT_PER_SHEET` plate sheets (neck.length): a warning per pair, with the ligament and the limit.
+    The plate's bending under mechanics.max_force_n is not checked: the plate rests on four corner spacers with
+    the caps pressed between them and holes in it; no closed form for that case is carried here."""
+    out = []
+    board = _board(spec)
+    limit = LIGAMENT_PER_SHEET * spec.neck.length
+    pairs = [(a.name, b.name, math.hypot(a.x - b.x, a.y - b.y) - (a.neck.diameter + b.neck.diameter) / 2)
+             for i, a in enumerate(board) for b in board[i + 1:]]
+    pairs += [(t.name, f"{what} hole at ({x:.2f}, {y:.2f})", math.hypot(t.x - x, t.y - y) - (t.neck.diameter + size) / 2)
+              for t in board for what, x, y, size in _stack_holes(spec)]
+    for a, b, web in pairs:
+        if web < limit:
+            out.append(Finding("board.ligament", "warning", round(web, 4), round(limit, 4),
+                               f"neck plate: {web:.2f} mm of acrylic between {a}'s neck and {b} (< {limit:g} mm, "
+                               f"{LIGAMENT_PER_SHEET:g} x the {spec.neck.length:g} mm sheet)",
+                               f"move the taxels apart ({_position_fields(spec)}) or enlarge plate.width / "
+                               "plate.depth"))
+    return out
+
+
+def mold_slots(spec) -> list[Finding]:
+    """The cap mold (``mold.count`` caps per mold) must hold every distinct cap of the board, or some taxel's cap
+    is never cast: an error naming mold.count; an info line with how many pours (or molds) one board takes."""
+    from matcad.parts.mold_layout import pours_per_board
+
+    board = _board(spec)
+    if not board or not spec.outputs.end_cap_mold:
+        return []
+    molds = pours_per_board(board, spec.mold.count)
+    missing = [name for g in molds["groups"] if not g["slots_per_mold"] for name in g["taxels"]]
+    if missing:
+        return [Finding("board.mold", "error", spec.mold.count, len(molds["groups"]),
+                        f"mold.count = {spec.mold.count} caps per mold holds fewer positions than the board's "
+                        f"{len(molds['groups'])} different caps: no mold casts {', '.join(missing)}",
+                        f"set mold.count >= {len(molds['groups'])}")]
+    return [Finding("board.mold", "info", molds["molds_per_board"], "", f"one mold holds {spec.mold.count} caps: "
+                    f"{molds['molds_per_board']} pour(s) (or molds poured at once) cast one cap for every taxel")]
+
+
+RULES = (plate_fit, spacing, jet_interference, plate_ligaments, mold_slots)
