@@ -9,6 +9,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
 PAPER = ROOT / "templates" / "mat-paper.toml"
+BOARD_TEMPLATES = [p for p in TEMPLATES if "[[taxel]]" in p.read_text(encoding="utf-8") or "[array]" in p.read_text(
+    encoding="utf-8")]
+SINGLE_TEMPLATES = [p for p in TEMPLATES if p not in BOARD_TEMPLATES]
+"""Templates of one taxel at the plate centre: the tests that measure that taxel's parts in place run on these;
+a board's parts are measured in tests/test_board.py."""
 
 MINIMAL = """name = "t"
 [cavity]

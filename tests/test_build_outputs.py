@@ -16,8 +16,11 @@ from matcad.export.dxf_svg import LAYERS
 from matcad.output import MANIFEST
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.features import cap_volume_mm3
+from matcad.parts.mold_layout import cap_groups
+from matcad.taxel import taxel_spec, taxels
 from matcad.report import KIT_ARCHIVE, REPORT_FILES
 from tests.conftest import TEMPLATES
+from tests.readback import expected_bodies
 
 
 @pytest.fixture(scope="module", params=TEMPLATES, ids=lambda p: p.stem)
@@ -83,10 +86,12 @@ def test_dxf_units_layers_holes_outlines(built):
 def test_neck_hole_is_spec_minus_kerf(built):
     spec, out, _ = built
     doc = ezdxf.readfile(out / "neck_plate.dxf")
-    neck = [c for c in doc.modelspace().query("CIRCLE") if abs(c.dxf.center.x) < 1e-9 and abs(c.dxf.center.y) < 1e-9]
-    cut = spec.neck.diameter - (spec.plate.pilot_undersize if spec.plate.neck_pilot else 0.0)
     kerf = spec.plate.laser_kerf if spec.plate.laser_kerf is not None else spec.machine.laser_kerf
-    assert len(neck) == 1 and 2 * neck[0].dxf.radius == pytest.approx(cut - kerf, abs=1e-6)
+    for t in taxels(spec):  # every taxel's neck at its position (the DXF's origin is the plate centre)
+        neck = [c for c in doc.modelspace().query("CIRCLE") if abs(c.dxf.center.x - t.x) < 1e-9
+                and abs(c.dxf.center.y - t.y) < 1e-9]
+        cut = t.neck.diameter - (spec.plate.pilot_undersize if spec.plate.neck_pilot else 0.0)
+        assert len(neck) == 1 and 2 * neck[0].dxf.radius == pytest.approx(cut - kerf, abs=1e-6)
 
 
 def test_svg_mm_size_viewbox_and_colours(built):
@@ -113,7 +118,7 @@ def test_stl_watertight_one_body_volume_matches_brep(built):
     for name in stls:
         mesh = trimesh.load_mesh(out / name)
         assert mesh.is_watertight and mesh.is_volume
-        assert len(mesh.split(only_watertight=False)) == 1
+        assert len(mesh.split(only_watertight=False)) == expected_bodies(spec, name)
         assert mesh.volume == pytest.approx(meshes[name]["brep_volume_mm3"], rel=1e-3)
 
 
@@ -122,8 +127,9 @@ def test_cap_volume_against_analytic(built):
     if not spec.outputs.end_cap_mold:
         assert not (out / "end_cap.stl").exists()
         return
-    mesh = trimesh.load_mesh(out / "end_cap.stl")
-    assert mesh.volume == pytest.approx(cap_volume_mm3(spec), rel=5e-3)
+    mesh = trimesh.load_mesh(out / "end_cap.stl")  # a board's distinct caps side by side
+    caps = [taxel_spec(spec, group[0]) for group in cap_groups(taxels(spec))]
+    assert mesh.volume == pytest.approx(sum(cap_volume_mm3(c) for c in caps), rel=5e-3)
 
 
 def test_only_asked_outputs_written(built):

@@ -11,10 +11,10 @@ import trimesh
 from matcad import spec as spec_mod
 from matcad.build import build
 from matcad.parts.features import cap_flange_thickness_mm, plate_bolt_positions_mm
-from tests.conftest import TEMPLATES
+from tests.conftest import SINGLE_TEMPLATES
 from tests.readback import nearest_circle, section_circles
 
-KIT_TEMPLATES = [p for p in TEMPLATES if spec_mod.load(p).outputs.needle_mount]
+KIT_TEMPLATES = [p for p in SINGLE_TEMPLATES if spec_mod.load(p).outputs.needle_mount]
 
 
 @pytest.fixture(scope="module", params=KIT_TEMPLATES, ids=lambda p: p.stem)

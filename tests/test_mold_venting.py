@@ -13,9 +13,9 @@ from scipy.spatial import cKDTree
 from matcad import spec as spec_mod
 from matcad.build import build
 from matcad.parts.mold_layout import CEILING_TILT_DEG
-from tests.conftest import TEMPLATES
+from tests.conftest import SINGLE_TEMPLATES
 
-MOLD_TEMPLATES = [p for p in TEMPLATES if spec_mod.load(p).outputs.end_cap_mold]
+MOLD_TEMPLATES = [p for p in SINGLE_TEMPLATES if spec_mod.load(p).outputs.end_cap_mold]
 SAMPLE_MM = 0.08
 
 

@@ -15,9 +15,9 @@ from matcad.parts.features import cap_volume_mm3
 from matcad.parts.neck_plate import neck_plate
 from matcad.parts.needle_mount import needle, needle_bore_diameter_mm, needle_mount
 from matcad.parts.solid import flat_solid
-from tests.conftest import TEMPLATES
+from tests.conftest import SINGLE_TEMPLATES
 
-SOLID_TEMPLATES = [p for p in TEMPLATES if spec_mod.load(p).outputs.needle_mount]
+SOLID_TEMPLATES = [p for p in SINGLE_TEMPLATES if spec_mod.load(p).outputs.needle_mount]
 
 
 def _overlap(a, b) -> float:

@@ -24,7 +24,8 @@ about one material thickness between cut features (laser and sheet-cutting desig
 "Distance Between Features"). Below it a bolted or drilled cast-acrylic plate may crack between the holes; it is
 a rule of thumb, not a measured strength, so its finding is a warning."""
 JET_SAMPLES = 72
-"""Points around each neighbour's neck mouth tested against the jet."""
+"""Points around each of three circles (centre, half radius, rim) of a neighbour's neck mouth tested against the
+jet."""
 
 
 def _board(spec):
@@ -89,50 +90,47 @@ def spacing(spec) -> list[Finding]:
     return out
 
 
-def jet_clearance_mm(jet, neck) -> tuple[float, str]:
+def jet_clearance_mm(jet, neck) -> tuple[float, float]:
     """How far the neck mouth of taxel ``neck`` stays outside the jet of taxel ``jet``'s needle (negative: inside),
-    and where: the free jet, a cone of half-angle :data:`JET_HALF_ANGLE_DEG` from the needle's tip along its axis
-    up to the plate underside; then, past its own neck, the jet deflected along the plate in its axis' direction
-    (+x), still widening at that angle with the distance travelled (mm)."""
+    as (free jet, jet along the plate): the free jet is a cone of half-angle :data:`JET_HALF_ANGLE_DEG` from the
+    needle's tip along its axis up to the plate underside; past there the jet runs along the plate in its axis'
+    direction (+x), still widening at that angle with the distance travelled (mm; inf where it never passes)."""
     tip = needle_tip_mm(jet)
     mouth, u = needle_axis_mm(jet)
     spread = math.tan(math.radians(JET_HALF_ANGLE_DEG))
     r0 = jet.needle.outer_diameter / 2
     s_plate = sum((m - p) * c for m, p, c in zip(mouth, tip, u))
-    best, where = math.inf, ""
-    for k in range(JET_SAMPLES):
-        a = 2 * math.pi * k / JET_SAMPLES
-        q = (neck.x + neck.neck.diameter / 2 * math.cos(a), neck.y + neck.neck.diameter / 2 * math.sin(a), 0.0)
+    free = wall = math.inf
+    disc = [(f * neck.neck.diameter / 2, 2 * math.pi * k / JET_SAMPLES) for f in (0.0, 0.5, 1.0)
+            for k in range(JET_SAMPLES)]  # the mouth is an opening: the jet may cross its middle, not its rim
+    for rho, a in disc:
+        q = (neck.x + rho * math.cos(a), neck.y + rho * math.sin(a), 0.0)
         rel = [qi - ti for qi, ti in zip(q, tip)]
         s = sum(r * c for r, c in zip(rel, u))
         if 0 < s <= s_plate:
-            perp = math.sqrt(max(sum(r * r for r in rel) - s * s, 0.0))
-            gap = perp - (r0 + s * spread)
-            if gap < best:
-                best, where = gap, f"in the free jet {s:.1f} mm from the tip"
+            free = min(free, math.sqrt(max(sum(r * r for r in rel) - s * s, 0.0)) - (r0 + s * spread))
         along = q[0] - mouth[0]
         if along > 0:
-            gap = abs(q[1] - mouth[1]) - (r0 + (s_plate + along) * spread)
-            if gap < best:
-                best, where = gap, f"in the jet along the plate {along:.1f} mm past where it meets it"
-    return best, where
+            wall = min(wall, abs(q[1] - mouth[1]) - (r0 + (s_plate + along) * spread))
+    return free, wall
 
 
 def jet_interference(spec) -> list[Finding]:
     """No needle's jet may reach another taxel's neck: inside the free jet (it blows straight across the
-    neighbour's mouth) is an error; inside the jet deflected along the plate is a warning (a wall jet decays with
-    distance, but it still sweeps that mouth and can make it sound or shift its tone). The caps sit above the plate,
-    out of the jet's way; only the necks open into it. Half-angle :data:`JET_HALF_ANGLE_DEG`."""
+    neighbour's mouth) is an error; inside the jet running along the plate is a warning (a wall jet decays with
+    distance, but it still sweeps that mouth and can make it sound or shift its tone). The caps sit above the
+    plate, out of the jet's way; only the necks open into it. Half-angle :data:`JET_HALF_ANGLE_DEG`."""
     out = []
     board = _board(spec)
     for a in board:
         for b in board:
             if a is b:
                 continue
-            gap, where = jet_clearance_mm(a, b)
-            if gap < 0:
-                free = where.startswith("in the free")
-                out.append(Finding("board.jet", "error" if free else "warning", round(gap, 3), ">= 0",
+            free, wall = jet_clearance_mm(a, b)
+            if free < 0 or wall < 0:
+                gap, level, where = ((free, "error", "in its free jet, between the needle's tip and the plate")
+                                     if free < 0 else (wall, "warning", "in the jet running along the plate"))
+                out.append(Finding("board.jet", level, round(gap, 3), ">= 0",
                                    f"{a.name}'s needle jet (±{JET_HALF_ANGLE_DEG:g}°) covers {b.name}'s neck "
                                    f"mouth by {-gap:.2f} mm, {where}",
                                    f"offset {b.name} in y from {a.name} (the jets blow toward +x), or move them "
