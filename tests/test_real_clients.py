@@ -20,7 +20,8 @@ from matcad.build import build, build_coupon
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.coupon import coupon_sheets, laser_coupon
 from matcad.parts.flat import cut_plan
-from tests.conftest import TEMPLATES
+from tests.conftest import SINGLE_TEMPLATES, TEMPLATES
+from tests.readback import expected_bodies
 
 TOOLS = ("admesh", "prusa-slicer", "librecad", "pdftoppm")
 REQUIRED = os.environ.get("MATCAD_REQUIRE_CLIENTS") == "1"
@@ -41,7 +42,7 @@ def builds(tmp_path_factory):
     for path in TEMPLATES:
         spec = spec_mod.load(path)
         out.append((spec, build(spec, root / spec.name).out_dir))
-    spec = spec_mod.load(TEMPLATES[0])
+    spec = spec_mod.load(SINGLE_TEMPLATES[0])
     out.append((None, build_coupon(spec, root / "coupon")[0]))
     return out
 
@@ -50,14 +51,21 @@ def _stls(builds):
     return [p for _, folder in builds for p in sorted(folder.glob("*.stl"))]
 
 
+def _bodies(builds) -> dict:
+    """STL path → bodies it should hold (a board's cap reference holds its distinct caps)."""
+    return {p: expected_bodies(spec, p.name) if spec is not None else 1
+            for spec, folder in builds for p in sorted(folder.glob("*.stl"))}
+
+
 def test_admesh_finds_nothing_to_repair(builds):
     need("admesh")
     stls = _stls(builds)
+    bodies = _bodies(builds)
     assert len(stls) >= 9
     for stl in stls:
         text = subprocess.run(["admesh", str(stl)], capture_output=True, text=True, check=True).stdout
         counts = {k.strip(): float(v) for k, v in re.findall(r"([A-Za-z][A-Za-z ]*?)\s*:\s*(-?[\d.]+)", text)}
-        assert counts["Number of parts"] == 1, stl.name
+        assert counts["Number of parts"] == bodies[stl], stl.name
         for key in ("Total disconnected facets", "Degenerate facets", "Edges fixed", "Facets removed", "Facets added", "Facets reversed",
                     "Backwards edges", "Normals fixed"):
             assert counts[key] == 0, (stl.name, key, counts[key])
@@ -149,7 +157,7 @@ def test_librecad_renders_every_dxf_at_one_to_one(builds, tmp_path):
     need("pdftoppm")
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
     checked = 0
-    coupon_spec = spec_mod.load(TEMPLATES[0])
+    coupon_spec = spec_mod.load(SINGLE_TEMPLATES[0])
     for spec, folder in builds:
         flats = laser_parts(spec) if spec is not None else [laser_coupon(coupon_spec, sheet)
                                                              for sheet in coupon_sheets(coupon_spec)]
