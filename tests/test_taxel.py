@@ -9,7 +9,8 @@ import pytest
 from matcad import spec as spec_mod
 from matcad.taxel import field_path, taxel_spec, taxels
 
-TEMPLATES = sorted(Path(__file__).parents[1].joinpath("templates").glob("*.toml"))
+from tests.conftest import SINGLE_TEMPLATES
+
 PAPER = Path(__file__).parents[1] / "templates" / "mat-paper.toml"
 
 
@@ -17,7 +18,7 @@ def _paper(**extra) -> dict:
     return tomllib.loads(PAPER.read_text()) | extra
 
 
-@pytest.mark.parametrize("path", TEMPLATES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", SINGLE_TEMPLATES, ids=lambda p: p.stem)
 def test_single_taxel_spec_is_one_taxel_at_the_centre(path):
     spec = spec_mod.load(path)
     (t,) = taxels(spec)
