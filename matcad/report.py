@@ -105,21 +105,24 @@ def casting(spec) -> dict | None:
 
 
 def needle_bom(spec) -> dict:
-    """The needle to buy and how deep it goes (mm)."""
-    from matcad.parts.features import nearest_needle_gauge, needle_tip_mm
-    from matcad.parts.features import needle_protrusion_mm
+    """The needle to buy and how deep it goes (mm); a board needs one per taxel, each on its own air line (the
+    mount offers no manifold), and its per-taxel needle rows sit in report.json's ``taxels``."""
+    from matcad.parts.features import nearest_needle_gauge, needle_protrusion_mm, needle_tip_mm
+    from matcad.taxel import taxels
 
     gauge, od = nearest_needle_gauge(spec.needle.outer_diameter)
     sin_t = math.sin(math.radians(spec.needle.theta_deg))
     through = (needle_tip_mm(spec)[2] + spec.spacer.height + spec.mount.thickness) / sin_t
-    from matcad.taxel import taxels
-
-    return {"count": len(taxels(spec)), "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
+    count = len(taxels(spec))
+    board = (f" A board takes {count} needles, one bore per taxel; the mount has no manifold: feed each needle "
+             "from its own regulated air line (or a splitter with a valve per line) so every jet can be set "
+             "alone" if count > 1 else "")
+    return {"count": count, "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
             "y_mm": spec.needle.y, "gauge": gauge, "gauge_od_mm": od, "hub": "Luer-lock hub, blunt (dispensing) tip",
             "min_length_mm": through + HUB_CLEARANCE_MM, "protrusion_mm": needle_protrusion_mm(spec),
             "note": f"nearest standard: {gauge} G ({od:.3f} mm, ISO 9626); measure yours and enter "
                     "needle.outer_diameter. Push it up the bore until its tip stands the stated protrusion out of "
-                    "the mount's top face (along the needle; a caliper depth rod), then fix the hub"}
+                    "the mount's top face (along the needle; a caliper depth rod), then fix the hub" + board}
 
 
 def kit_hardware(spec) -> dict:

@@ -183,7 +183,7 @@ def test_report_lists_every_taxel_and_its_needle(laser_build):
     report = json.loads((out / "report.json").read_text())
     rows = report["taxels"]
     assert [(r["name"], r["x_mm"], r["y_mm"]) for r in rows] == [(t.name, t.x, t.y) for t in taxels(spec)]
-    assert report["bom"]["needle"]["count"] == 4
+    assert report["bom"]["needle"]["count"] == 4 and "no manifold" in report["bom"]["needle"]["note"]
     f0 = [r["prediction"]["f0_hz"] for r in rows]
     assert f0 == sorted(f0) and all(b / a > 1.08 for a, b in zip(f0, f0[1:]))
 
