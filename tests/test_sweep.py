@@ -160,6 +160,25 @@ def test_local_processes_give_the_same_table():
     assert _table(sweep(data, axes, executor=Executor(2))) == _table(sweep(data, axes))
 
 
+def crash_on_index_3(tasks):
+    """A chunk function whose worker process dies on variant 3 (module level: spawned workers import it)."""
+    import os
+
+    if any(t["index"] == 3 for t in tasks):
+        os._exit(3)
+    return [{"index": t["index"], "status": "ok", "reason": ""} for t in tasks]
+
+
+@pytest.mark.slow
+def test_dead_worker_fails_its_variants_not_the_sweep():
+    from matcad.sweep.executor import run
+
+    results = run(crash_on_index_3, [{"index": i} for i in range(8)], Executor(2))
+    assert [r["index"] for r in results] == list(range(8))
+    assert results[3]["status"] == "failed" and "worker lost" in results[3]["reason"]
+    assert all(r["status"] in ("ok", "failed") for r in results)
+
+
 def test_unreachable_scheduler_is_bad_input(tmp_path):
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--scheduler", "tcp://127.0.0.1:9",
                            "--out", tmp_path / "s")

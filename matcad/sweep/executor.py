@@ -45,14 +45,15 @@ def run(fn_chunk, tasks: list[dict], executor: Executor) -> list[dict]:
         return []
     if executor.scheduler:
         return _dask(fn_chunk, tasks, executor.scheduler)
-    if executor.workers == 1:
+    workers = min(executor.workers, len(tasks))  # never more processes than variants
+    if workers == 1:
         return fn_chunk(tasks)
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     # spawn: workers start clean (no inherited threads or CAD-kernel state), the same on every platform
-    with ProcessPoolExecutor(executor.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        chunks = _chunks(tasks, executor.workers)
+    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        chunks = _chunks(tasks, workers)
         futures = [pool.submit(fn_chunk, c) for c in chunks]
         return _collect(chunks, futures)
 
