@@ -246,3 +246,17 @@ def test_needle_mount_has_one_bore_per_taxel_aimed_at_its_neck(solid_build):
         assert radius == pytest.approx(bore / 2, abs=1e-6)
         # aimed at its own neck: needle.y from the axis' crossing to the neck's near edge
         assert t.x - t.neck.diameter / 2 - mx == pytest.approx(t.needle.y, abs=1e-6)
+
+
+def test_assembly_places_every_taxels_cap_and_needle(spec):
+    from matcad.parts.assembly import assembled_parts
+    from matcad.parts.features import needle_tip_mm
+
+    parts = assembled_parts(spec)
+    for t in taxels(spec):
+        box = parts[f"end_cap_{t.name}"].bounding_box()
+        assert (box.center().X, box.center().Y) == (pytest.approx(t.x, abs=1e-6), pytest.approx(t.y, abs=1e-6))
+        assert box.min.Z == pytest.approx(spec.neck.length, abs=1e-6)  # on the plate
+        tip = needle_tip_mm(t)
+        assert parts[f"needle_{t.name}"].bounding_box().max.Z == pytest.approx(-t.needle.tip_clearance, abs=1e-6)
+        assert abs(parts[f"needle_{t.name}"].bounding_box().center().Y - tip[1]) < 1e-6
