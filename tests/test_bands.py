@@ -173,3 +173,26 @@ def test_single_taxel_build_bands_never_fail_on_the_rise():
     (t,) = board_bands(s)["taxels"]
     assert t["rise"] == 1.0 and "not computed" in t["rise_source"] and "mechanics.max_force_n" in t["rise_source"]
     assert t["loaded_hz"] == t["unloaded_hz"]
+
+
+def test_build_writes_the_band_chart_and_its_numbers(tmp_path):
+    import json
+
+    from matcad.build import build
+
+    s = spec_mod.load(PAPER)
+    s = dataclasses.replace(s, outputs=dataclasses.replace(s.outputs, end_cap_mold=False, needle_mount=False,
+                                                           assembly=False))
+    build(s, tmp_path / "kit")
+    report = json.loads((tmp_path / "kit" / "report.json").read_text())
+    (row,) = report["bands"]["taxels"]
+    band = taxel_band(s)
+    assert row["loaded_hz"] == pytest.approx(list(band.loaded_hz)) and row["rise"] == pytest.approx(band.rise)
+    assert report["bands"]["guard_hz"] == pytest.approx(guard_hz(s.microphone.sample_rate_hz))
+    png = tmp_path / "kit" / "plot_taxel_bands.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "plot_taxel_bands.png" in [f["file"] for f in report["figures"]]
+    md = (tmp_path / "kit" / "report.md").read_text()
+    assert f"| t1 | 0, 0 | {band.f0_hz:.0f} | {band.unloaded_hz[0]:.0f}–{band.unloaded_hz[1]:.0f} | " \
+           f"{band.loaded_hz[0]:.0f}–{band.loaded_hz[1]:.0f} |" in md
+    assert "(plot_taxel_bands.png)" in md and "plot_taxel_bands.png" in (tmp_path / "kit" / "report.html").read_text()

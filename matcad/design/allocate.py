@@ -134,11 +134,12 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
     from matcad.acoustics.bands import guard_hz, taxel_band
     from matcad.rules import check, errors
+    from matcad.spec import MAX_TAXELS
     from matcad.taxel import taxel_spec, taxels
 
     start_time = time.perf_counter()
-    if not 2 <= n <= 16:
-        raise ValueError(f"--taxels {n} invalid, must be 2-16 (one microphone, one band each)")
+    if not 2 <= n <= MAX_TAXELS:
+        raise ValueError(f"--taxels {n} invalid, must be 2-{MAX_TAXELS} (a board of one is --target-hz)")
     if not (math.isfinite(lo_hz) and math.isfinite(hi_hz) and 0 < lo_hz < hi_hz):
         raise ValueError(f"--band {lo_hz:g} {hi_hz:g} invalid, must be 0 < LO < HI (Hz)")
     bad = [k for k in vary if k not in CONTINUOUS]

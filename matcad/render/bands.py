@@ -34,6 +34,8 @@ def band_chart(d: dict, path: Path) -> dict:
     rows = d["taxels"]
     lo = min(t["loaded_hz"][0] for t in rows) - 3 * d["guard_hz"]
     hi = max(t["loaded_hz"][1] for t in rows) + 3 * d["guard_hz"]
+    if len(rows) > 1:  # show the lowest band's 2f: where the harmonic rule bites first
+        hi = max(hi, min(d["harmonics"]) * min(t["loaded_hz"][1] for t in rows) + 3 * d["guard_hz"])
     span = hi - lo
     lo, hi = lo - 0.05 * span, hi + 0.05 * span
     g = d["guard_hz"]
