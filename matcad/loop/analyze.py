@@ -9,7 +9,7 @@ The paper used MATLAB spectrogram + tfridge and a pspectrum peak in 4–5.5 kHz.
    power is exponential; with a *known* median the tail would be exp(−ln 2 · 10^(x/10)) per bin, but the floor is
    itself estimated from ~30 independent bins, so the measured tail is far heavier: 1.2e-4 over 12 dB (law 2e-5),
    ~8e-7 over 15 dB (law 3e-10) per bin (benchmarks/analyze.py; the order-statistic law for a median of 31–41
-   bins brackets it within ×2). Over ~300 band bins a lone frame ≥ 15 dB therefore comes every ~4000 noise frames.
+   bins brackets it within ×2). A lone frame whose ridge stands ≥ 15 dB came 5 times in 116 100 noise frames.
 2. *Mains combs removed.* A line with lines of similar level (within :data:`COMB_LEVEL_DB`) at ±Δ and ±2Δ
    (Δ = 50, 60, 100 or 120 Hz; 3 of the 4 places) belongs to hum or buzz, not to a taxel, whose neighbours are
    not a comb: its bins are removed before tracking.
@@ -22,9 +22,10 @@ The paper used MATLAB spectrogram + tfridge and a pspectrum peak in 4–5.5 kHz.
    ≥ :data:`MIN_RUN` frames long or ≥ :data:`STRONG_RUN` frames with one ≥ :data:`STRONG_DB` (a lone strong frame
    is not enough: see 1). A line that is one of a harmonic comb (:func:`_in_harmonic_comb`: a voice) is no
    candidate. Design value: at most 1e-4 falsely voiced frames per frame of noise (one per ~8 min); measured 0
-   in 38 700 frames (1.1e7 frame × bins) of white, pink and brown noise, 95 % upper bound 7.7e-5 per frame
-   (benchmarks/analyze.py, false-alarm table). Speech alone voices ~2 % of frames (10 seeds). The threshold is a
-   strength and a stability, never a fraction of the file: 1 s of clear tone in a 10 min file is found.
+   in 116 100 frames (3.2e7 frame × bins; 30 min each of white, pink and brown noise), 95 % upper bound 2.6e-5
+   per frame (benchmarks/analyze.py --noise-minutes 30). Speech alone voices ~2 % of frames (10 seeds). The
+   threshold is a strength and a stability, never a fraction of the file: 1 s of clear tone in a 10 min file is
+   found.
 5. *Segments.* Voiced frames are cut into steady segments at gaps and at steps larger than :data:`STEP_HZ`
    between frames; a segment that sits more than :data:`MODE_JUMP_RATIO` above or below the one before it,
    without a ramp in between, cannot be a press (Eq. 5 spans ~+11 % from 0 to 25 N): it is flagged as a mode
