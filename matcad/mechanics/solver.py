@@ -100,6 +100,17 @@ def _cell_strains(field_container, cells: int) -> np.ndarray:
     return np.max(np.abs(0.5 * np.log(stretch2)), axis=1)
 
 
+def _finite_spsolve(a, b):
+    """scipy's sparse solve, refusing a non-finite stiffness or residual (a diverging Newton step) before SuperLU
+    sees it: BLAS prints 'illegal value' warnings on such input and SuperLU may crash, whereas a FloatingPointError
+    makes the caller cut the step."""
+    from scipy.sparse.linalg import spsolve
+
+    if not (np.isfinite(a.data).all() and np.isfinite(b).all()):
+        raise FloatingPointError("the Newton step diverged (non-finite stiffness or residual)")
+    return spsolve(a, b)
+
+
 def _singular_corner(cm: CapMesh, sec: CapSection, point) -> str:
     """Name the sharp corner next to ``point`` (r, z mm), where the surface creases first, or ''."""
     near = 3 * cm.element_size_mm
@@ -192,7 +203,7 @@ def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking",
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
             res = fem.newtonraphson(items=items, dof1=dof1, dof0=dof0, ext0=ext0, maxiter=MAX_NEWTON,
-                                    tol=NEWTON_TOL, verbose=0)
+                                    tol=NEWTON_TOL, verbose=0, solver=_finite_spsolve)
             strains = _cell_strains(fields, len(cm.cells))
             strain = float(strains.max())
             deformed = cm.points + u.values[:n, ::-1]
