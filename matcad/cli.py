@@ -196,18 +196,23 @@ def cmd_build(args) -> int:
             print(_format_findings([f for f in exc.findings if f.level == "error"]))
             print("matcad: design-rule errors: nothing written (fix the spec or use --force)", file=sys.stderr)
         return EXIT_RULES
-    if args.json:
+    board = result.report["bands"]["taxels"] if "taxels" in result.report else None
+    p = result.prediction
+    if args.json:  # a board has no single f0: its taxels' bands instead
         _print_json({"verdict": result.report["verdict"], "out_dir": str(result.out_dir),
-                     "written": list(result.files), "f0_hz": result.prediction.f0_hz,
-                     "band_hz": list(result.prediction.band_hz),
-                     "findings": [f.to_dict() for f in result.findings]})
+                     "written": list(result.files), "f0_hz": None if board else p.f0_hz,
+                     "band_hz": None if board else list(p.band_hz)} | ({"taxels": board} if board else {})
+                    | {"findings": [f.to_dict() for f in result.findings]})
     else:
-        p = result.prediction
         print(f"{spec.name}: {len(result.files)} files in {result.out_dir}/")
         for name in result.files:
             print(f"  {name}")
-        print(f"f0 = {p.f0_hz:.0f} Hz ({p.model}), band {p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz; "
-              f"verdict {result.report['verdict']}")
+        for t in board or ():
+            print(f"{t['name']} at ({t['x_mm']:g}, {t['y_mm']:g}) mm: f0 = {t['f0_hz']:.0f} Hz ({t['model']}), band "
+                  f"{t['unloaded_hz'][0]:.0f}-{t['unloaded_hz'][1]:.0f} Hz, loaded to {t['max_force_n']:g} N "
+                  f"{t['loaded_hz'][0]:.0f}-{t['loaded_hz'][1]:.0f} Hz")
+        print((f"{len(board)} taxels" if board else f"f0 = {p.f0_hz:.0f} Hz ({p.model}), band "
+               f"{p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz") + f"; verdict {result.report['verdict']}")
         print(_format_findings([f for f in result.findings if f.level != "info"]))
     return EXIT_OK
 

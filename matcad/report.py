@@ -228,14 +228,38 @@ def _casting_markdown(c: dict | None) -> list[str]:
     return lines
 
 
+def _taxels_markdown(board: list[dict] | None) -> list[str]:
+    """A board's taxels: position, geometry, needle and unloaded prediction, one row each (mm, deg, Hz)."""
+    if not board:
+        return []
+    lines = ["", "## Taxels", "",
+             "| taxel | x, y [mm] | cavity D × L [mm] | neck d [mm] | cap outer / top [mm] | needle θ, y | "
+             "f0 [Hz] (model) | band [Hz] |", "|---|---|---|---:|---|---|---|---|"]
+    for t in board:
+        c, n, e, nd, p = t["cavity"], t["neck"], t["end_cap"], t["needle"], t["prediction"]
+        lines.append(f"| {t['name']} | {t['x_mm']:g}, {t['y_mm']:g} | {c['diameter']:g} × {c['length']:g} | "
+                     f"{n['diameter']:g} | {e['outer_diameter']:g} / {e['top_thickness']:g} | "
+                     f"{nd['theta_deg']:g}°, {nd['y']:g} mm | {p['f0_hz']:.0f} ({p['model']}) | "
+                     f"{p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} |")
+    return lines
+
+
 def _markdown(r: dict) -> str:
     from matcad.render.bands import bands_markdown
 
     p, ab, bom = r["prediction"], r["as_built"], r["bom"]
+    board = r.get("taxels")
+    if board:  # the top-level prediction and as-built numbers are the first taxel's: say so
+        headline = f"{len(board)} taxels: " + ", ".join(
+            f"{t['name']} {t['f0_hz']:.0f} Hz ({t['unloaded_hz'][0]:.0f}–{t['unloaded_hz'][1]:.0f})"
+            for t in r["bands"]["taxels"])
+        scope = f" of taxel {board[0]['name']} (every taxel: Taxel bands, Taxels)"
+    else:
+        headline = f"f0 = {p['f0_hz']:.0f} Hz ({p['model']}), band {p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz"
+        scope = ""
     lines = [f"# {r['name']} — matcad {r['matcad_version']} build report", "",
-             f"**Verdict: {r['verdict']}** · f0 = {p['f0_hz']:.0f} Hz ({p['model']}), band "
-             f"{p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz", "",
-             "## As built", "",
+             f"**Verdict: {r['verdict']}** · {headline}", "",
+             f"## As built{scope}", "",
              f"- cavity: D {ab['cavity_diameter_mm']:g} × L {ab['cavity_length_mm']:g} mm, draft "
              f"{ab['draft_deg']:g}° (closed-end D {ab['cavity_tip_diameter_mm']:.3f} mm), volume "
              f"{ab['cavity_volume_mm3']:.3f} mm³",
@@ -244,7 +268,7 @@ def _markdown(r: dict) -> str:
              f"{ab['neck_length_mm']:g} mm ({'measured' if ab['neck_length_measured'] else 'nominal'})",
              f"- neck area {p['neck_area_mm2']:.4f} mm², A·l/V {p['neck_air_ratio']:.3f}, c "
              f"{p['speed_of_sound_m_s']:.2f} m/s", "",
-             "## Prediction", "", "| model | f0 [Hz] | valid | failed checks |", "|---|---:|---|---|"]
+             f"## Prediction{scope}", "", "| model | f0 [Hz] | valid | failed checks |", "|---|---:|---|---|"]
     for name, m in p["models"].items():
         failed = ", ".join(k for k, ok in m["checks"].items() if not ok) or "–"
         lines.append(f"| {name}{' (chosen)' if name == p['model'] else ''} | {m['f0_hz']:.1f} | "
@@ -284,6 +308,7 @@ def _markdown(r: dict) -> str:
         lines.append(f"- mount fixing: {f['count']} × {f['size']} screws {f['note']}")
     lines += _fabrication_markdown(r.get("fabrication"))
     lines += _casting_markdown(r.get("casting"))
+    lines += _taxels_markdown(board)
     lines += ["", "## Files", "", "| file | bytes | sha256 |", "|---|---:|---|"]
     lines += [f"| {f['file']} | {f['bytes']} | `{f['sha256'][:16]}…` |" for f in r["files"]]
     if r["meshes"]:

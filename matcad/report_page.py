@@ -11,7 +11,7 @@ from __future__ import annotations
 import html
 
 KNOWN_KEYS = frozenset({"matcad_version", "name", "spec", "as_built", "prediction", "findings", "verdict", "bom",
-                        "meshes", "files", "figures", "casting", "fabrication", "bands"})
+                        "meshes", "files", "figures", "casting", "fabrication", "bands", "taxels"})
 """Report keys rendered by :func:`matcad.report._markdown` or as pictures; every other key is rendered
 generically (a list as a numbered list, a list of tables as a table, a table as key: value lines)."""
 RULE_PARTS = {"needle.": "needle_mount", "fit.dowel_printed": "needle_mount", "mold.": "end_cap_mold_base",

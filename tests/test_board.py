@@ -188,6 +188,28 @@ def test_report_lists_every_taxel_and_its_needle(laser_build):
     assert f0 == sorted(f0) and all(b / a > 1.08 for a, b in zip(f0, f0[1:]))
 
 
+def test_report_and_summary_give_every_taxel_not_the_first_as_the_board(laser_build, tmp_path, capsys):
+    """report.md's headline and Taxels table carry each taxel's own f0 and band; the first taxel's detailed
+    sections say whose they are; `build --json` of a board gives its taxels' bands and no single f0."""
+    from matcad.cli import main
+
+    spec, out = laser_build
+    report = json.loads((out / "report.json").read_text())
+    text = (out / "report.md").read_text()
+    head = text.splitlines()[2]
+    for row in report["taxels"]:
+        p = row["prediction"]
+        assert f"{row['name']} {p['f0_hz']:.0f} Hz ({p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f})" in head
+        assert (f"| {row['name']} | {row['x_mm']:g}, {row['y_mm']:g} | {row['cavity']['diameter']:g} × "
+                f"{row['cavity']['length']:g} | {row['neck']['diameter']:g} |") in text
+    assert "## Prediction of taxel t1 " in text and "## As built of taxel t1 " in text
+    assert main(["build", str(out / "report.json"), "--out", str(tmp_path / "again"), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["f0_hz"] is None and summary["band_hz"] is None
+    assert [(t["name"], t["f0_hz"]) for t in summary["taxels"]] == [(r["name"], r["prediction"]["f0_hz"])
+                                                                    for r in report["taxels"]]
+
+
 # --- 3-D parts read back from STL / STEP (CAD kernel) ----------------------------------------------------------
 
 @pytest.fixture(scope="module")

@@ -39,16 +39,20 @@ def render_figures(spec, prediction, folder: Path, meshes: dict) -> list[dict]:
     from matcad.parts.flat import cut_plan
     from matcad.render.plots import BAND_PNG, LOAD_PNG, band_plot, load_plot
     from matcad.render.previews import flat_preview, preview_name, printed_preview
+    from matcad.taxel import taxel_spec, taxels
 
     figures = []
     if (folder / "section.svg").is_file():
         figures.append({"part": "assembly", "file": "section.svg",
                         "caption": "section through the neck and needle axes, dimensioned (mm)"})
-    p = prediction.to_dict()
-    figures.append(band_plot(p, folder / BAND_PNG))
-    forces = load_forces_n(spec)
+    board = taxels(spec)
+    first = taxel_spec(spec, board[0])  # ``prediction`` is the first taxel's; the band chart shows every taxel
+    scope = f" (taxel {board[0].name} of {len(board)})" if len(board) > 1 else ""
+    figure = band_plot(prediction.to_dict(), folder / BAND_PNG)
+    figures.append(figure | {"caption": figure["caption"] + scope})
+    forces = load_forces_n(first)
     if len(forces):
-        figure = load_plot(predict(spec, forces_n=forces, mechanics=False).to_dict(), folder / LOAD_PNG)
+        figure = load_plot(predict(first, forces_n=forces, mechanics=False).to_dict(), folder / LOAD_PNG)
         if figure:
             figures.append(figure)
     for flat in laser_parts(spec):
