@@ -106,6 +106,14 @@ def test_thin_ligament_between_neck_and_bolt_is_a_warning(spec):
     assert found[0].value == pytest.approx(want, abs=1e-4) and found[0].limit == pytest.approx(6.35)
 
 
+def test_crossing_needle_bores_are_an_error(spec):
+    bad = _moved(spec, 1, y=10.5, needle_theta_deg=30.0)  # t2 in t1's row, its 30° bore runs back under t1
+    found = board_rules.bore_crossings(bad)
+    assert [(f.id, f.level) for f in found] == [("board.bores", "error")]
+    assert "t1" in found[0].message and "t2" in found[0].message and found[0].value < found[0].limit
+    assert board_rules.bore_crossings(_moved(spec, 1, y=10.5)) == []  # same θ: parallel bores 15 mm apart
+
+
 def test_mold_too_small_for_the_board_is_an_error(spec):
     bad = dataclasses.replace(spec, mold=dataclasses.replace(spec.mold, count=2))
     found = board_rules.mold_slots(bad)

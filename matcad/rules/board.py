@@ -179,4 +179,36 @@ def mold_slots(spec) -> list[Finding]:
                     f"{molds['molds_per_board']} pour(s) (or molds poured at once) cast one cap for every taxel")]
 
 
-RULES = (plate_fit, spacing, jet_interference, plate_ligaments, mold_slots)
+def _bore_points(spec, taxel, samples: int = 240):
+    """Points along ``taxel``'s needle axis from the plate underside down to the mount's underside (mm)."""
+    mouth, u = needle_axis_mm(taxel)
+    depth = spec.spacer.height + spec.mount.thickness
+    run = depth / max(u[2], 1e-9)
+    return [tuple(m - run * k / samples * c for m, c in zip(mouth, u)) for k in range(samples + 1)]
+
+
+def bore_crossings(spec) -> list[Finding]:
+    """Two needles' bores must not meet between the plate and the mount's underside (the needles would collide
+    and neither bore would hold its needle): an error per pair with the least distance between the axes against
+    the sum of the bore radii. Parallel bores (equal θ, different y or x) never meet; taxels with different θ in
+    one row can."""
+    board = _board(spec)
+    out = []
+    radius = {t.name: pin_hole_diameter_mm(t.needle.outer_diameter, spec.machine.printer, t.needle.fit) / 2
+              for t in board}
+    points = {t.name: _bore_points(spec, t) for t in board}
+    for i, a in enumerate(board):
+        for b in board[i + 1:]:
+            if abs(a.y - b.y) > radius[a.name] + radius[b.name]:
+                continue  # each axis stays in its own y plane
+            least = min(math.dist(p, q) for p in points[a.name] for q in points[b.name])
+            limit = radius[a.name] + radius[b.name]
+            if least < limit:
+                out.append(Finding("board.bores", "error", round(least, 3), round(limit, 3),
+                                   f"{a.name}'s and {b.name}'s needle bores come {least:.2f} mm apart in the mount "
+                                   f"(bore radii add to {limit:.2f} mm): the needles would collide",
+                                   "give taxels in one row the same needle_theta_deg, or offset them in y"))
+    return out
+
+
+RULES = (plate_fit, spacing, jet_interference, plate_ligaments, mold_slots, bore_crossings)
