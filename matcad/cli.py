@@ -1001,13 +1001,16 @@ def quiet_exit() -> None:
 
 
 def run() -> None:
-    """Console entry point. After a command that loaded OpenCASCADE, every output file is closed and moved into
-    place, yet interpreter teardown would spend 0.3-0.7 s destroying kernel objects: flush and leave at once."""
+    """Console entry point. After a command that loaded OpenCASCADE (or was interrupted, perhaps half-way through
+    loading it), every output file is closed and moved into place or cleaned up, yet interpreter teardown would
+    spend 0.3-0.7 s destroying kernel objects, and on a half-imported kernel abort ("Fatal Python error ...
+    finalizing", exit -6): flush and leave at once."""
     quiet_exit()
     code = main()
     for sig in (signal.SIGINT, signal.SIGTERM):  # the answer is decided: a late signal must not become a traceback
         signal.signal(sig, signal.SIG_IGN)
-    if "OCP" in sys.modules:
+    kernel = any(name.partition(".")[0] in ("OCP", "build123d") for name in sys.modules)
+    if kernel or _SIGNALLED:  # also a kernel import cut short by a signal: its half-made objects abort teardown
         try:
             sys.stdout.flush()
         except BrokenPipeError:
