@@ -23,6 +23,16 @@ length = 4.76
 diameter = 2.1
 length = 6.35
 """
+FAST_MECHANICS = MINIMAL + """[end_cap]
+outer_diameter = 8.0
+top_thickness = 2.0
+[mechanics]
+material = "neo_hookean"
+shear_modulus_mpa = 0.3
+displacement_mm = 1.0
+steps = 4
+"""
+"""MINIMAL with a cheap cap-mechanics run (coarse neo-Hookean, 4 steps to 1 mm): seconds, not tens."""
 
 
 def run_cli(*args, cwd=None):

@@ -12,18 +12,9 @@ from matcad.acoustics.bands import TaxelBand, conflicts, guard_hz, taxel_band
 from matcad.acoustics.load import frequency_at_force_hz
 from matcad.acoustics.predict import predict, spec_calibration
 from matcad.spec import SpecError
-from tests.conftest import MINIMAL, PAPER
+from tests.conftest import FAST_MECHANICS, MINIMAL, PAPER
 
-FAST = MINIMAL + """[end_cap]
-outer_diameter = 8.0
-top_thickness = 2.0
-[mechanics]
-material = "neo_hookean"
-shear_modulus_mpa = 0.3
-displacement_mm = 1.0
-steps = 4
-max_force_n = 6.0
-"""
+FAST = FAST_MECHANICS + "max_force_n = 6.0\n"
 
 
 def _band(name, lo, hi):

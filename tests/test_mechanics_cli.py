@@ -4,17 +4,9 @@ import json
 
 import pytest
 
-from tests.conftest import MINIMAL, run_cli
+from tests.conftest import FAST_MECHANICS, run_cli
 
-FAST = MINIMAL + """[end_cap]
-outer_diameter = 8.0
-top_thickness = 2.0
-[mechanics]
-material = "neo_hookean"
-shear_modulus_mpa = 0.3
-displacement_mm = 1.0
-steps = 4
-"""
+FAST = FAST_MECHANICS
 
 
 def test_predict_force_without_calibration_uses_the_cap_mechanics(write_spec):
