@@ -32,15 +32,46 @@ def test_no_tone_in_noise_or_buzz(name):
             analyze(rec.x, rec.fs, rec.band_hz)
 
 
-def test_speech_is_rarely_taken_for_a_tone():
-    voiced = []
-    for seed in range(3):
+def test_speech_alone_is_no_tone():
+    """Synthetic speech (gliding, jittering 100–220 Hz pitch, formants, syllables) through a room and a tablet
+    microphone, no taxel: "no tone" in every seed. Before the harmonic-sound rule 4 of these 6 seeds voiced 0.9–5.6 %
+    of their frames (short steady lines left by smeared high harmonics and the room's response peaks)."""
+    for seed in range(6):
         rec = synth.scenario("speech-only", 10.0, seed)
+        with pytest.raises(LoopError, match="no tone"):
+            analyze(rec.x, rec.fs, rec.band_hz)
+
+
+def test_a_tone_that_starts_while_someone_speaks_is_found_from_its_start():
+    """Speech throughout; the taxel starts singing at 3 s. The first frames are held by the harmonic-sound rule
+    and voiced once the tone has lasted MIN_RUN_HARMONIC frames: voiced from (almost) its first frame."""
+    fs, seconds = synth.FS, 10.0
+    n = int(seconds * fs)
+    t = np.arange(n) / fs
+    gate = (t > 3.0).astype(float)
+    freq = synth.frequency_of_force(np.full(n, 8.0))
+    x = synth.taxel(freq, fs, 3, gate=gate) + synth.speech_like(n, fs, 3, rms=0.1)
+    x = synth.microphone(synth.reverb(x, fs, 0.5, 4), fs)
+    a = analyze(x, fs, (3900.0, 5600.0))
+    first = a.times_s[np.argmax(a.voiced)]
+    assert 3.0 <= first < 3.0 + 0.2, first
+    assert not np.any(a.voiced[a.times_s < 2.95])
+    assert abs(a.mean_hz - freq[0]) < 1.0
+    assert np.mean(a.voiced[a.times_s > 3.2]) > 0.9
+
+
+def test_room_noise_false_alarms_stay_few():
+    """Broadband noise through a reverberant room (RT60 0.6 s) leaves short steady lines at the room's response
+    peaks, which the voicing cannot tell from a weak tone: measured 6.5 % of frames over 5 seeds (13 % and 2.3 % in
+    these two; benchmarks/analyze.py, room-noise). A documented limit; this guards it from growing."""
+    voiced = []
+    for seed in range(2):
+        rec = synth.scenario("room-noise", 10.0, seed)
         try:
             voiced.append(analyze(rec.x, rec.fs, rec.band_hz).tone_fraction)
         except LoopError:
             voiced.append(0.0)
-    assert np.mean(voiced) < 0.05, voiced  # 2.6 % measured (4.2 % before the wider comb test)
+    assert np.mean(voiced) < 0.10, voiced
 
 
 @pytest.mark.parametrize("name", ["steady", "buzz+tone", "speech+tone"])

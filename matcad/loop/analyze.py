@@ -21,11 +21,18 @@ The paper used MATLAB spectrogram + tfridge and a pspectrum peak in 4–5.5 kHz.
    ±:data:`STABLE_BINS` bins and stands ≥ :data:`WEAK_DB` over the floor, and the run is either
    ≥ :data:`MIN_RUN` frames long or ≥ :data:`STRONG_RUN` frames with one ≥ :data:`STRONG_DB` (a lone strong frame
    is not enough: see 1). A line that is one of a harmonic comb (:func:`_in_harmonic_comb`: a voice) is no
-   candidate. Design value: at most 1e-4 falsely voiced frames per frame of noise (one per ~8 min); measured 0
-   in 116 100 frames (3.2e7 frame × bins; 30 min each of white, pink and brown noise), 95 % upper bound 2.6e-5
-   per frame (benchmarks/analyze.py --noise-minutes 30). Speech alone voices ~2 % of frames (10 seeds). The
-   threshold is a strength and a stability, never a fraction of the file: 1 s of clear tone in a 10 min file is
-   found.
+   candidate. While a harmonic sound — a voice or buzz, recognised by its resolved low harmonics below the band
+   (:mod:`matcad.loop.harmonic`) — is present and no tone has been established (a run of
+   :data:`MIN_RUN_HARMONIC` frames within :data:`ANCHOR_FRAMES`), a run needs MIN_RUN_HARMONIC frames (~0.46 s):
+   a voice's smeared high harmonics and the room's response peaks it excites leave steady-looking lines of 2–8
+   frames. A run that would have qualified otherwise is held and voiced after all if such a run starts within
+   ANCHOR_FRAMES after it. Design value: at most 1e-4 falsely voiced frames per frame of noise (one per ~8 min);
+   measured 0 in 116 100 frames (3.2e7 frame × bins; 30 min each of white, pink and brown noise), 95 % upper
+   bound 2.6e-5 per frame (benchmarks/analyze.py --noise-minutes 30). Synthetic speech alone: 0 frames voiced in
+   20 seeds (was 3.4 %). Not met: broadband noise heard through a reverberant room (RT60 0.6 s) voices ~6 % of
+   frames (room-noise case) — its lines at the room's response peaks are as steady as a weak tone over 5 frames.
+   The threshold is a strength and a stability, never a fraction of the file: 1 s of clear tone in a 10 min file
+   is found.
 5. *Segments.* Voiced frames are cut into steady segments at gaps and at steps larger than :data:`STEP_HZ`
    between frames; a segment that sits more than :data:`MODE_JUMP_RATIO` above or below the one before it,
    without a ramp in between, cannot be a press (Eq. 5 spans ~+11 % from 0 to 25 N): it is flagged as a mode
@@ -43,6 +50,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from matcad.loop import LoopError
+from matcad.loop.harmonic import harmonic_frames
 
 WINDOW_S = 0.093
 """~4096 samples at 44.1 kHz: ~11 Hz resolution (5.4 Hz bins with 2× padding), 46 ms between frames."""
@@ -63,6 +71,13 @@ STRONG_RUN = 2
 """A run qualifies by strength (≥ STRONG_DB) once it has this many frames: a lone strong frame is a noise or speech
 peak as often as a tone (measured: benchmarks/analyze.py, voicing false alarms)."""
 MIN_RUN = 5
+MIN_RUN_HARMONIC = 10
+"""While a harmonic sound (voice, buzz; :mod:`matcad.loop.harmonic`) is present within HARMONIC_NEAR_FRAMES of a
+run, and no run of this length ended within ANCHOR_FRAMES before it, the run needs this many frames (~0.46 s):
+neither the strength shortcut nor MIN_RUN. Speech-excited lines and room-response peaks last ≤ 8 frames
+(benchmarks/analyze.py)."""
+HARMONIC_NEAR_FRAMES = 4
+ANCHOR_FRAMES = 10
 STABLE_BINS = 2
 COMB_SPACINGS_HZ = (50.0, 60.0, 100.0, 120.0)
 COMB_LEVEL_DB = 10.0
@@ -236,6 +251,10 @@ class BandTracker:
         self.times, self.track, self.excess, self.state, self.other_bin, self.other_excess = [], [], [], [], [], []
         self.other_level, self.harmonic = [], []
         self._run_start, self._run_max, self._marked = -1, -np.inf, 0  # current candidate run (none: start −1)
+        self._harmonic_sound: list[bool] = []  # per frame pushed: a harmonic sound below the band
+        self._anchor_end = -np.inf  # last frame of the latest run of MIN_RUN_HARMONIC frames
+        self._run_lenient = False  # the current run would qualify without the harmonic-sound rule
+        self._held: list[tuple[int, int]] = []  # such runs (first, last frame) not voiced, awaiting a tone
         self._voice_done = 0  # frames whose voicing is final
         self._plot_cols: list[np.ndarray] = []
         self._plot_times: list[float] = []
@@ -264,6 +283,7 @@ class BandTracker:
         emit = np.where(comb_zone[:, band], 0.0, np.clip(excess_slab[:, band], 0.0, None))
         band_lines = np.where(comb_zone[:, band], -np.inf, lines[:, band])
         self.band_peak_power += slab[:, band].sum(axis=0)
+        self._harmonic_sound.extend(harmonic_frames(power, self.freqs, self.band[0]).tolist())
         self._plot(times, log_slab[:, band])
         back, best = self._forward(emit)
         self._p_times = np.concatenate([self._p_times, times])
@@ -382,28 +402,45 @@ class BandTracker:
 
     def _voice(self, i):
         """Voicing state machine: candidate runs qualify by strength or by length and stability; a frame whose
-        line is one of a harmonic comb is no candidate."""
+        line is one of a harmonic comb is no candidate. Near a harmonic sound and away from an established tone (a
+        run of MIN_RUN_HARMONIC frames within ANCHOR_FRAMES before it) a run needs MIN_RUN_HARMONIC frames; one that
+        would have qualified otherwise is held, and voiced after all when such a run starts within ANCHOR_FRAMES
+        after it (a tone that begins while someone speaks)."""
         e = -np.inf if self.harmonic[i] else self.excess[i]
         start = self._run_start
         stable = start >= 0 and abs(self._bin_of(i) - self._bin_of(i - 1)) <= STABLE_BINS
         if e >= WEAK_DB and (start < 0 or stable):
             if start < 0:
-                start, self._run_max = i, e
+                start, self._run_max, self._run_lenient = i, e, False
             else:
                 self._run_max = max(self._run_max, e)
         else:
+            if start >= 0 and self._run_lenient and self.state[start] == 0:
+                self._held.append((start, i - 1))
             start = i if e >= WEAK_DB else -1
-            self._run_max = e
+            self._run_max, self._run_lenient = e, False
         self._run_start = start
         length = i - start + 1
-        if start >= 0 and (length >= MIN_RUN or (length >= STRONG_RUN and self._run_max >= STRONG_DB)):
-            for j in range(max(start, self._marked), i + 1):
-                self.state[j] = 1
+        if start >= 0 and length >= MIN_RUN_HARMONIC:
+            self._anchor_end = i
+            for first, last in self._held:
+                if start - last <= ANCHOR_FRAMES:
+                    self._mark(first, last)
+            self._held = []
+        self._held = [h for h in self._held if i - h[1] <= ANCHOR_FRAMES + MIN_RUN_HARMONIC]
+        lenient = start >= 0 and (length >= MIN_RUN or (length >= STRONG_RUN and self._run_max >= STRONG_DB))
+        self._run_lenient |= lenient
+        strict = (start >= 0 and start - self._anchor_end > ANCHOR_FRAMES
+                  and any(self._harmonic_sound[max(0, start - HARMONIC_NEAR_FRAMES):i + HARMONIC_NEAR_FRAMES + 1]))
+        if start >= 0 and (length >= MIN_RUN_HARMONIC or (lenient and not strict)):
+            self._mark(max(start, self._marked), i)
             self._marked = i + 1
-        if start < 0 or self.state[start] == 1:
-            self._emit_until(i + 1)
-        else:
-            self._emit_until(start)
+        stop = i + 1 if start < 0 or self.state[start] == 1 else start
+        self._emit_until(min([stop] + [h[0] for h in self._held]))
+
+    def _mark(self, first, last):
+        for j in range(first, last + 1):
+            self.state[j] = 1
 
     def _bin_of(self, i):
         return (self.track[i] - self.freqs[self.in_band[0]]) / self.df

@@ -247,6 +247,10 @@ def scenario(name: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) ->
         x, truth = _base(seconds, fs, seed, force, freq=freq)
         truth = np.where(jump, np.nan, truth)  # not the taxel's load-bearing mode: must be flagged, not sensed
         x = _room(x, fs, seed)
+    elif name == "room-noise":  # a fan's broadband noise heard through a reverberant room (RT60 0.6 s), no tone
+        force = steady
+        truth = np.full(n, np.nan)
+        x = microphone(reverb(coloured_noise(n, fs, seed, 1.0, 0.05), fs, 0.6, seed + 1, wet=0.8), fs)
     elif name == "white-noise":
         force = steady
         truth = np.full(n, np.nan)
@@ -261,7 +265,7 @@ def scenario(name: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) ->
 
 
 CASES = ("steady", "presses", "tapping", "gaps", "short-tone", "buzz-only", "buzz+tone", "speech-only",
-         "speech+tone", "neighbour", "overblown", "white-noise", "brown-noise")
+         "speech+tone", "neighbour", "overblown", "white-noise", "brown-noise", "room-noise")
 
 
 # --- a board: several taxels heard by one microphone ---------------------------------------------------------------
