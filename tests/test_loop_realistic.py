@@ -60,18 +60,19 @@ def test_a_tone_that_starts_while_someone_speaks_is_found_from_its_start():
     assert np.mean(a.voiced[a.times_s > 3.2]) > 0.9
 
 
-def test_room_noise_false_alarms_stay_few():
+def test_room_noise_false_alarms_are_cut_by_the_adaptive_thresholds():
     """Broadband noise through a reverberant room (RT60 0.6 s) leaves short steady lines at the room's response
-    peaks, which the voicing cannot tell from a weak tone: measured 6.5 % of frames over 5 seeds (13 % and 2.3 % in
-    these two; benchmarks/analyze.py, room-noise). A documented limit; this guards it from growing."""
+    peaks. Thresholds raised by the clutter's tail (CFAR) cut them from 6.5 % of frames to 2.7 % over these 5 seeds
+    (benchmarks/analyze.py, room-noise) — a documented limit, not a rejection; without the shift this fails."""
     voiced = []
-    for seed in range(2):
+    for seed in range(5):
         rec = synth.scenario("room-noise", 10.0, seed)
         try:
             voiced.append(analyze(rec.x, rec.fs, rec.band_hz).tone_fraction)
         except LoopError:
             voiced.append(0.0)
-    assert np.mean(voiced) < 0.10, voiced
+    assert np.mean(voiced) < 0.04, voiced
+    assert sum(v == 0.0 for v in voiced) >= 3, voiced
 
 
 @pytest.mark.parametrize("name", ["steady", "buzz+tone", "speech+tone"])

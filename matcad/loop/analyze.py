@@ -26,11 +26,16 @@ The paper used MATLAB spectrogram + tfridge and a pspectrum peak in 4–5.5 kHz.
    :data:`MIN_RUN_HARMONIC` frames within :data:`ANCHOR_FRAMES`), a run needs MIN_RUN_HARMONIC frames (~0.46 s):
    a voice's smeared high harmonics and the room's response peaks it excites leave steady-looking lines of 2–8
    frames. A run that would have qualified otherwise is held and voiced after all if such a run starts within
-   ANCHOR_FRAMES after it. Design value: at most 1e-4 falsely voiced frames per frame of noise (one per ~8 min);
+   ANCHOR_FRAMES after it. Away from a voiced frame (ANCHOR_FRAMES), the thresholds also adapt to the clutter
+   (order-statistic CFAR): where the band's other bins, pooled over ±:data:`CLUTTER_FRAMES` frames, stand
+   ≥ WEAK_DB more often than :data:`CLUTTER_TARGET` (dry noise: 0.76 %), WEAK_DB and STRONG_DB rise together until
+   they do not — broadband noise through a reverberant room has a tail ~3× heavier at 8 dB, ~10× at 10 dB, from
+   the room's response peaks. Design value: at most 1e-4 falsely voiced frames per frame of noise (one per ~8 min);
    measured 0 in 116 100 frames (3.2e7 frame × bins; 30 min each of white, pink and brown noise), 95 % upper
    bound 2.6e-5 per frame (benchmarks/analyze.py --noise-minutes 30). Synthetic speech alone: 0 frames voiced in
-   20 seeds (was 3.4 %). Not met: broadband noise heard through a reverberant room (RT60 0.6 s) voices ~6 % of
-   frames (room-noise case) — its lines at the room's response peaks are as steady as a weak tone over 5 frames.
+   20 seeds (was 3.4 %). Not met: broadband noise heard through a reverberant room (RT60 0.6 s) still voices
+   2.7 % of frames over 5 seeds (6.5 % without the adaptive thresholds; room-noise case) — its lines at the room's
+   response peaks are as steady as a weak tone over 5–8 frames.
    The threshold is a strength and a stability, never a fraction of the file: 1 s of clear tone in a 10 min file
    is found.
 5. *Segments.* Voiced frames are cut into steady segments at gaps and at steps larger than :data:`STEP_HZ`
@@ -71,6 +76,16 @@ STRONG_RUN = 2
 """A run qualifies by strength (≥ STRONG_DB) once it has this many frames: a lone strong frame is a noise or speech
 peak as often as a tone (measured: benchmarks/analyze.py, voicing false alarms)."""
 MIN_RUN = 5
+CLUTTER_GUARD_BINS = 30
+"""Bins either side of a frame's strongest line left out of its clutter (the tone and its skirt)."""
+CLUTTER_FRAMES = 10
+CLUTTER_STEP_DB = 0.5
+CLUTTER_STEPS = 16
+CLUTTER_TARGET = 0.01
+"""Adaptive thresholds (order-statistic CFAR, Rohling 1983): over the band's bins outside the strongest line's
+guard, pooled over ±CLUTTER_FRAMES frames, the fraction ≥ WEAK_DB + s must not exceed this (dry noise: 0.76 % on average,
+above 1 % in about one window in ten, which then asks 0.5 dB more of a new weak tone); s (a multiple of CLUTTER_STEP_DB, at most CLUTTER_STEPS of them) raises WEAK_DB
+and STRONG_DB alike where the clutter's tail is heavier — a reverberant room's response peaks, a voice."""
 MIN_RUN_HARMONIC = 10
 """While a harmonic sound (voice, buzz; :mod:`matcad.loop.harmonic`) is present within HARMONIC_NEAR_FRAMES of a
 run, and no run of this length ended within ANCHOR_FRAMES before it, the run needs this many frames (~0.46 s):
@@ -211,7 +226,7 @@ class BandTracker:
     operations per frame) works on whole blocks of frames: the floor is one running median over the block's rows
     laid end to end, the fixed-lag decisions of a block are one vectorised backtrack, peak refinement and the
     harmonic test act on all decided frames at once. Frames whose bin is not yet decided (≤ LAG_FRAMES) are kept;
-    the arrays kept grow by seven numbers per frame (~0.1 MB per minute of audio); the plot is max-pooled to at
+    the arrays kept grow by eight numbers per frame (~0.1 MB per minute of audio); the plot is max-pooled to at
     most 2·PLOT_COLUMNS columns. ``on_frame`` (optional) is called with (time s, frequency Hz or NaN, excess dB)
     as each frame's voicing becomes final, for live output.
     """
@@ -252,8 +267,13 @@ class BandTracker:
         self.other_level, self.harmonic = [], []
         self._run_start, self._run_max, self._marked = -1, -np.inf, 0  # current candidate run (none: start −1)
         self._harmonic_sound: list[bool] = []  # per frame pushed: a harmonic sound below the band
+        self._clutter = np.zeros((0, CLUTTER_STEPS + 1))  # per recent frame: clutter bins >= WEAK_DB + k*step
+        self._clutter_bins = np.zeros(0)
+        self._clutter_first = 0  # frame index of the first row kept
         self._anchor_end = -np.inf  # last frame of the latest run of MIN_RUN_HARMONIC frames
-        self._run_lenient = False  # the current run would qualify without the harmonic-sound rule
+        self._run_lenient = False  # the current run would qualify near an established tone
+        self._run_firm, self._run_max_shifted = 0, -np.inf  # its frames over the shifted WEAK_DB; its best, shifted
+        self._voiced_end = -np.inf  # the latest voiced frame
         self._held: list[tuple[int, int]] = []  # such runs (first, last frame) not voiced, awaiting a tone
         self._voice_done = 0  # frames whose voicing is final
         self._plot_cols: list[np.ndarray] = []
@@ -284,6 +304,9 @@ class BandTracker:
         band_lines = np.where(comb_zone[:, band], -np.inf, lines[:, band])
         self.band_peak_power += slab[:, band].sum(axis=0)
         self._harmonic_sound.extend(harmonic_frames(power, self.freqs, self.band[0]).tolist())
+        counts, bins = _clutter_counts(excess_slab[:, band])
+        self._clutter = np.concatenate([self._clutter, counts])
+        self._clutter_bins = np.concatenate([self._clutter_bins, bins])
         self._plot(times, log_slab[:, band])
         back, best = self._forward(emit)
         self._p_times = np.concatenate([self._p_times, times])
@@ -301,6 +324,9 @@ class BandTracker:
             for s in range(LAG_FRAMES, 0, -1):
                 states = self._p_back[rows + s, states]
             self._decide(ready, states)
+        drop = max(0, self._voice_done - CLUTTER_FRAMES - 1 - self._clutter_first)  # rows no frame will pool again
+        self._clutter, self._clutter_bins = self._clutter[drop:], self._clutter_bins[drop:]
+        self._clutter_first += drop
 
     def _forward(self, emit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Viterbi recursion over a block's emissions (frames × bins, dB): back pointers and each frame's best
@@ -401,24 +427,30 @@ class BandTracker:
             self._voice(i)
 
     def _voice(self, i):
-        """Voicing state machine: candidate runs qualify by strength or by length and stability; a frame whose
-        line is one of a harmonic comb is no candidate. Near a harmonic sound and away from an established tone (a
-        run of MIN_RUN_HARMONIC frames within ANCHOR_FRAMES before it) a run needs MIN_RUN_HARMONIC frames; one that
-        would have qualified otherwise is held, and voiced after all when such a run starts within ANCHOR_FRAMES
-        after it (a tone that begins while someone speaks)."""
+        """Voicing state machine: candidate runs (frames ≥ WEAK_DB on a stable line; a frame whose line is one of a
+        harmonic comb is none) qualify by length (MIN_RUN) or strength (STRONG_RUN frames, one ≥ STRONG_DB). Away from
+        an established tone (a run of MIN_RUN_HARMONIC frames within ANCHOR_FRAMES before it) a run must do more:
+        near a harmonic sound it needs MIN_RUN_HARMONIC frames; elsewhere it must qualify with both thresholds raised
+        by the clutter's shift (:meth:`_threshold_shift`). A run that would have qualified otherwise is held, and
+        voiced after all when an established tone starts within ANCHOR_FRAMES after it (a tone that begins while
+        someone speaks or a fan blows in a reverberant room)."""
         e = -np.inf if self.harmonic[i] else self.excess[i]
+        shifted = e - self._threshold_shift(i)
         start = self._run_start
         stable = start >= 0 and abs(self._bin_of(i) - self._bin_of(i - 1)) <= STABLE_BINS
         if e >= WEAK_DB and (start < 0 or stable):
             if start < 0:
                 start, self._run_max, self._run_lenient = i, e, False
+                self._run_firm, self._run_max_shifted = 0, shifted
             else:
                 self._run_max = max(self._run_max, e)
+                self._run_max_shifted = max(self._run_max_shifted, shifted)
         else:
             if start >= 0 and self._run_lenient and self.state[start] == 0:
                 self._held.append((start, i - 1))
             start = i if e >= WEAK_DB else -1
-            self._run_max, self._run_lenient = e, False
+            self._run_max, self._run_lenient, self._run_firm, self._run_max_shifted = e, False, 0, shifted
+        self._run_firm += start >= 0 and shifted >= WEAK_DB
         self._run_start = start
         length = i - start + 1
         if start >= 0 and length >= MIN_RUN_HARMONIC:
@@ -430,13 +462,29 @@ class BandTracker:
         self._held = [h for h in self._held if i - h[1] <= ANCHOR_FRAMES + MIN_RUN_HARMONIC]
         lenient = start >= 0 and (length >= MIN_RUN or (length >= STRONG_RUN and self._run_max >= STRONG_DB))
         self._run_lenient |= lenient
-        strict = (start >= 0 and start - self._anchor_end > ANCHOR_FRAMES
-                  and any(self._harmonic_sound[max(0, start - HARMONIC_NEAR_FRAMES):i + HARMONIC_NEAR_FRAMES + 1]))
-        if start >= 0 and (length >= MIN_RUN_HARMONIC or (lenient and not strict)):
+        if start < 0:
+            qualifies = False
+        elif length >= MIN_RUN_HARMONIC or start - self._anchor_end <= ANCHOR_FRAMES:
+            qualifies = lenient or length >= MIN_RUN_HARMONIC
+        elif any(self._harmonic_sound[max(0, start - HARMONIC_NEAR_FRAMES):i + HARMONIC_NEAR_FRAMES + 1]):
+            qualifies = False
+        elif start - self._voiced_end <= ANCHOR_FRAMES:
+            qualifies = lenient
+        else:
+            qualifies = self._run_firm >= MIN_RUN or (self._run_firm >= STRONG_RUN
+                                                      and self._run_max_shifted >= STRONG_DB)
+        if qualifies:
             self._mark(max(start, self._marked), i)
             self._marked = i + 1
+            self._voiced_end = i
         stop = i + 1 if start < 0 or self.state[start] == 1 else start
         self._emit_until(min([stop] + [h[0] for h in self._held]))
+
+    def _threshold_shift(self, i):
+        """dB by which the clutter around frame ``i`` raises WEAK_DB and STRONG_DB (CLUTTER_TARGET)."""
+        lo, hi = max(0, i - CLUTTER_FRAMES - self._clutter_first), i + CLUTTER_FRAMES + 1 - self._clutter_first
+        fraction = self._clutter[lo:hi].sum(axis=0) / max(1.0, self._clutter_bins[lo:hi].sum())
+        return CLUTTER_STEP_DB * int(np.argmax(np.append(fraction, 0.0) <= CLUTTER_TARGET))
 
     def _mark(self, first, last):
         for j in range(first, last + 1):
@@ -568,6 +616,16 @@ def _running_median_rows(rows: np.ndarray, width: int) -> np.ndarray:
     half = width // 2
     padded = np.pad(rows, ((0, 0), (half, half)), mode="edge")
     return median_filter(padded.ravel(), size=width, mode="nearest").reshape(padded.shape)[:, half:-half]
+
+
+def _clutter_counts(excess: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per frame (rows of band excess, dB): how many bins outside CLUTTER_GUARD_BINS of the strongest stand
+    ≥ WEAK_DB + k·CLUTTER_STEP_DB (k = 0 … CLUTTER_STEPS), and how many bins were counted."""
+    cols = np.arange(excess.shape[1])
+    outside = np.abs(cols[None, :] - np.argmax(excess, axis=1)[:, None]) > CLUTTER_GUARD_BINS
+    levels = WEAK_DB + CLUTTER_STEP_DB * np.arange(CLUTTER_STEPS + 1)
+    counts = ((excess[:, :, None] >= levels[None, None, :]) & outside[:, :, None]).sum(axis=1)
+    return counts.astype(float), outside.sum(axis=1).astype(float)
 
 
 def _in_harmonic_comb(lines: np.ndarray, p: np.ndarray, df: float) -> np.ndarray:
