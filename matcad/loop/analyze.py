@@ -35,7 +35,9 @@ The paper used MATLAB spectrogram + tfridge and a pspectrum peak in 4–5.5 kHz.
    bound 2.6e-5 per frame (benchmarks/analyze.py --noise-minutes 30). Synthetic speech alone: 0 frames voiced in
    20 seeds (was 3.4 %). Not met: broadband noise heard through a reverberant room (RT60 0.6 s) still voices
    2.7 % of frames over 5 seeds (6.5 % without the adaptive thresholds; room-noise case) — its lines at the room's
-   response peaks are as steady as a weak tone over 5–8 frames.
+   response peaks are as steady as a weak tone over 5–8 frames; when no voiced stretch lasts MIN_RUN_HARMONIC
+   frames the analysis warns that the frames may be such peaks (every room-noise false alarm measured; no case
+   with a tone).
    The threshold is a strength and a stability, never a fraction of the file: 1 s of clear tone in a 10 min file
    is found.
 5. *Segments.* Voiced frames are cut into steady segments at gaps and at steps larger than :data:`STEP_HZ`
@@ -559,6 +561,12 @@ class BandTracker:
                             "overtone; if it is the taxel, narrow the band with --band")
         for s in flagged:
             warnings.append(f"{s.start_s:.2f}-{s.end_s:.2f} s at {s.mean_hz:.0f} Hz: {s.flag}; left out")
+        longest = _longest_run(voiced)
+        if longest < MIN_RUN_HARMONIC:
+            seconds = MIN_RUN_HARMONIC * (window_samples(self.fs) // 2) / self.fs
+            warnings.append(f"no voiced stretch lasts {MIN_RUN_HARMONIC} frames ({seconds:.2f} s; the longest: "
+                            f"{longest}): these may be a room's response peaks or another transient rather than a "
+                            "singing taxel")
         prom = np.where(np.isfinite(other_level[voiced]), -other_level[voiced], excess[voiced])
         return Analysis(mean_hz=float(np.mean(track[voiced])), median_hz=float(np.median(track[voiced])),
                         std_hz=float(np.std(track[voiced])), snr_db=float(np.median(excess[voiced])),
@@ -605,6 +613,12 @@ def _segments(times, track, state, df) -> list[Segment]:
         out.append(Segment(float(times[run[0]]), float(times[run[-1]]), len(run), mean, float(np.median(f)),
                            float(np.std(f)), flag))
     return out
+
+
+def _longest_run(flags: np.ndarray) -> int:
+    """Length of the longest stretch of consecutive True values."""
+    edges = np.diff(np.concatenate([[0], flags.astype(np.int8), [0]]))
+    return int(np.max(np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1), initial=0))
 
 
 def _running_median_rows(rows: np.ndarray, width: int) -> np.ndarray:
