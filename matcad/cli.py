@@ -307,14 +307,20 @@ def cmd_analyze(args) -> int:
     return EXIT_OK
 
 
-def _board_bands(args):
-    """(name, listening band Hz) per taxel when ``--spec`` names an array (and no --band is given), else None."""
+def _board_spec(args):
+    """The spec of ``--spec`` when it names an array (and no --band is given), else None."""
     if not getattr(args, "spec", None) or getattr(args, "band", None):
         return None
     from matcad.taxel import is_array
 
     spec = _load_spec(args.spec, args)
-    if not is_array(spec):
+    return spec if is_array(spec) else None
+
+
+def _board_bands(args):
+    """(name, listening band Hz) per taxel when ``--spec`` names an array (and no --band is given), else None."""
+    spec = _board_spec(args)
+    if spec is None:
         return None
     from matcad.loop.board import board_bands
 
@@ -382,6 +388,10 @@ def cmd_calibrate(args) -> int:
     target = _loop_output(args, "calibrate", str(args.data))
     with staged_output(target) as tmp:
         (tmp / "calibration.toml").write_text(cal.to_toml(), encoding="utf-8")
+        if args.taxel is not None:  # the same table to paste under that [[taxel]] entry of the board spec
+            (tmp / "taxel_calibration.toml").write_text(
+                f"# paste under the [[taxel]] entry named {args.taxel!r} of {args.spec}\n"
+                + cal.to_toml("taxel.calibration"), encoding="utf-8")
         plot(cal, tmp / "residuals.png")
         _write_json(tmp / "report.json", {"data": str(args.data), "spec": spec.name, **cal.to_dict()})
     if args.json:
@@ -398,7 +408,8 @@ def cmd_calibrate(args) -> int:
               f"({cal.cycles} cycle(s)); at {cal.temperature_c:g} degC")
         for note in cal.notes:
             print(f"  note: {note}")
-        print(f"  calibration.toml, residuals.png in {target}/")
+        extra = f"taxel_calibration.toml ([taxel.calibration] of {args.taxel}), " if args.taxel is not None else ""
+        print(f"  calibration.toml, {extra}residuals.png in {target}/")
     return EXIT_OK
 
 
@@ -427,9 +438,12 @@ def cmd_sense(args) -> int:
     from matcad.output import staged_output
     from matcad.spec import load_calibration
 
-    board = _board_bands(args)
-    if board is not None:
-        return _sense_board(args, board)
+    board_spec = _board_spec(args)
+    if board_spec is not None:
+        return _sense_board(args, board_spec)
+    if not args.calibration:
+        raise ValueError("--calibration FILE is required (calibration.toml from `matcad calibrate`, or a spec with "
+                         "a [calibration] table); an array --spec may carry [taxel.calibration] tables instead")
     if len(args.calibration) != 1:
         raise ValueError(f"--calibration given {len(args.calibration)} times: several calibrations need --spec "
                          "naming an array, one NAME=FILE per taxel")
@@ -494,34 +508,43 @@ def cmd_sense(args) -> int:
     return EXIT_OK
 
 
-def _sense_board(args, named_bands) -> int:
+def _sense_board(args, spec) -> int:
     import numpy as np
 
     from matcad.loop import board
     from matcad.loop.sense import SensorCalibration, force_with_interval
     from matcad.output import staged_output
-    from matcad.spec import load_calibration
 
+    named_bands = board.board_bands(spec)
     names = [n for n, _ in named_bands]
-    files = board.parse_calibrations(args.calibration, names)
-    cals = {n: SensorCalibration.from_spec_calibration(load_calibration(f)) for n, f in files.items()}
+    given = board.board_calibrations(spec, args.calibration)
+    cals = {n: SensorCalibration.from_spec_calibration(cal) for n, (_, cal) in given.items()}
     for cal in cals.values():
         cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
     blocks, fs, name = _recording_blocks(args)
     on_frame = None
     if args.live:
-        def on_frame(k, time_s, freq, _excess):
-            taxel, text = names[k], "no tone"
-            if freq == freq:
-                text = f"{freq:9.2f} Hz"
-                if taxel in cals:
-                    force, half = force_with_interval(cals[taxel], [freq], temperature_c=args.temperature_c)
-                    text += (f"  F = {force[0]:.3f} +- {half[0]:.3f} N" if np.isfinite(force[0])
-                             else "  outside the calibrated range")
-            print(f"{time_s:9.3f} s  {taxel}  {text}", flush=True)
-    tracks = board.analyze_board(blocks, fs, named_bands, on_frame)
+        def taxel_text(taxel, freq):
+            if freq != freq:
+                return f"{taxel} no tone"
+            text = f"{taxel} {freq:.2f} Hz"
+            if taxel in cals:
+                force, half = force_with_interval(cals[taxel], [freq], temperature_c=args.temperature_c)
+                text += (f" F={force[0]:.3f}+-{half[0]:.3f} N" if np.isfinite(force[0])
+                         else " outside the calibrated range")
+            return text
+
+        def line(time_s, values):  # one frame, every taxel: printed once all have decided it
+            print(f"{time_s:9.3f} s  " + " | ".join(taxel_text(taxel, freq) for taxel, (freq, _) in
+                                                    zip(names, values)), flush=True)
+        on_frame = board.LiveFrames(len(names), line)
+    try:
+        tracks = board.analyze_board(blocks, fs, named_bands, on_frame)
+    finally:
+        if on_frame is not None:
+            on_frame.flush()
     readings = board.sense_board(tracks, cals, args.temperature_c)
-    report = {"recording": name, "calibrations": files,
+    report = {"recording": name, "calibrations": {n: source for n, (source, _) in given.items()},
               "taxels": [{**t.to_dict(), **({"reading": readings[t.name].to_dict()} if t.name in readings else {})}
                          for t in tracks]}
     target = _loop_output(args, "sense", name) if not (args.live and args.out is None) else None
@@ -782,9 +805,10 @@ def _parser() -> argparse.ArgumentParser:
     n = command("sense", cmd_sense, "force from a recording through a calibration, with 95 %% intervals",
                 "out/sense-<recording>-<hash>")
     n.add_argument("recording", help="WAV file, or '-' for standard input (WAV, or raw PCM with --format --rate)")
-    n.add_argument("--calibration", required=True, action="append", metavar="[NAME=]FILE",
+    n.add_argument("--calibration", action="append", metavar="[NAME=]FILE",
                    help="calibration.toml from `matcad calibrate`, or a spec; with --spec naming an array, one "
-                        "NAME=FILE per taxel (repeat the option; a taxel without one gets frequencies only)")
+                        "NAME=FILE per taxel (repeat the option; it overrides that taxel's [taxel.calibration] in "
+                        "the spec; a taxel with neither gets frequencies only)")
     n.add_argument("--spec", help="spec TOML of an array: every taxel tracked in its own (loaded) band")
     n.add_argument("--set", action="append", metavar="KEY=VALUE", help="override one field of --spec (TOML value)")
     n.add_argument("--temperature-c", type=float, help="air temperature now (degC): frequencies are scaled by "

@@ -43,10 +43,11 @@ class SpecError(ValueError):
 
 def _param(doc: str, unit: str = "", default: Any = dataclasses.MISSING, *, kind: str = "number",
            lo: float | None = None, hi: float | None = None, lo_open: bool = True,
-           choices: tuple[str, ...] = ()) -> Any:
-    """Declare one spec field. ``kind`` is number | integer | bool | text | range | choice | name."""
+           choices: tuple[str, ...] = (), section: type | None = None) -> Any:
+    """Declare one spec field. ``kind`` is number | integer | bool | text | range | choice | name | section (a
+    sub-table validated as the Section class ``section``)."""
     meta = {"doc": doc, "unit": unit, "kind": kind, "lo": lo, "hi": hi, "lo_open": lo_open,
-            "choices": choices}
+            "choices": choices, "section": section}
     return field(default=default, metadata=meta)
 
 
@@ -422,6 +423,10 @@ class TaxelEntry(Section):
                                             None, lo=0.0, hi=90.0)
     needle_y: float | None = _param("this taxel's needle offset y (see needle.y); default [needle]", "mm", None,
                                     lo=-LENGTH_MAX_MM, hi=LENGTH_MAX_MM, lo_open=False)
+    calibration: Calibration | None = _param(
+        "this taxel's Eq. 5 calibration as a [taxel.calibration] sub-table, the fields of [calibration] (`matcad "
+        "calibrate --taxel NAME` writes it); `sense --spec` uses it, `--calibration NAME=FILE` overrides it",
+        default=None, kind="section", section=Calibration)
 
 
 @dataclass(frozen=True)
@@ -558,6 +563,8 @@ def _convert(path: str, value: Any, meta: dict) -> Any:
         if lo > hi:
             raise SpecError(path, value, "must be [low, high] with low <= high")
         return (lo, hi)
+    if kind == "section":
+        return value if isinstance(value, meta["section"]) else _section(meta["section"], path, value)
     if kind == "name":
         if not isinstance(value, str) or not _NAME_RE.fullmatch(value) or value in (".", ".."):
             raise SpecError(path, value, "must be 1-64 characters of A-Z a-z 0-9 . _ - "
@@ -581,7 +588,13 @@ def _section(cls: type, path: str, data: Any) -> Any:
             values[name] = _convert(f"{path}.{name}", data[name], dict(f.metadata))
         elif f.default is dataclasses.MISSING:
             raise SpecError(f"{path}.{name}", None, f"is required ({f.metadata['doc']})")
-    return cls(**values)
+    own = SECTION_NAMES.get(cls, "")
+    try:
+        return cls(**values)
+    except SpecError as err:  # a cross-field check names the table by its own name: name it where it sits
+        if path == own or not err.field.startswith(own + "."):
+            raise
+        raise SpecError(path + err.field[len(own):], err.value, err.allowed) from None
 
 
 def _cross_checks(spec: Spec) -> None:
@@ -804,9 +817,14 @@ def schema() -> list[dict]:
     rows.append({"key": "name", "unit": "", "default": None, "allowed": "A-Z a-z 0-9 . _ - (1-64)",
                  "required": True, "doc": name_meta["doc"], "kind": "name", "choices": [], "lo": None,
                  "hi": None, "lo_open": True, "required_in_table": True})
-    for section, cls in [*SECTIONS.items(), ("taxel[]", TaxelEntry)]:
+    tables = [*SECTIONS.items(), ("taxel[]", TaxelEntry)]
+    tables += [(f"{name}.{f.name}", f.metadata["section"]) for name, cls in tables for f in dataclasses.fields(cls)
+               if f.metadata["kind"] == "section"]  # sub-tables, e.g. taxel[].calibration
+    for section, cls in tables:
         for f in dataclasses.fields(cls):
             meta = f.metadata
+            if meta["kind"] == "section":
+                continue
             allowed = _allowed_text(dict(meta))
             default = None if f.default is dataclasses.MISSING else f.default
             required = f.default is dataclasses.MISSING and section in REQUIRED_SECTIONS

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from matcad.spec import Cavity, EndCap, Neck, Needle, Spec, TaxelEntry
+from matcad.spec import Calibration, Cavity, EndCap, Neck, Needle, Spec, TaxelEntry
 
 ENTRY_FIELDS = {
     "cavity.diameter": "cavity_diameter", "cavity.length": "cavity_length", "neck.diameter": "neck_diameter",
@@ -23,7 +23,8 @@ ENTRY_FIELDS = {
 @dataclass(frozen=True)
 class Taxel:
     """One resonator of a board: its name, where its neck axis is on the neck plate (x, y in mm, plate centre =
-    origin) and its own validated geometry. ``neck.length`` is the plate's sheet, the same for every taxel."""
+    origin) and its own validated geometry. ``neck.length`` is the plate's sheet, the same for every taxel.
+    ``calibration``: its own Eq. 5 calibration ([taxel.calibration]), None when the spec gives it none."""
 
     name: str
     x: float
@@ -32,6 +33,7 @@ class Taxel:
     neck: Neck
     end_cap: EndCap
     needle: Needle
+    calibration: Calibration | None = None
 
 
 def _override(section, prefix: str, entry: TaxelEntry):
@@ -43,7 +45,8 @@ def _override(section, prefix: str, entry: TaxelEntry):
 def _from_entry(spec: Spec, index: int, entry: TaxelEntry) -> Taxel:
     return Taxel(name=entry.name or f"t{index}", x=entry.x, y=entry.y,
                  cavity=_override(spec.cavity, "cavity", entry), neck=_override(spec.neck, "neck", entry),
-                 end_cap=_override(spec.end_cap, "end_cap", entry), needle=_override(spec.needle, "needle", entry))
+                 end_cap=_override(spec.end_cap, "end_cap", entry), needle=_override(spec.needle, "needle", entry),
+                 calibration=entry.calibration)
 
 
 def grid_positions_mm(columns: int, rows: int, pitch_x: float | None, pitch_y: float | None) \
@@ -81,7 +84,9 @@ def field_path(spec: Spec, index: int, key: str) -> str:
 
 
 def taxel_spec(spec: Spec, taxel: Taxel) -> Spec:
-    """A single-taxel spec with ``taxel``'s geometry (its position dropped): how per-taxel physics (predict, wall
-    modes, cap mechanics) is applied to one taxel of a board."""
+    """A single-taxel spec with ``taxel``'s geometry (its position dropped) and its own calibration when it has
+    one (else the spec's [calibration]): how per-taxel physics (predict, wall modes, cap mechanics) is applied to
+    one taxel of a board."""
+    calibration = taxel.calibration if taxel.calibration is not None else spec.calibration
     return dataclasses.replace(spec, cavity=taxel.cavity, neck=taxel.neck, end_cap=taxel.end_cap,
-                               needle=taxel.needle, array=None, taxel=())
+                               needle=taxel.needle, calibration=calibration, array=None, taxel=())

@@ -241,6 +241,8 @@ def test_every_numeric_field_at_its_extremes_gives_finite_json_or_exit_2(tmp_pat
         section, _, name = row["key"].partition(".")
         if not name or not isinstance(row["default"], (float, type(None))) or "a finite number" not in row["allowed"]:
             continue
+        if "." in name:  # a sub-table's field (taxel[].calibration.*): the same declaration is tried at its table
+            continue
         entry = section == "taxel[]"  # a [[taxel]] field: one entry at the centre carrying it
         cls = spec_mod.TaxelEntry if entry else spec_mod.SECTIONS[section]
         meta = dict(next(f for f in dataclasses.fields(cls) if f.name == name).metadata)

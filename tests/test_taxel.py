@@ -59,7 +59,11 @@ def test_a_shared_end_cap_the_user_gave_is_every_taxel_s():
 
 @pytest.mark.parametrize("extra", [
     {"array": {"columns": 2, "rows": 2, "pitch_x": 12.0, "pitch_y": 12.0}},
-    {"taxel": [{"x": -6.0, "y": 0.0, "cavity_length": 5.0}, {"x": 6.0, "y": 0.0, "name": "b", "needle_y": 0.5}]}])
+    {"taxel": [{"x": -6.0, "y": 0.0, "cavity_length": 5.0}, {"x": 6.0, "y": 0.0, "name": "b", "needle_y": 0.5}]},
+    {"taxel": [{"x": -6.0, "y": 0.0, "calibration": {"v0_mm3": 36.0, "a": -0.0086, "b": 0.4626}},
+               {"x": 6.0, "y": 0.0, "calibration": {"v0_mm3": 30.0, "a": -0.01, "b": 0.5, "k_mm3_hz2": 7.9e8,
+                                                    "force_range_n": [0.0, 15.0], "dof": 8,
+                                                    "covariance": [1.0, 0, 0, 0, 0.01, 0, 0, 0, 1e-4]}}]}])
 def test_array_specs_round_trip(extra):
     spec = spec_mod.from_dict(_paper(**extra))
     assert spec_mod.from_dict(spec_mod.to_dict(spec)) == spec
@@ -76,6 +80,14 @@ def test_array_specs_round_trip(extra):
     ({"taxel": [{"x": 0.0, "y": 0.0, "name": "a/b"}]}, "taxel[1].name", "A-Z"),
     ({"taxel": [{"x": float("nan"), "y": 0.0}]}, "taxel[1].x", "finite"),
     ({"taxel": []}, "taxel", "1 to 64"),
+    ({"taxel": [{"x": 0.0, "y": 0.0, "calibration": {"v0_mm3": 36.0, "a": 0.0, "b": 0.5, "k_mm3_hz2": -1.0}}]},
+     "taxel[1].calibration.k_mm3_hz2", "0 < value <= 1e+30 mm^3 Hz^2"),
+    ({"taxel": [{"x": 0.0, "y": 0.0}, {"x": 1.0, "y": 0.0, "calibration": {"a": 0.0, "b": 0.5}}]},
+     "taxel[2].calibration.v0_mm3", "is required"),
+    ({"taxel": [{"x": 0.0, "y": 0.0, "calibration": {"v0_mm3": 36.0, "a": 0.0, "b": 0.5,
+                                                      "covariance": [1, 2, 3, 4, 5, 6, 7, 8, 9]}}]},
+     "taxel[1].calibration.covariance", "symmetric"),
+    ({"taxel": [{"x": 0.0, "y": 0.0, "calibration": 3.0}]}, "taxel[1].calibration", "must be a table"),
     ({"taxel": {"x": 0.0, "y": 0.0}}, "taxel", "[[taxel]] tables"),
     ({"taxel": [{"x": float(i), "y": 0.0} for i in range(65)]}, "taxel", "1 to 64"),
     ({"array": {"columns": 2}}, "array.pitch_x", "required"),
@@ -92,3 +104,7 @@ def test_bad_array_input_names_the_field(extra, field, words):
 def test_schema_lists_the_taxel_entry_fields():
     keys = {row["key"] for row in spec_mod.schema()}
     assert {"array.columns", "array.pitch_x", "taxel[].x", "taxel[].cavity_diameter", "taxel[].name"} <= keys
+    # the [taxel.calibration] sub-table: exactly the fields of [calibration], listed from the same declarations
+    assert {k.removeprefix("taxel[].") for k in keys if k.startswith("taxel[].calibration.")} == \
+        {k for k in keys if k.startswith("calibration.")}
+    assert "taxel[].calibration" not in keys

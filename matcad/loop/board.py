@@ -11,8 +11,14 @@ neighbour's tone lies in the neighbour's band: it is that taxel's tone, not a di
 still reported, and a second line inside a taxel's own band is reported as before. A silent taxel does not stop
 the others: its track carries the reason; "no tone" (exit 1) only when no taxel has one.
 
-Calibrations: each taxel has its own Eq. 5 calibration (``matcad calibrate`` per taxel), given to ``sense`` as
-``--calibration NAME=FILE`` once per taxel; a taxel without one gets frequencies, no force.
+Calibrations: each taxel has its own Eq. 5 calibration (``matcad calibrate --taxel NAME`` per taxel), carried in
+the spec as that [[taxel]] entry's [taxel.calibration] table or given to ``sense`` as ``--calibration NAME=FILE``
+(which overrides the spec's for that taxel); a taxel without one gets frequencies, no force
+(:func:`board_calibrations`).
+
+Live output (``sense --live``): each tracker reports a frame once its voicing is final, and the trackers finish
+frames at different moments (a candidate run waits until it qualifies); :class:`LiveFrames` joins the reports into
+one row per frame, in time order, as soon as every taxel has decided that frame.
 """
 
 from __future__ import annotations
@@ -80,6 +86,53 @@ def parse_calibrations(values, names) -> dict[str, str]:
             raise ValueError(f"--calibration {value!r}: taxel {name!r} is given twice")
         out[name] = path
     return out
+
+
+def board_calibrations(spec, values) -> dict:
+    """{taxel name: (source text, :class:`matcad.spec.Calibration`)} for a board: each taxel's [taxel.calibration]
+    from ``spec``, overridden by ``--calibration NAME=FILE`` ``values`` (:func:`parse_calibrations`). ValueError
+    (exit 2) when neither gives any calibration, or naming the file or field when one is bad."""
+    from matcad.spec import load_calibration
+    from matcad.taxel import taxels
+
+    board = taxels(spec)
+    names = [t.name for t in board]
+    files = parse_calibrations(values or (), names)
+    out = {t.name: ("spec [taxel.calibration]", t.calibration) for t in board if t.calibration is not None}
+    out |= {name: (path, load_calibration(path)) for name, path in files.items()}
+    if not out:
+        raise ValueError(f"--calibration is required: {spec.name} has no [taxel.calibration] table; give one per "
+                         f"taxel in the spec or as --calibration NAME=FILE, NAME one of {', '.join(names)}")
+    return {name: out[name] for name in names if name in out}
+
+
+class LiveFrames:
+    """The ``on_frame`` callback of :func:`analyze_board` for live output: collects (frequency Hz or NaN, excess
+    dB) per taxel and frame index and calls ``emit(time s, [(frequency, excess) per taxel])`` once per frame, in
+    frame order, as soon as every taxel has reported that frame. Each tracker reports its frames in order, so a
+    frame's index is the count of that taxel's earlier reports; the rows kept are those between the slowest and
+    the fastest taxel (at most ~LAG_FRAMES + MIN_RUN frames): memory stays bounded."""
+
+    def __init__(self, count: int, emit):
+        self.count, self.emit = count, emit
+        self.reported = [0] * count  # frames reported so far, per taxel
+        self.rows: dict[int, tuple[float, list]] = {}
+        self.next = 0  # the next frame to emit
+
+    def __call__(self, k: int, time_s: float, freq: float, excess: float) -> None:
+        i = self.reported[k]
+        self.reported[k] += 1
+        self.rows.setdefault(i, (time_s, [None] * self.count))[1][k] = (freq, excess)
+        while self.next in self.rows and None not in self.rows[self.next][1]:
+            self.emit(*self.rows.pop(self.next))
+            self.next += 1
+
+    def flush(self) -> None:
+        """Emit the frames some taxel never reported (its tracker stopped early), a missing taxel as (NaN, NaN)."""
+        for i in sorted(self.rows):
+            time_s, values = self.rows.pop(i)
+            self.emit(time_s, [v if v is not None else (float("nan"), float("nan")) for v in values])
+        self.next = max(self.reported, default=0)
 
 
 def frame_times(tracks) -> np.ndarray:

@@ -70,10 +70,11 @@ class CalibrationFit:
                 "outliers": [{"point": i + 1, "studentized_residual": r} for i, r in self.outliers],
                 "notes": list(self.notes)}
 
-    def to_toml(self) -> str:
-        """A [calibration] table that a spec accepts as it is."""
+    def to_toml(self, table: str = "calibration") -> str:
+        """A [calibration] table that a spec accepts as it is (``table`` "taxel.calibration": the same fields as
+        one [[taxel]] entry's sub-table)."""
         cov = ", ".join(repr(float(x)) for x in self.covariance.ravel())
-        return ("# written by `matcad calibrate`: paper Eq. 5, V_eff = v0 - a F^2 - b F\n[calibration]\n"
+        return (f"# written by `matcad calibrate`: paper Eq. 5, V_eff = v0 - a F^2 - b F\n[{table}]\n"
                 f"v0_mm3 = {self.v0_mm3!r}\na = {self.a!r}\nb = {self.b!r}\narea_convention = \"pi_d2/4\"\n"
                 f"k_mm3_hz2 = {self.k_mm3_hz2!r}\nforce_range_n = [{self.force_range_n[0]!r}, "
                 f"{self.force_range_n[1]!r}]\ncovariance = [{cov}]\n"
