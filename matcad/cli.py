@@ -813,8 +813,9 @@ def _parser() -> argparse.ArgumentParser:
     n.add_argument("--set", action="append", metavar="KEY=VALUE", help="override one field of --spec (TOML value)")
     n.add_argument("--temperature-c", type=float, help="air temperature now (degC): frequencies are scaled by "
                                                        "sqrt(T_cal/T) to the calibration's temperature")
-    n.add_argument("--live", action="store_true", help="print each frame's force as it is decided (~1 s lag); "
-                                                       "no output folder unless --out")
+    n.add_argument("--live", action="store_true", help="print each frame's force as it is decided (~1 s lag, up "
+                                                       "to ~2 s while a new line is held: a voice, a reverberant "
+                                                       "room); no output folder unless --out")
     for cmd in (a, n):
         cmd.add_argument("--format", choices=("s16le", "s24le", "s32le", "u8", "f32le", "f64le"),
                          help="raw PCM sample format on standard input (default: a WAV header is expected)")
