@@ -533,7 +533,11 @@ class BandTracker:
             raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz: no frame has a line >= {STRONG_DB:g} dB over the "
                             f"local noise floor, nor >= {WEAK_DB:g} dB steady for {MIN_RUN} frames (best frame "
                             f"{np.max(excess):.1f} dB){hint}")
-        segments = _segments(times, track, state, self.df)
+        from matcad.loop.crossing import follow_taxel  # the taxel's line through hops and crossings of two tones
+
+        ident = follow_taxel(times, track, state, np.array(self.other_bin), np.array(self.other_excess),
+                             np.array(self.other_level), excess, self.freqs[self.in_band])
+        track, state, segments = ident.track_hz, ident.state, list(ident.segments)
         flagged = [s for s in segments if s.flag]
         for s in flagged:
             state[(times >= s.start_s) & (times <= s.end_s) & (state == 1)] = 2
@@ -548,10 +552,10 @@ class BandTracker:
             raise LoopError(f"the ridge hugs the band edge ({100 * edge:.0f} % of voiced frames within {EDGE_BINS} "
                             f"bins of {lo:.0f} or {hi:.0f} Hz): the tone is probably outside the band; widen "
                             f"it{hint}")
-        other_excess, other_level = np.array(self.other_excess), np.array(self.other_level)
-        sources = _second_sources(np.array(self.other_bin)[voiced], other_excess[voiced], other_level[voiced],
+        other_excess, other_level = ident.other_excess, ident.other_level
+        sources = _second_sources(ident.other_bin[voiced], other_excess[voiced], other_level[voiced],
                                   self.freqs[self.in_band])
-        warnings = []
+        warnings = list(ident.warnings)
         if loudest:
             warnings.append(f"{loudest} was ignored: hum, a harmonic or another source")
         for s in sources:

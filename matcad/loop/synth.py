@@ -319,3 +319,31 @@ def board_scenario(seconds: float = 10.0, seed: int = 0, fs: float = FS, f0_hz=B
     x = _room(x, fs, seed, rt60=0.4)
     return BoardRecording(x, fs, tuple(f"t{k + 1}" for k in range(len(f0_hz))), np.array(freqs), np.array(forces),
                           tuple(board_band_hz(f0) for f0 in f0_hz))
+
+
+# --- two taxels of equal level crossing inside one band --------------------------------------------------------------
+
+CROSSING_KINDS = ("pass", "touch", "other-pressed")
+"""Kinds of :func:`crossing_scenario`: the taxel pressed through the neighbour's steady tone and back ("pass"), the
+taxel pressed up to the neighbour's pitch and released ("touch"), the neighbour pressed through the taxel's steady
+tone and back ("other-pressed")."""
+
+
+def crossing_scenario(kind: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) -> Recording:
+    """The taxel (truth) and a second taxel of EQUAL level in one band whose pitches cross (kinds
+    :data:`CROSSING_KINDS`). The pressed one goes 2 → 14 N with 1 s ramps (Eq. 5: ~4450 → ~4710 Hz, ~250 Hz/s)
+    through the other's steady 8 N pitch (~4600 Hz), or, for "touch", 2 → 8 N and back (0.3 s at the other's
+    pitch). The neighbour starts singing 1 s after the taxel: with equal levels and one band nothing else says
+    which tone is the taxel. Room as :func:`scenario` (pink noise, RT60 0.5 s, tablet microphone)."""
+    if kind not in CROSSING_KINDS:
+        raise ValueError(f"crossing kind {kind!r} invalid, must be one of {CROSSING_KINDS}")
+    n = int(seconds * fs)
+    t = np.arange(n) / fs
+    up = seconds * 0.25
+    steps = [(up, up + 2.3, 8.0)] if kind == "touch" else [(up, up + 4.5, 14.0)]
+    moving = press_profile(seconds, fs, steps, ramp_s=1.0)
+    still = np.full(n, 8.0)
+    force, other = (still, moving) if kind == "other-pressed" else (moving, still)
+    x, truth = _base(seconds, fs, seed, force)
+    x = x + taxel(frequency_of_force(other), fs, seed + 7, gate=(t > 1.0).astype(float))
+    return Recording(_room(x, fs, seed), fs, truth, force)
