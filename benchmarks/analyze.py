@@ -13,10 +13,14 @@
 4. A board: four taxels singing at once (synth.board_scenario; t2 and t4 pressed 2 → 12 N), each tracked in its
    own band — per taxel the mean per-frame error, track RMS, frames wrong and voiced; and issue 11's neighbour case
    with the louder neighbour in its own band.
-5. Memory and time of `matcad analyze` on 10 s, 10 min and 60 min WAV files (peak RSS from /usr/bin/time -v, or
+5. Two taxels of equal level crossing in one band (synth.crossing_scenario: pass-through, touch and return, the
+   other pressed through): frames wrong, swapped and flagged, the ridge alone (before matcad.loop.crossing) and
+   after.
+6. Memory and time of `matcad analyze` on 10 s, 10 min and 60 min WAV files (peak RSS from /usr/bin/time -v, or
    resource.getrusage of the child when it is missing).
 
-Run: /work/venv/bin/python benchmarks/analyze.py [--quick] [--memory-only | --no-memory] [--noise-minutes N]
+Run: /work/venv/bin/python benchmarks/analyze.py [--quick] [--memory-only | --no-memory | --board-only |
+--crossing-only] [--noise-minutes N]
 """
 
 import argparse
@@ -267,6 +271,58 @@ def board_table(seeds, seconds):
               f"{np.mean(col[:, 4]):.1f} | {np.mean(col[:, 5]):.0f} |")
 
 
+def _ridge_only(times, track, state, other_bin, other_excess, other_level, excess, band_freqs):
+    """matcad.loop.crossing.follow_taxel doing nothing: the ridge as the tracker gives it (the code before
+    crossing.py; its outputs were bit-identical to main's on every realistic case)."""
+    from matcad.loop.analyze import _segments
+    from matcad.loop.crossing import Identity
+
+    return Identity(np.asarray(track), np.asarray(state, dtype=int).copy(), other_bin, other_excess, other_level,
+                    tuple(_segments(times, track, state, band_freqs[1] - band_freqs[0])), ())
+
+
+def crossing_table(seeds, seconds):
+    """Two taxels of equal level crossing in one band (synth.crossing_scenario): per kind, over seeds, frames wrong
+    (voiced and > WRONG_HZ off, or missed), swapped (voiced, > WRONG_HZ off and within WRONG_HZ of the other
+    taxel), flagged (left out as overlapping or uncertain), ridge only (before matcad.loop.crossing) and after."""
+    from unittest import mock
+
+    print(f"\nTwo taxels of EQUAL level crossing in one band ({seconds:g} s, {seeds} seeds; frames whose window "
+          "spans a ramp not scored; share of scored frames):\n")
+    print("| kind | version | frames wrong | swapped frames | flagged frames | silent wrong (voiced, > 10 Hz) | "
+          "seeds with a crossing warning |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    hop = 0.0464
+    for kind in synth.CROSSING_KINDS:
+        taxel_f, other_f = synth.crossing_forces(kind, seconds, FS)
+        other_hz = synth.frequency_of_force(other_f)
+        for version in ("ridge only", "crossing.py"):
+            sums = np.zeros(4)
+            warned = 0
+            for seed in range(seeds):
+                rec = synth.crossing_scenario(kind, seconds, seed)
+                with mock.patch("matcad.loop.crossing.follow_taxel", _ridge_only) if version == "ridge only" \
+                        else mock.patch.dict({}):
+                    a = analyze(rec.x, rec.fs, rec.band_hz)
+                truth = rec.truth_at(a.times_s)
+                ramp = np.fmax(*[np.abs(rec.truth_at(a.times_s + d) - truth) for d in (-hop, hop)]) > WRONG_HZ
+                scored = np.isfinite(truth) & ~ramp
+                err = np.abs(a.track_hz - truth)
+                other = other_hz[np.clip((a.times_s * FS).astype(int), 0, len(other_hz) - 1)]
+                flagged = np.zeros(len(truth), bool)
+                for s in a.segments:
+                    if s.flag:
+                        flagged |= (a.times_s >= s.start_s) & (a.times_s <= s.end_s)
+                bad = scored & a.voiced & (err > WRONG_HZ)
+                sums += [np.sum(bad | (scored & ~a.voiced)) / scored.sum(),
+                         np.sum(bad & (np.abs(a.track_hz - other) <= WRONG_HZ)) / scored.sum(),
+                         np.sum(scored & flagged) / scored.sum(), np.sum(bad) / scored.sum()]
+                warned += any("crossed" in w for w in a.warnings)
+            sums /= seeds
+            print(f"| {kind} | {version} | {100 * sums[0]:.1f} % | {100 * sums[1]:.1f} % | {100 * sums[2]:.1f} % | "
+                  f"{100 * sums[3]:.1f} % | {warned}/{seeds} |")
+
+
 def write_long_wav(path, minutes):
     """A long 16-bit recording written 10 s at a time (never held whole): the 'presses' case repeated."""
     block = synth.scenario("presses", 10.0, 0)
@@ -310,6 +366,7 @@ def main():
     parser.add_argument("--memory-only", action="store_true")
     parser.add_argument("--no-memory", action="store_true", help="skip the long files")
     parser.add_argument("--board-only", action="store_true", help="only the board table")
+    parser.add_argument("--crossing-only", action="store_true", help="only the crossing table")
     parser.add_argument("--speech-seeds", type=int, default=20, help="seeds of the speech cases (they vary most)")
     parser.add_argument("--noise-minutes", type=float, default=10.0,
                         help="minutes of each noise for the false-alarm table (0 skips it)")
@@ -320,10 +377,14 @@ def main():
     if args.board_only:
         board_table(3, 10.0)
         return
+    if args.crossing_only:
+        crossing_table(10, 10.0)
+        return
     if not args.memory_only:
         clean_tone_table()
         realistic_table(2 if args.quick else 3, 5.0 if args.quick else 10.0, 2 if args.quick else args.speech_seeds)
         board_table(2 if args.quick else 3, 5.0 if args.quick else 10.0)
+        crossing_table(5 if args.quick else 10, 10.0)
         if args.noise_minutes > 0:
             false_alarm_table(1 if args.quick else args.noise_minutes)
     if not args.no_memory:

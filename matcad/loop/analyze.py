@@ -45,7 +45,10 @@ The paper used MATLAB spectrogram + tfridge and a pspectrum peak in 4–5.5 kHz.
    without a ramp in between, cannot be a press (Eq. 5 spans ~+11 % from 0 to 25 N): it is flagged as a mode
    jump (overblowing) and its frames are left out of the statistics.
 6. *Other sources.* A second stable line in the band (a neighbouring taxel) is reported with its frequency and
-   level; a stronger tone outside the band (hum, a harmonic) is reported, never taken.
+   level; a stronger tone outside the band (hum, a harmonic) is reported, never taken. When a second tone of
+   similar level shares the band, :mod:`matcad.loop.crossing` keeps the taxel on its own line where the ridge
+   hops to the other or the two cross (by slope, else level), and leaves out, with a warning, the frames after a
+   crossing whose identity nothing decides.
 
 Frequencies Hz, times s, levels dB.
 """

@@ -9,11 +9,12 @@ Per frame the tracker keeps the ridge and the strongest other line (its bin, exc
 1. *The second tone.* The other line counts as a tone where it stands ≥ WEAK_DB over its floor, within
    :data:`COMPARABLE_DB` of the ridge, and moves ≤ :data:`LINE_STEP_BINS` bins a frame for ≥ MIN_RUN frames.
 2. *Hops.* The ridge jumps more than :data:`HOP_BINS` bins while the second tone now sits closer to where
-   the ridge was than half the jump: the taxel's line went on; the taxel stays on it (the ridge is now the
+   the ridge was than half the jump, or the ridge lands where the second tone was: the taxel's line went on; the taxel stays on it (the ridge is now the
    other tone). Said in a warning.
 3. *Crossings.* The second tone disappears into the ridge (within the main lobe, ±EXCLUDE_BINS, it is not seen)
    or comes within :data:`NEAR_BINS` of it for :data:`MIN_MEET_FRAMES` to :data:`MAX_MEET_FRAMES` frames, having come within
-   :data:`APPROACH_BINS` before and leaving within it after. Which line after it is the taxel is decided from what tells them apart: the slopes of both lines over
+   :data:`APPROACH_BINS` before and leaving within it after. Which line after it is the taxel is decided from
+   what tells them apart: the slopes (Theil-Sen, robust to a stray line) of both lines over
    :data:`WINDOW_FRAMES` frames before and after (a line that was moving keeps moving, a steady one stays; the
    pairing whose slope mismatch is smaller by ≥ :data:`SLOPE_CLEAR_HZ_S`), else their levels (the taxel's line
    ≥ :data:`LEVEL_CLEAR_DB` louder or weaker than the other's on both sides; less is the ridge's own selection
@@ -43,6 +44,9 @@ MAX_DROP_FRAMES = 2
 """Frames a line may go unseen (weaker, or another line picked) without ending it."""
 HOP_BINS = 12
 """A ridge jump larger than this (bins, ~65 Hz) may be a hop to another tone."""
+HOP_LOOK_FRAMES = 10
+"""After a ridge jump, the line it left may be unseen this many frames (~0.46 s) before it shows as a second tone
+(a weaker taxel under a newcomer's skirt)."""
 NEAR_BINS = 10
 """Lines closer than this (bins, ~54 Hz; the main lobe hides one within EXCLUDE_BINS = 6) are meeting."""
 APPROACH_BINS = 20
@@ -122,10 +126,10 @@ def follow_taxel(times, track, state, other_bin, other_excess, other_level, exce
                         f"that {why}; {len(meet)} frames where they overlapped left out")
     role = hopped ^ on_b  # the taxel is the other line
     for _, k, _ in hops:
-        i = voiced[k]
+        i, j = voiced[k], voiced[k - 1]
         if role[i] and not left_out[i]:
-            warnings.append(f"the ridge jumped at t={times[i]:.2f} s to another tone at {track[i]:.0f} Hz while "
-                            f"the taxel's line went on at {other_hz[i]:.0f} Hz: the taxel is kept on its line")
+            warnings.append(f"the ridge jumped at t={times[i]:.2f} s from {track[j]:.0f} Hz to another tone at "
+                            f"{track[i]:.0f} Hz while the taxel's line went on: the taxel is kept on its line")
     if not np.any(role) and not np.any(left_out):
         return Identity(np.asarray(track), state, other_bin, other_excess, other_level,
                         tuple(_segments(times, track, state, df)), ())
@@ -133,7 +137,7 @@ def follow_taxel(times, track, state, other_bin, other_excess, other_level, exce
     new_track = np.where(swapped, other_hz, track)
     last = np.nan
     for i in np.flatnonzero(swapped):  # the taxel's line seen: a tone, or a line where it just was
-        if tone[i] or (other_excess[i] >= WEAK_DB and abs(other_hz[i] - last) <= LINE_STEP_BINS * df):
+        if tone[i] or (other_excess[i] >= WEAK_DB and abs(other_hz[i] - last) <= LINE_STEP_BINS // 2 * df):
             last = other_hz[i]
         else:
             state[i] = 0
@@ -180,15 +184,19 @@ def _second_tone(voiced, track, other_hz, other_excess, other_level, df) -> np.n
 
 def _hops(voiced, track, other_hz, tone, df) -> list:
     """('hop', k, k) where the ridge jumps > HOP_BINS between frames k−1 and k and the second tone at k (or
-    within 2 frames after, where the moved line is seen again) sits closer to the ridge at k−1 than half the jump (the line the ridge left goes on)."""
+    where it is first seen within HOP_LOOK_FRAMES after) sits closer to the ridge at k−1 than half the jump (the
+    line the ridge left goes on), or the ridge at k lands that close to where the second tone was last seen (within
+    HOP_LOOK_FRAMES before): either way the two lines swapped places on the ridge."""
     out = []
     for k in range(1, len(voiced)):
         i, j = voiced[k], voiced[k - 1]
         jump = abs(track[i] - track[j])
         if i - j > 3 or jump <= HOP_BINS * df:
             continue
-        seen = [m for m in voiced[k:k + 3] if tone[m] and m - i <= 2]
-        if seen and abs(other_hz[seen[0]] - track[j]) <= 0.5 * jump:
+        seen = [m for m in voiced[k:k + HOP_LOOK_FRAMES + 1] if tone[m] and m - i <= HOP_LOOK_FRAMES]
+        was = [m for m in voiced[max(0, k - HOP_LOOK_FRAMES):k] if tone[m] and j - m <= HOP_LOOK_FRAMES]
+        if ((seen and abs(other_hz[seen[0]] - track[j]) <= 0.5 * jump)
+                or (was and abs(other_hz[was[-1]] - track[i]) <= 0.5 * jump)):
             out.append(("hop", k, k))
     return out
 
@@ -226,9 +234,10 @@ def _decide(times, line_a, line_b, level_ba, was_b, before, after):
     if len(before) < 3 or len(after) < 3:
         return None, ""
 
-    def slope(frames, f):
-        t = times[frames]
-        return float(np.polyfit(t - t.mean(), f[frames], 1)[0])
+    from scipy.stats import theilslopes
+
+    def slope(frames, f):  # Theil-Sen: a blend or a stray line in the window does not tip it
+        return float(theilslopes(f[frames], times[frames])[0])
 
     s_a, s_b = slope(before, line_a), slope(before, line_b)
     s_taxel, s_rest = (s_b, s_a) if was_b else (s_a, s_b)

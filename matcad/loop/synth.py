@@ -329,21 +329,26 @@ taxel pressed up to the neighbour's pitch and released ("touch"), the neighbour 
 tone and back ("other-pressed")."""
 
 
-def crossing_scenario(kind: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) -> Recording:
-    """The taxel (truth) and a second taxel of EQUAL level in one band whose pitches cross (kinds
-    :data:`CROSSING_KINDS`). The pressed one goes 2 → 14 N with 1 s ramps (Eq. 5: ~4450 → ~4710 Hz, ~250 Hz/s)
-    through the other's steady 8 N pitch (~4600 Hz), or, for "touch", 2 → 8 N and back (0.3 s at the other's
-    pitch). The neighbour starts singing 1 s after the taxel: with equal levels and one band nothing else says
-    which tone is the taxel. Room as :func:`scenario` (pink noise, RT60 0.5 s, tablet microphone)."""
+def crossing_forces(kind: str, seconds: float = 10.0, fs: float = FS) -> tuple[np.ndarray, np.ndarray]:
+    """Per-sample forces (N) of the taxel and of the neighbour in :func:`crossing_scenario`: the pressed one goes
+    2 → 14 N with 1 s ramps (Eq. 5: ~4450 → ~4710 Hz, ~250 Hz/s) through the other's steady 8 N pitch (~4600 Hz)
+    and back, or, for "touch", 2 → 8 N and back (0.3 s at the other's pitch)."""
     if kind not in CROSSING_KINDS:
         raise ValueError(f"crossing kind {kind!r} invalid, must be one of {CROSSING_KINDS}")
-    n = int(seconds * fs)
-    t = np.arange(n) / fs
     up = seconds * 0.25
     steps = [(up, up + 2.3, 8.0)] if kind == "touch" else [(up, up + 4.5, 14.0)]
     moving = press_profile(seconds, fs, steps, ramp_s=1.0)
-    still = np.full(n, 8.0)
-    force, other = (still, moving) if kind == "other-pressed" else (moving, still)
+    still = np.full(len(moving), 8.0)
+    return (still, moving) if kind == "other-pressed" else (moving, still)
+
+
+def crossing_scenario(kind: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) -> Recording:
+    """The taxel (truth) and a second taxel of EQUAL level in one band whose pitches cross (kinds
+    :data:`CROSSING_KINDS`, forces :func:`crossing_forces`). The neighbour starts singing 1 s after the taxel: with
+    equal levels and one band nothing else says which tone is the taxel. Room as :func:`scenario` (pink noise,
+    RT60 0.5 s, tablet microphone)."""
+    force, other = crossing_forces(kind, seconds, fs)
     x, truth = _base(seconds, fs, seed, force)
+    t = np.arange(len(force)) / fs
     x = x + taxel(frequency_of_force(other), fs, seed + 7, gate=(t > 1.0).astype(float))
     return Recording(_room(x, fs, seed), fs, truth, force)
