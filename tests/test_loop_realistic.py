@@ -62,8 +62,9 @@ def test_a_tone_that_starts_while_someone_speaks_is_found_from_its_start():
 
 def test_room_noise_false_alarms_are_cut_by_the_adaptive_thresholds():
     """Broadband noise through a reverberant room (RT60 0.6 s) leaves short steady lines at the room's response
-    peaks. Thresholds raised by the clutter's tail (CFAR) cut them from 6.5 % of frames to 2.7 % over these 5 seeds
-    (benchmarks/analyze.py, room-noise) — a documented limit, not a rejection; without the shift this fails."""
+    peaks. Thresholds raised by the clutter's tail (CFAR) and MIN_RUN_NEW frames for a tone starting from nothing cut
+    them from 6.5 % of frames to 0.28 % over these 5 seeds, "no tone" in 4 (benchmarks/analyze.py, room-noise) —
+    reduced, not rejected; with MIN_RUN instead of MIN_RUN_NEW this fails (2.7 %, 3 of 5)."""
     voiced = []
     for seed in range(5):
         rec = synth.scenario("room-noise", 10.0, seed)
@@ -71,14 +72,14 @@ def test_room_noise_false_alarms_are_cut_by_the_adaptive_thresholds():
             voiced.append(analyze(rec.x, rec.fs, rec.band_hz).tone_fraction)
         except LoopError:
             voiced.append(0.0)
-    assert np.mean(voiced) < 0.04, voiced
-    assert sum(v == 0.0 for v in voiced) >= 3, voiced
+    assert np.mean(voiced) < 0.01, voiced
+    assert sum(v == 0.0 for v in voiced) >= 4, voiced
 
 
 def test_only_short_voiced_stretches_are_warned_about():
     """What room noise still voices comes in stretches shorter than 10 frames (0.46 s): the analysis says so. A
     singing taxel, pressed, tapped or gated, holds a longer stretch somewhere and gets no such warning."""
-    rec = synth.scenario("room-noise", 10.0, 0)
+    rec = synth.scenario("room-noise", 10.0, 2)
     a = analyze(rec.x, rec.fs, rec.band_hz)
     assert any("no voiced stretch lasts 10 frames" in w for w in a.warnings), a.warnings
     for name in ("tapping", "presses", "short-tone"):
