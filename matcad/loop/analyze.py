@@ -813,6 +813,13 @@ def plot(analysis: Analysis, path, forces=None) -> None:
         bx.plot(analysis.times_s, force, "k.", ms=2, label="force per voiced frame")
         bx.set(ylabel="force [N]")
         bx.legend(loc="upper right", fontsize=8)
+    save_time_figure(fig, axes, path)
+
+
+def save_time_figure(fig, axes, path) -> None:
+    """Label the shared time axis (s) of a column of panels and write the figure as PNG (100 dpi)."""
+    import matplotlib.pyplot as plt
+
     axes[-1, 0].set(xlabel="time [s]")
     fig.tight_layout()
     fig.savefig(path, dpi=100)

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from matcad.loop import LoopError
-from matcad.loop.analyze import Analysis, run_trackers
+from matcad.loop.analyze import Analysis, run_trackers, save_time_figure
 
 
 @dataclass(frozen=True)
@@ -242,10 +242,7 @@ def plot(tracks, path, readings=None) -> None:
             bx.plot(times, r.frames_n, color=colour, lw=1, label=t.name)
         bx.set(ylabel="force [N]")
         bx.legend(loc="upper right", fontsize=7)
-    axes[-1, 0].set(xlabel="time [s]")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save_time_figure(fig, axes, path)
 
 
 def sense_board(tracks, calibrations, temperature_c=None) -> dict:
