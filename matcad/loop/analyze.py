@@ -441,10 +441,11 @@ class BandTracker:
         """Voicing state machine: candidate runs (frames ≥ WEAK_DB on a stable line; a frame whose line is one of a
         harmonic comb is none) qualify by length (MIN_RUN) or strength (STRONG_RUN frames, one ≥ STRONG_DB). Away from
         an established tone (a run of MIN_RUN_HARMONIC frames within ANCHOR_FRAMES before it) a run must do more:
-        near a harmonic sound it needs MIN_RUN_HARMONIC frames; elsewhere it must qualify with both thresholds raised
-        by the clutter's shift (:meth:`_threshold_shift`). A run that would have qualified otherwise is held, and
-        voiced after all when an established tone starts within ANCHOR_FRAMES after it (a tone that begins while
-        someone speaks or a fan blows in a reverberant room)."""
+        near a harmonic sound it needs MIN_RUN_HARMONIC frames; elsewhere, with no voiced frame within ANCHOR_FRAMES
+        before it, it needs MIN_RUN_NEW frames (or the strength shortcut) over both thresholds raised by the
+        clutter's shift (:meth:`_threshold_shift`). A run that would have qualified otherwise is held, and voiced
+        after all when an established tone starts within ANCHOR_FRAMES after it (a tone that begins while someone
+        speaks or a fan blows in a reverberant room)."""
         e = -np.inf if self.harmonic[i] else self.excess[i]
         shifted = e - self._threshold_shift(i)
         start = self._run_start
@@ -476,7 +477,7 @@ class BandTracker:
         if start < 0:
             qualifies = False
         elif length >= MIN_RUN_HARMONIC or start - self._anchor_end <= ANCHOR_FRAMES:
-            qualifies = lenient or length >= MIN_RUN_HARMONIC
+            qualifies = lenient  # MIN_RUN_HARMONIC >= MIN_RUN: a run that long is lenient
         elif any(self._harmonic_sound[max(0, start - HARMONIC_NEAR_FRAMES):i + HARMONIC_NEAR_FRAMES + 1]):
             qualifies = False
         elif start - self._voiced_end <= ANCHOR_FRAMES:
