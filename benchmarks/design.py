@@ -13,7 +13,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from matcad import spec as spec_mod  # noqa: E402
-from matcad.acoustics.predict import predict  # noqa: E402
+from matcad.prediction import predict  # noqa: E402
 from matcad.design import RulesFailed, Unreachable  # noqa: E402
 from matcad.design.solve import parse_vary, solve  # noqa: E402
 
@@ -42,7 +42,7 @@ def inverse_design():
 
 
 def allocation():
-    from matcad.acoustics.bands import conflicts, guard_hz, taxel_bands
+    from matcad.prediction.bands import conflicts, guard_hz, taxel_bands
     from matcad.design.allocate import allocate
 
     s = spec_mod.load(ROOT / "templates" / "mat-laser-only.toml")

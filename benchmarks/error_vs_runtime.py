@@ -21,9 +21,23 @@ sys.path.insert(0, str(ROOT))
 
 from matcad import spec as spec_mod  # noqa: E402
 from matcad.acoustics import fem, fsi  # noqa: E402
-from matcad.acoustics.predict import predict  # noqa: E402
+from matcad.prediction import predict  # noqa: E402
 from matcad.acoustics import wall as wall_model  # noqa: E402
-from matcad.acoustics.resonator import CHEAP_MODELS, evaluate, resonator, wall_arguments, wall_modes  # noqa: E402
+from matcad.acoustics.design import design  # noqa: E402
+from matcad.acoustics.registry import cheap_models, model as registered  # noqa: E402
+from matcad.acoustics.resonator import resonator, wall_modes  # noqa: E402
+
+
+def model_f(spec, name):
+    """f0 (Hz) of closed-form model ``name`` on ``spec`` at the middle of its wall ranges."""
+    d = design(spec)
+    return float(registered(name).f0_hz(resonator(d), d.wall))
+
+
+def elastic_cap(spec):
+    """The coupled FEM's cap of ``spec`` at the middle of its kHz modulus and loss ranges."""
+    d = design(spec)
+    return fsi.cap(d, *registered("elastic_wall").wall_arguments(d.wall))
 
 LEVELS = (2, 4, 8, 16)
 WALL_SWEEP_G_MPA = (0.1, 0.2, 0.35, 0.6, 1.0, 2.0, 4.0, 10.0)
@@ -79,10 +93,10 @@ def reference(levels_f):
 def run_case(name, dims):
     spec = case_spec(dims)
     p = predict(spec)
-    geom = fem.geometry_from_spec(spec)
+    geom = fem.geometry(design(spec))
     c = p.speed_of_sound_m_s
     if spec.wall.model == "silicone":  # the coupled elastic cap + air FEM at the spec's middle kHz modulus and loss
-        cap = fsi.cap_from_spec(spec, *wall_arguments(spec, "elastic_wall"))
+        cap = elastic_cap(spec)
         runs = [fsi.solve(geom, cap, p.f0_hz, level, c) for level in LEVELS]
     else:
         k0 = 2 * math.pi * p.f0_hz / (c * 1e3)
@@ -91,9 +105,9 @@ def run_case(name, dims):
     rows = []
     # rigid-wall models are scored against the rigid FEM only; a silicone case scores the two wall models
     models = ["soft_wall", "elastic_wall"] if spec.wall.model == "silicone" else [
-        m for m in CHEAP_MODELS if m in p.models and m not in ("soft_wall", "elastic_wall")]
+        m for m in cheap_models() if m in p.models and m not in ("soft_wall", "elastic_wall")]
     for model in models:
-        f, seconds = _timed(lambda: float(evaluate(resonator(spec), model, *wall_arguments(spec, model))), 20)
+        f, seconds = _timed(lambda: model_f(spec, model), 20)
         rows.append({"case": name, "model": model, "f_hz": f, "error": f / f_ref - 1, "seconds": seconds,
                      "valid": p.models[model].valid})
     for r in runs:
@@ -108,19 +122,22 @@ def wall_sweep():
     for mouth in ("mount", "baffled"):
         spec = spec_mod.load(ROOT / "templates" / "mat-paper.toml")
         spec = dataclasses.replace(spec, neck=dataclasses.replace(spec.neck, mouth=mouth))
-        res = resonator(spec)
-        geom = fem.geometry_from_spec(spec)
+        d = design(spec)
+        res = resonator(d)
+        geom = fem.geometry(d)
         c = res.c_m_s
-        rigid = fsi.solve(geom, None, float(evaluate(res, "transmission_line")), fem.DEFAULT_LEVEL, c)
+        rigid = fsi.solve(geom, None, float(registered("transmission_line").f0_hz(res)), fem.DEFAULT_LEVEL, c)
         for g_mpa in WALL_SWEEP_G_MPA:
             for eta in WALL_SWEEP_ETA:
-                fast, seconds = _timed(lambda: float(evaluate(res, "elastic_wall", g_mpa * 1e6, eta)), 5)
+                fast, seconds = _timed(lambda: float(registered("elastic_wall").f0_hz(res, shear_modulus_pa=g_mpa * 1e6,
+                                                                                      loss_factor=eta)), 5)
                 near = wall_model.mode_near(wall_modes(res, g_mpa * 1e6), fast)
-                run = fsi.solve(geom, fsi.cap_from_spec(spec, g_mpa * 1e6, eta), fast, fem.DEFAULT_LEVEL, c)
+                run = fsi.solve(geom, fsi.cap(d, g_mpa * 1e6, eta), fast, fem.DEFAULT_LEVEL, c)
                 rows.append({"mouth": mouth, "g_mpa": g_mpa, "eta": eta, "fem_hz": run.f0_hz, "q": run.q,
                              "fem_seconds": run.seconds, "wall_modes_hz": run.wall_modes_hz, "rigid_hz": rigid.f0_hz,
                              "elastic_hz": fast, "elastic_seconds": seconds,
-                             "soft_hz": float(evaluate(res, "soft_wall", g_mpa * 1e6)), "near_mode_hz": near})
+                             "soft_hz": float(registered("soft_wall").f0_hz(res, shear_modulus_pa=g_mpa * 1e6)),
+                             "near_mode_hz": near})
                 print(f"  {mouth} G {g_mpa} eta {eta}: FEM {run.f0_hz:.0f} Hz ({run.seconds:.1f} s), elastic_wall "
                       f"{fast:.0f} Hz ({fast / run.f0_hz - 1:+.2%})", flush=True)
     return rows
@@ -152,17 +169,14 @@ def ratio_sweep():
         models = ["transmission_line"] if wall == "rigid" else ["elastic_wall", "soft_wall"]
 
         def fem_f(spec):
-            res = resonator(spec)
-            guess = float(evaluate(res, "transmission_line"))
+            d = design(spec)
+            res = resonator(d)
+            guess = float(registered("transmission_line").f0_hz(res))
             if wall == "silicone":
-                cap = fsi.cap_from_spec(spec, *wall_arguments(spec, "elastic_wall"))
-                return fsi.solve(fem.geometry_from_spec(spec), cap, guess, fem.DEFAULT_LEVEL, res.c_m_s,
+                return fsi.solve(fem.geometry(d), elastic_cap(spec), guess, fem.DEFAULT_LEVEL, res.c_m_s,
                                  wall_modes=0).f0_hz
-            return fem.solve(fem.geometry_from_spec(spec), 2 * math.pi * guess / (res.c_m_s * 1e3),
+            return fem.solve(fem.geometry(d), 2 * math.pi * guess / (res.c_m_s * 1e3),
                              fem.DEFAULT_LEVEL, res.c_m_s).f0_hz
-
-        def model_f(spec, model):
-            return float(evaluate(resonator(spec), model, *wall_arguments(spec, model)))
 
         f_ref = fem_f(base)
         for name, changes in RATIO_VARIANTS.items():
@@ -282,7 +296,7 @@ def write_outputs(results, stls, sweep, ratios):
     errors = {}
     sweep_rows = [{"model": "elastic_wall", "error": r["elastic_hz"] / r["fem_hz"] - 1,
                    "valid": r["near_mode_hz"] is None} for r in sweep]
-    for model in list(CHEAP_MODELS) + ["fem"]:
+    for model in list(cheap_models()) + ["fem"]:
         key = f"fem level {fem.DEFAULT_LEVEL}" if model == "fem" else model
         picked = [r for _, rows in results.values() for r in rows if r["model"] == key]
         picked += [r for r in sweep_rows if r["model"] == key]

@@ -14,7 +14,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from matcad import spec as spec_mod  # noqa: E402
 from matcad.acoustics.load import MAT_PAPER_2024, frequency_at_force_hz, frequency_constant_mm3_hz2  # noqa: E402
-from matcad.acoustics.predict import predict  # noqa: E402
+from matcad.prediction import predict  # noqa: E402
+from matcad.acoustics.design import design  # noqa: E402
+from matcad.mechanics.case import cap_case  # noqa: E402
 from matcad.mechanics.frequency import force_curve  # noqa: E402
 from matcad.mechanics.solver import cap_curve  # noqa: E402
 
@@ -34,11 +36,11 @@ def main():
     for material in ("neo_hookean", "yeoh", "ogden"):
         spec = paper_spec(material)
         t0 = time.perf_counter()
-        curve = cap_curve(spec)
+        curve = cap_curve(cap_case(spec))
         t_mech = time.perf_counter() - t0
         f0 = predict(spec).f0_hz
         t1 = time.perf_counter()
-        fc = force_curve(spec, curve, f0)
+        fc = force_curve(design(spec), curve, f0)
         t_tl = time.perf_counter() - t1
         print(f"\n{material}: curve {t_mech:.1f} s ({curve.nodes} nodes, {curve.newton_iterations} Newton iterations, "
               f"complete: {curve.complete}), f(F) by transmission line {t_tl:.2f} s, total {t_mech + t_tl:.1f} s "
@@ -71,9 +73,9 @@ def main():
                           f"(paper {float(frequency_at_force_hz(MAT_PAPER_2024, F, c, spec.neck.diameter, spec.neck.length)) / float(frequency_at_force_hz(MAT_PAPER_2024, 0.0, c, spec.neck.diameter, spec.neck.length)):.4f})"
                           for F in (5.0, 10.0, 15.4, 25.0)))
     spec = paper_spec("ogden")
-    curve = cap_curve(spec)
+    curve = cap_curve(cap_case(spec))
     t0 = time.perf_counter()
-    fc = force_curve(spec, curve, None, fem_level=4)
+    fc = force_curve(design(spec), curve, None, fem_level=4)
     print(f"\nFEM on the deformed outlines (level 4, {len(fc.states)} states): {time.perf_counter() - t0:.1f} s; "
           f"{fc.fem_note or 'all states meshed'}")
     for s in fc.states:

@@ -13,6 +13,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from matcad.spec_input import read_spec_data  # noqa: E402
 from matcad.sweep import Executor, parse_axes, sweep  # noqa: E402
+from matcad.acoustics.design import Making, WallMaterial  # noqa: E402
 from matcad.sweep import fast  # noqa: E402
 
 PAPER = Path(__file__).resolve().parents[1] / "templates" / "mat-paper.toml"
@@ -27,7 +28,8 @@ def random_variants(n: int, seed: int = 0) -> fast.Variants:
               "mold.draft_deg": rng.uniform(0.0, 1.0, n), "air.temperature_c": rng.uniform(10.0, 30.0, n),
               "air.speed_of_sound": np.full(n, np.nan), "spacer.height": rng.uniform(0.5, 3.0, n),
               "plate.width": np.full(n, 24.0), "plate.depth": np.full(n, 24.0)}
-    return fast.Variants(values, np.full(n, 0.1), 0.4 + 0.1 * values["neck.length"], np.full(n, 0.1), "mount")
+    return fast.Variants(values, "mount", WallMaterial("rigid", (0.2, 0.6), (1.0, 1.6), (0.1, 0.2), 1080.0),
+                         Making(np.zeros(n, bool), np.zeros(n, bool), np.full(n, "fdm")))
 
 
 def best_time(fn, repeats: int) -> float:

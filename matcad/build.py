@@ -10,7 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from matcad.acoustics.predict import Prediction, predict
+from matcad.acoustics.predict import Prediction
+from matcad.prediction import predict
 from matcad.output import MANIFEST, staged_output
 from matcad.export.dxf_svg import write_dxf, write_svg
 from matcad.parts.catalogue import laser_parts, needs_cad_kernel, printed_parts
@@ -101,11 +102,11 @@ def write_archive(folder: Path, name: str) -> None:
 
 
 def board_bands(spec) -> dict:
-    """Every taxel's band as report data (:func:`matcad.acoustics.bands.summary`). An array's loaded bands take
+    """Every taxel's band as report data (:func:`matcad.prediction.bands.summary`). An array's loaded bands take
     the cap mechanics when it has no [calibration] (its rules need them anyway); a single taxel takes the cheap
     path (no FElupe) and never fails on its rise: without a calibration, or past where it holds, the loaded rise
     is marked not computed and says why (`matcad predict --load` gives the mechanics curve)."""
-    from matcad.acoustics.bands import summary, taxel_bands
+    from matcad.prediction.bands import summary, taxel_bands
     from matcad.taxel import is_array
 
     board = is_array(spec)

@@ -108,7 +108,7 @@ def _check_fem_level(args) -> None:
 
 
 def cmd_predict(args) -> int:
-    from matcad.acoustics.predict import predict
+    from matcad.prediction import predict
 
     _check_fem_level(args)
     if args.force_deprecated:
@@ -129,10 +129,10 @@ def cmd_predict(args) -> int:
 
 
 def _predict_array(spec, args) -> int:
-    """`predict` of an array spec: each taxel's f0, unloaded and loaded band (matcad.acoustics.bands), and the
+    """`predict` of an array spec: each taxel's f0, unloaded and loaded band (matcad.prediction.bands), and the
     band conflicts; --json adds each taxel's whole prediction."""
-    from matcad.acoustics.bands import summary, taxel_band
-    from matcad.acoustics.predict import predict
+    from matcad.prediction.bands import summary, taxel_band
+    from matcad.prediction import predict
     from matcad.taxel import taxel_spec, taxels
 
     bands, predictions = [], {}
@@ -238,7 +238,7 @@ def _band(args):
             raise ValueError(f"--band {lo:g} {hi:g} invalid, must be 0 <= LO < HI (Hz)")
         return lo, hi
     if args.spec:
-        from matcad.acoustics.predict import predict
+        from matcad.prediction import predict
         from matcad.loop.analyze import band_from_prediction
 
         return band_from_prediction(predict(_load_spec(args.spec, args)).band_hz)

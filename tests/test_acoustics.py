@@ -7,7 +7,7 @@ import pytest
 
 from matcad import spec as spec_mod
 from matcad.acoustics import air, geometry, models
-from matcad.acoustics.predict import predict
+from matcad.prediction import predict
 from tests.conftest import PAPER
 
 D, L, d, l = 3.18, 4.76, 2.10, 6.35
@@ -194,7 +194,8 @@ def test_vectorised_matches_scalar():
 
 
 def test_uncertainty_budget_lines_and_band():
-    from matcad.acoustics.uncertainty import model_errors, total
+    from matcad.acoustics.registry import model_errors
+    from matcad.acoustics.uncertainty import total
     p = predict(spec_mod.load(PAPER))
     sources = [b.source for b in p.budget]
     assert sources == ["model", "neck diameter", "neck length (sheet)", "cavity diameter (core pin)",
@@ -226,7 +227,7 @@ def test_measuring_the_sheet_narrows_the_band():
 
 
 def test_model_errors_come_from_the_benchmark():
-    from matcad.acoustics.uncertainty import model_errors
+    from matcad.acoustics.registry import model_errors
     errors = model_errors()
     assert set(errors) >= {"lumped", "end_corrected", "transmission_line", "soft_wall", "elastic_wall", "fem"}
     assert all(e["measured_by"] == "benchmarks/error_vs_runtime.py" and e["cases"] >= 1 for e in errors.values())
@@ -248,7 +249,9 @@ def test_boundary_layer_estimate_matches_digest_and_grows_small():
 
 
 def test_prediction_relative_to_a_measured_reference():
-    from matcad.acoustics.resonator import evaluate, resonator, wall_arguments
+    from matcad.acoustics.design import design
+    from matcad.acoustics.registry import model as registered
+    from matcad.acoustics.resonator import resonator
     from matcad.spec import SpecError, reference_spec
 
     same = predict(_spec(reference__f0_hz=4000.0))
@@ -257,8 +260,8 @@ def test_prediction_relative_to_a_measured_reference():
     p = predict(longer)
     ref = reference_spec(longer)
     assert ref.cavity.length == 3.5 and ref.reference is None and ref.neck == longer.neck
-    model = p.models["elastic_wall"].f0_hz / float(evaluate(resonator(ref), "elastic_wall",
-                                                               *wall_arguments(ref, "elastic_wall")))
+    model = p.models["elastic_wall"].f0_hz / float(registered("elastic_wall").f0_hz(resonator(design(ref)),
+                                                                                     design(ref).wall))
     assert p.f0_hz == pytest.approx(4000.0 * model, rel=1e-12)
     assert p.f0_hz < 4000.0  # a longer cavity than the reference sings lower
     sources = [b.source for b in p.budget]

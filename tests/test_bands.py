@@ -7,10 +7,12 @@ import numpy as np
 import pytest
 
 from matcad import spec as spec_mod
-from matcad.acoustics import bands
-from matcad.acoustics.bands import TaxelBand, conflicts, guard_hz, taxel_band
+from matcad.prediction import bands
+from matcad.prediction import taxel as taxel_prediction
+from matcad.prediction.bands import TaxelBand, conflicts, guard_hz, taxel_band
 from matcad.acoustics.load import frequency_at_force_hz
-from matcad.acoustics.predict import predict, spec_calibration
+from matcad.acoustics.design import calibration
+from matcad.prediction import predict
 from matcad.spec import SpecError
 from tests.conftest import FAST_MECHANICS, MINIMAL, PAPER
 
@@ -25,7 +27,7 @@ def test_calibrated_band_is_the_predicted_band_raised_by_eq5():
     s = spec_mod.load(PAPER)
     b = taxel_band(s)
     p = predict(s)
-    cal = spec_calibration(s)
+    cal = calibration(s)
     f = frequency_at_force_hz(cal, [0.0, s.mechanics.max_force_n], 343.0, 2.1, 6.35)  # f(F)/f(0) needs no K
     assert b.f0_hz == p.f0_hz and b.unloaded_hz == p.band_hz
     assert b.rise == pytest.approx(f[1] / f[0], rel=1e-12)
@@ -57,7 +59,7 @@ def test_mechanics_rise_once_per_cap_and_equal_to_predict_load(monkeypatch):
     calls = []
     real = solver.cap_curve
     monkeypatch.setattr(solver, "cap_curve", lambda s: calls.append(1) or real(s))
-    monkeypatch.setattr(bands, "_CAP_CURVES", {})
+    monkeypatch.setattr(taxel_prediction, "_CAP_CURVES", {})
     s = spec_mod.from_dict(spec_mod.tomllib.loads(FAST))
     wide = dataclasses.replace(s, neck=dataclasses.replace(s.neck, diameter=2.6))
     b1, b2 = taxel_band(s), taxel_band(wide)
@@ -103,7 +105,7 @@ def test_conflicts_overlap_guard_and_harmonics():
 def test_bands_module_does_not_import_felupe_on_the_cheap_path():
     import subprocess
 
-    code = ("import sys; from matcad import spec; from matcad.acoustics.bands import taxel_band; "
+    code = ("import sys; from matcad import spec; from matcad.prediction.bands import taxel_band; "
             "s = spec.load(%r); taxel_band(s); taxel_band(s, mechanics=False); "
             "assert 'felupe' not in sys.modules and 'skfem' not in sys.modules" % str(PAPER))
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from matcad import spec as spec_mod
-from matcad.acoustics.predict import predict
+from matcad.prediction import predict
 from matcad.design import RulesFailed, Unreachable
 from matcad.design.solve import FIELDS, get_field, parse_vary, solve
 from matcad.output import MANIFEST
@@ -125,7 +125,7 @@ def _array_base(write_spec, max_force="5.0"):
 
 
 def test_taxels_bands_are_disjoint_inside_the_band_and_check_accepts(tmp_path, write_spec):
-    from matcad.acoustics.bands import conflicts, guard_hz, taxel_bands
+    from matcad.prediction.bands import conflicts, guard_hz, taxel_bands
     from matcad.taxel import taxels
 
     out = tmp_path / "arr"

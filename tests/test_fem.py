@@ -8,7 +8,7 @@ import pytest
 
 from matcad import spec as spec_mod
 from matcad.acoustics import fem, models
-from matcad.acoustics.predict import predict
+from matcad.prediction import predict
 from tests.conftest import PAPER
 
 C = 343.0

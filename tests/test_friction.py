@@ -13,7 +13,7 @@ import zipfile
 import pytest
 
 from matcad import spec as spec_mod
-from matcad.acoustics.predict import predict
+from matcad.prediction import predict
 from matcad.build import build
 from matcad.plausibility import frequency_notes, spec_notes
 from tests.conftest import MINIMAL, PAPER, ROOT, run_cli

@@ -144,7 +144,7 @@ cavity_length = 3.0
 
 
 def test_cli_analyze_and_sense_an_array_spec(tmp_path):
-    """`analyze` and `sense` with a two-taxel spec: each taxel heard in its loaded band (matcad.acoustics.bands),
+    """`analyze` and `sense` with a two-taxel spec: each taxel heard in its loaded band (matcad.prediction.bands),
     the low one pressed 2 → 10 N; per-taxel columns; a calibration per taxel given as NAME=FILE."""
     import json
 

@@ -13,6 +13,7 @@ from matcad.parts.end_cap import cavity_tip_radius_mm
 from matcad.mechanics.material import MODELS, preset
 from matcad.mechanics.mesh import disc_mesh, mesh_section
 from matcad.mechanics.section import CapSection, cavity_volume_mm3, revolved_volume_mm3, section_from_spec
+from matcad.mechanics.case import cap_case
 from matcad.mechanics.solver import cap_curve, compress
 from tests.conftest import PAPER as PAPER_TOML
 
@@ -141,7 +142,7 @@ def test_spec_section_and_bad_travel():
                                "mechanics": {"material": "yeoh", "contact": "frictionless", "displacement_mm": 6.0}})
     assert spec.mechanics.material == "yeoh"
     with pytest.raises(spec_mod.SpecError, match="mechanics.displacement_mm"):
-        cap_curve(spec)
+        cap_curve(cap_case(spec))
     with pytest.raises(spec_mod.SpecError, match="mechanics.contact"):
         spec_mod.from_dict({"name": "t", "cavity": {"diameter": 3.18, "length": 4.76},
                             "neck": {"diameter": 2.1, "length": 6.35}, "mechanics": {"contact": "glued"}})
@@ -179,7 +180,7 @@ def test_a_short_stiff_cap_prints_no_blas_warnings(capfd):
     from matcad.taxel import taxel_spec, taxels
 
     spec = spec_mod.load(PAPER_TOML.parent / "mat-array-4.toml")
-    curve = cap_curve(taxel_spec(spec, taxels(spec)[2]))
+    curve = cap_curve(cap_case(taxel_spec(spec, taxels(spec)[2])))
     assert curve.steps and all(np.isfinite(s.force_n) for s in curve.steps)
     out, err = capfd.readouterr()
     assert "illegal value" not in out + err  # OpenBLAS's xerbla prints to standard output

@@ -52,7 +52,7 @@ def test_build_load_plot_path_stays_on_eq5_without_felupe():
 
     from tests.conftest import PAPER, ROOT
 
-    code = ("import sys; from matcad import spec; from matcad.acoustics.predict import predict; "
+    code = ("import sys; from matcad import spec; from matcad.prediction import predict; "
             "from matcad.render.kit import load_forces_n; s = spec.load(%r); "
             "p = predict(s, forces_n=load_forces_n(s), mechanics=False); "
             "assert p.load_curve and all(q.source.startswith('calibration') for q in p.load_curve); "

@@ -7,8 +7,9 @@ import pytest
 
 from matcad import spec as spec_mod
 from matcad.acoustics import fem
+from matcad.acoustics.design import design
 from matcad.acoustics.load import frequency_at_force_hz
-from matcad.acoustics.predict import predict
+from matcad.prediction import predict
 from matcad.mechanics.frequency import at_forces, equivalent_length_mm, force_curve
 from matcad.mechanics.material import preset
 from matcad.mechanics.section import section_from_spec
@@ -32,7 +33,7 @@ def _outline(radius, length, n=9):
 def test_fem_outline_entry_point_against_an_independent_mesh():
     """The unloaded outline maps the mesh onto itself (same f); a shorter cylinder's outline gives the f of a
     mesh built for that cylinder directly, to the FEM's own discretisation error (0.3 %)."""
-    g = fem.geometry_from_spec(PAPER)
+    g = fem.geometry(design(PAPER))
     k = 2 * np.pi * 5000 / 343.2e3
     base = fem.solve(g, k, 4)
     assert fem.solve(g, k, 4, cavity_outline=_outline(g.cavity_radius, g.cavity_length)).f0_hz == pytest.approx(
@@ -51,7 +52,7 @@ def test_equivalent_length_of_a_flat_and_a_conical_end():
 
 def test_force_curve_rises_and_starts_at_the_unloaded_ladder(curve):
     tl = predict(PAPER, model="transmission_line").f0_hz
-    fc = force_curve(PAPER, curve)
+    fc = force_curve(design(PAPER), curve)
     f = np.array([s.f_hz for s in fc.states])
     assert f[0] == pytest.approx(tl, rel=1e-9)
     assert np.all(np.diff(f) > 0) and fc.turn_force_n is None
@@ -64,7 +65,7 @@ def test_force_curve_rises_and_starts_at_the_unloaded_ladder(curve):
 
 
 def test_force_curve_fem_route_and_interpolation(curve):
-    fc = force_curve(PAPER, curve, f0_hz=5000.0, fem_level=3)
+    fc = force_curve(design(PAPER), curve, f0_hz=5000.0, fem_level=3)
     assert fc.route.startswith("axisymmetric FEM") and fc.fem_note == ""
     fem_f = np.array([s.f_fem_hz for s in fc.states])
     tl_f = np.array([s.f_tl_hz for s in fc.states])

@@ -189,15 +189,14 @@ def test_every_registered_part_of_the_paper_template_renders_and_reads_back(pape
 
 def test_model_registry_is_the_one_list():
     from matcad.acoustics import registry as models
-    from matcad.acoustics.resonator import CHEAP_MODELS
-    from matcad.acoustics.uncertainty import model_errors
+    from matcad.acoustics.registry import cheap_models, model_errors
     from matcad.cli import _parser
 
     parser = _parser()
     predict = next(a for a in parser._subparsers._group_actions[0].choices["predict"]._actions
                    if "--model" in a.option_strings)
     assert list(predict.choices) == models.model_choices()
-    assert CHEAP_MODELS == tuple(m.name for m in models.MODELS if not m.needs_skfem)
+    assert cheap_models() == tuple(m.name for m in models.MODELS if not m.needs_skfem)
     assert [m.rung for m in models.MODELS] == sorted(m.rung for m in models.MODELS)
     assert set(models.model_names()) <= set(model_errors())  # each rung's measured error (fem: vs its extrapolation)
     for m in models.MODELS:
@@ -208,13 +207,15 @@ def test_registry_models_evaluate_their_closed_forms():
     """The registry's lumped rung is paper Eq. 1 (c_f = 0): f = c/(2π) sqrt(A/(V l)), evaluated independently."""
     import math
 
-    from matcad.acoustics.resonator import evaluate, resonator
+    from matcad.acoustics.design import design
+    from matcad.acoustics.registry import model
+    from matcad.acoustics.resonator import resonator
 
-    res = resonator(load_spec(PAPER))
+    res = resonator(design(load_spec(PAPER)))
     want = res.c_m_s * 1000 / (2 * math.pi) * math.sqrt(res.neck_area / (res.volume * res.neck_length))
-    assert float(evaluate(res, "lumped")) == pytest.approx(want, rel=1e-12)
-    with pytest.raises(ValueError, match="'fem' invalid"):
-        evaluate(res, "fem")  # a solver rung is not a closed form
+    assert float(model("lumped").f0_hz(res)) == pytest.approx(want, rel=1e-12)
+    with pytest.raises(ValueError, match="'fem' solves a mesh"):
+        model("fem").f0_hz(res)  # a solver rung is not a closed form
 
 
 def test_model_registry_imports_no_solver():

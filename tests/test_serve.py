@@ -17,7 +17,7 @@ from concurrent.futures import ThreadPoolExecutor
 import pytest
 
 from matcad import spec as spec_mod
-from matcad.acoustics.predict import predict
+from matcad.prediction import predict
 from matcad.serve import MAX_BODY_BYTES, make_server
 from tests.browser import broken_images, chromium, console_errors
 from tests.conftest import ROOT

@@ -10,7 +10,8 @@ from hypothesis import strategies as st
 
 from matcad import spec as spec_mod
 from matcad.acoustics import fem, load, models
-from matcad.acoustics.predict import predict
+from matcad.acoustics.design import design
+from matcad.prediction import predict
 from matcad.spec import SpecError
 
 D, L, d, l = 3.18, 4.76, 2.10, 6.35
@@ -117,7 +118,7 @@ def test_tline_root_is_the_fundamental_for_any_input(r, ln, lc):
 def test_fem_and_tline_find_the_same_mode_at_extremes(ratio, neck_length):
     s = _spec(neck__diameter=D * ratio, neck__length=neck_length)
     tl = predict(s).models["transmission_line"].f0_hz
-    run = fem.solve(fem.geometry_from_spec(s), 2 * math.pi * tl / 343.2e3, 4, 343.2)
+    run = fem.solve(fem.geometry(design(s)), 2 * math.pi * tl / 343.2e3, 4, 343.2)
     assert run.f0_hz == pytest.approx(tl, rel=0.05)
     assert run.cavity_energy_fraction > 0.3
 

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from matcad.acoustics.load import frequency_at_force_hz
-from matcad.acoustics.predict import predict, spec_calibration
+from matcad.acoustics.design import calibration
+from matcad.prediction import predict
 from matcad.spec import from_dict
 from matcad.spec_input import read_spec_data
 from matcad.sweep import MAX_POINTS, Executor, parse_axes, sweep
@@ -76,7 +77,7 @@ def test_sweep_table_load_sensitivity_is_eq5_slope():
     result = sweep(data, parse_axes(["neck.diameter=1.8,2.1"]), model="transmission_line", rules=False)
     for row in result.rows:
         spec = from_dict({**data, "neck": {**data["neck"], "diameter": row["neck.diameter"]}})
-        cal = spec_calibration(spec)
+        cal = calibration(spec)
         c = predict(spec, mechanics=False).speed_of_sound_m_s
         f = frequency_at_force_hz(cal, np.array([0.0, 1e-4]), c, spec.neck.diameter, spec.neck.length)
         assert row[LOAD_SENSITIVITY] == pytest.approx((f[1] - f[0]) / 1e-4, rel=1e-3)

@@ -8,7 +8,9 @@ import pytest
 
 from matcad import spec as spec_mod
 from matcad.acoustics import fem, fsi, wall
-from matcad.acoustics.resonator import evaluate, resonator, wall_modes
+from matcad.acoustics.design import design
+from matcad.acoustics.registry import model
+from matcad.acoustics.resonator import resonator, wall_modes
 from tests.conftest import PAPER
 
 
@@ -42,12 +44,14 @@ def test_dynamic_compliance_spring_below_mass_above():
 
 
 def _fem_shift(spec, shear, loss, level=fem.DEFAULT_LEVEL):
-    res = resonator(spec)
-    geom = fem.geometry_from_spec(spec)
-    f_guess = float(evaluate(res, "transmission_line"))
+    d = design(spec)
+    res = resonator(d)
+    geom = fem.geometry(d)
+    line = model("transmission_line")
+    f_guess = float(line.f0_hz(res))
     rigid = fsi.solve(geom, None, f_guess, level, res.c_m_s).f0_hz
-    soft = fsi.solve(geom, fsi.cap_from_spec(spec, shear, loss), f_guess, level, res.c_m_s, wall_modes=0).f0_hz
-    fast = float(evaluate(res, "elastic_wall", shear, loss)) / float(evaluate(res, "transmission_line"))
+    soft = fsi.solve(geom, fsi.cap(d, shear, loss), f_guess, level, res.c_m_s, wall_modes=0).f0_hz
+    fast = float(model("elastic_wall").f0_hz(res, shear_modulus_pa=shear, loss_factor=loss)) / float(line.f0_hz(res))
     return soft / rigid, fast
 
 
@@ -73,7 +77,7 @@ def test_quasi_static_check_follows_the_wall_modes():
     soft = wall.modes(shape, 0.35e6, 1080.0)
     stiff = wall.modes(shape, 100e6, 1080.0)
     assert not wall.quasi_static_valid(soft, 5000.0) and wall.quasi_static_valid(stiff, 5000.0)
-    assert wall_modes(resonator(spec_mod.load(PAPER)), 0.35e6).coupled_hz()[0] < 2500
+    assert wall_modes(resonator(design(spec_mod.load(PAPER))), 0.35e6).coupled_hz()[0] < 2500
 
 
 def test_wall_mode_near_f_is_flagged():

@@ -34,7 +34,7 @@ FIXED_POINT_ITERATIONS = 6
 
 @dataclass(frozen=True)
 class FemGeometry:
-    """Everything the FEM needs (mm, Pa); build it from a spec with :func:`geometry_from_spec`."""
+    """Everything the FEM needs (mm, Pa); build it from a design with :func:`geometry`."""
 
     neck_radius: float
     neck_length: float
@@ -58,15 +58,14 @@ class FemResult:
     seconds: float
 
 
-def geometry_from_spec(spec) -> FemGeometry:
-    """The FEM geometry of a spec's air (drafted cavity, neck, mouth, gap), mm."""
+def geometry(d) -> FemGeometry:
+    """The FEM geometry of a :class:`~matcad.acoustics.design.Design`'s air (drafted cavity, neck, mouth, gap), mm."""
     from matcad.acoustics.geometry import drafted_tip_diameter_mm
 
-    tip = float(drafted_tip_diameter_mm(spec.cavity.diameter, spec.cavity.length, spec.mold.draft_deg))
-    return FemGeometry(neck_radius=spec.neck.diameter / 2, neck_length=spec.neck.length,
-                       cavity_radius=spec.cavity.diameter / 2, cavity_tip_radius=tip / 2,
-                       cavity_length=spec.cavity.length, mouth=spec.neck.mouth, gap=spec.spacer.height,
-                       gap_radius=min(spec.plate.width, spec.plate.depth) / 2)
+    tip = float(drafted_tip_diameter_mm(d.cavity_diameter, d.cavity_length, d.draft_deg))
+    return FemGeometry(neck_radius=d.neck_diameter / 2, neck_length=d.neck_length,
+                       cavity_radius=d.cavity_diameter / 2, cavity_tip_radius=tip / 2,
+                       cavity_length=d.cavity_length, mouth=d.mouth, gap=d.gap_mm, gap_radius=d.gap_radius_mm)
 
 
 # ---------------------------------------------------------------- mesh

@@ -75,12 +75,10 @@ class CoupledResult:
     solves: int
 
 
-def cap_from_spec(spec, shear_modulus_pa: float, loss_factor: float) -> Cap:
-    """The cap of ``spec`` (end_cap, guide, silicone sections) at the given modulus (Pa) and loss factor."""
-    from matcad.parts.features import cap_flange_thickness_mm
-
-    return Cap(outer_radius=spec.end_cap.outer_diameter / 2, top_thickness=spec.end_cap.top_thickness,
-               clamp_height=cap_flange_thickness_mm(spec), density_kg_m3=spec.silicone.density_g_cm3 * 1000.0,
+def cap(d, shear_modulus_pa: float, loss_factor: float) -> Cap:
+    """The silicone cap of a :class:`~matcad.acoustics.design.Design` at the given modulus (Pa) and loss factor."""
+    return Cap(outer_radius=d.cap_outer_diameter / 2, top_thickness=d.cap_top_thickness,
+               clamp_height=d.cap_clamp_height, density_kg_m3=d.wall.density_kg_m3,
                shear_modulus_pa=shear_modulus_pa, loss_factor=loss_factor)
 
 

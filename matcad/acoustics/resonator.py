@@ -1,24 +1,28 @@
-"""A spec's as-built acoustic quantities and the cheap models evaluated on them (mm, mm², mm³, m/s, Hz).
+"""A design's as-built acoustic quantities and the closed-form models evaluated on them (mm, mm², mm³, m/s, Hz).
 
-Shared by :mod:`matcad.acoustics.predict` (the ladder) and :mod:`matcad.acoustics.uncertainty` (which re-evaluates
-the chosen model on perturbed specs).
+:func:`resonator` turns a :class:`matcad.acoustics.design.Design` into the quantities every model reads (the
+drafted cavity as its equal-volume cylinder, areas, end corrections, the cap around it); the ``*_hz`` functions are
+the closed-form rungs the registry (:mod:`matcad.acoustics.registry`) names. Each takes the resonator, the wall's
+shear modulus (Pa) and loss factor, and works on floats or on numpy arrays of a sweep's variants (the elastic wall
+on floats only).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, fields
 
 import numpy as np
 
-from matcad.acoustics import geometry, models, registry, wall
+from matcad.acoustics import geometry, models, wall
 from matcad.acoustics.air import speed_of_sound_m_s
-from matcad.parts.features import cap_flange_thickness_mm
+from matcad.acoustics.design import Design
 
 
 @dataclass(frozen=True)
 class Resonator:
-    """The as-built acoustic quantities of a spec (mm, mm², mm³, m/s): drafted cavity as its equal-volume
-    cylinder, neck, end corrections."""
+    """The as-built acoustic quantities of a design (mm, mm², mm³, m/s, kg/m³): drafted cavity as its equal-volume
+    cylinder, neck, end corrections, the cap around the cavity."""
 
     c_m_s: float
     volume: float
@@ -48,7 +52,7 @@ def as_built(c_m_s, cavity_diameter, cavity_length, neck_diameter, neck_length, 
              gap_radius_mm) -> Resonator:
     """The acoustic quantities of as-built geometry (mm, m/s), broadcast over numpy arrays (a sweep's variants):
     the drafted cavity as its equal-volume cylinder, the neck and its end corrections. The cap fields are NaN;
-    :func:`resonator` fills them from a spec."""
+    :func:`resonator` fills them from a design."""
     volume = geometry.drafted_cavity_volume_mm3(cavity_diameter, cavity_length, draft_deg)
     cav_diameter = geometry.equivalent_diameter_mm(volume, cavity_length)
     nan = float("nan")
@@ -62,16 +66,22 @@ def as_built(c_m_s, cavity_diameter, cavity_length, neck_diameter, neck_length, 
         cap_outer_diameter=nan, cap_top_thickness=nan, cap_clamp_height=nan, silicone_density=nan)
 
 
-def resonator(spec) -> Resonator:
-    """Derive the as-built acoustic quantities of ``spec`` (:func:`as_built` plus the cap, as floats)."""
-    cav, neck = spec.cavity, spec.neck
-    c = float(spec.air.speed_of_sound or speed_of_sound_m_s(spec.air.temperature_c))
-    res = as_built(c, cav.diameter, cav.length, neck.diameter, neck.length, spec.mold.draft_deg, neck.mouth,
-                   spec.spacer.height, min(spec.plate.width, spec.plate.depth) / 2.0)
-    values = {f.name: float(getattr(res, f.name)) for f in fields(Resonator)}
-    values.update(cap_outer_diameter=spec.end_cap.outer_diameter, cap_top_thickness=spec.end_cap.top_thickness,
-                  cap_clamp_height=cap_flange_thickness_mm(spec), silicone_density=spec.silicone.density_g_cm3 * 1000.0)
-    return Resonator(**values)
+def resonator(d: Design) -> Resonator:
+    """The as-built acoustic quantities of a :class:`~matcad.acoustics.design.Design` (:func:`as_built` plus the
+    cap): floats for a design of scalars, arrays for a design of arrays (a sweep's variants)."""
+    given = d.air.speed_of_sound_m_s
+    if np.ndim(d.cavity_diameter) == 0:
+        c = float(given or speed_of_sound_m_s(d.air.temperature_c))
+    else:
+        given = np.asarray(np.nan if given is None else given, dtype=float)
+        c = np.where(np.isnan(given), speed_of_sound_m_s(d.air.temperature_c), given)
+    res = as_built(c, d.cavity_diameter, d.cavity_length, d.neck_diameter, d.neck_length, d.draft_deg, d.mouth,
+                   d.gap_mm, d.gap_radius_mm)
+    cap = dict(cap_outer_diameter=d.cap_outer_diameter, cap_top_thickness=d.cap_top_thickness,
+               cap_clamp_height=d.cap_clamp_height, silicone_density=d.wall.density_kg_m3)
+    if np.ndim(d.cavity_diameter) == 0:
+        return Resonator(**({f.name: float(getattr(res, f.name)) for f in fields(Resonator)} | cap))
+    return dataclasses.replace(res, **cap)
 
 
 def cap_shape(res: Resonator) -> wall.CapShape:
@@ -122,43 +132,3 @@ def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0):
     f_tl = transmission_line_hz(res)
     return f_tl * wall.peak_ratio(float(f_tl), res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
                                   res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor)
-
-
-def evaluate(res: Resonator, model: str, shear_modulus_pa=None, loss_factor: float = 0.0):
-    """f0 (Hz) of one cheap model of :mod:`matcad.acoustics.registry`; ``soft_wall`` takes the shear modulus
-    (Pa, scalar or array), ``elastic_wall`` the (dynamic) shear modulus (Pa, scalar) and the loss factor."""
-    if model not in CHEAP_MODELS:
-        raise ValueError(f"model {model!r} invalid, must be one of {list(CHEAP_MODELS)}")
-    return registry.model(model).function()(res, shear_modulus_pa, loss_factor)
-
-
-CHEAP_MODELS = registry.cheap_models()
-
-
-def shear_moduli_pa(spec) -> tuple[float, float, float]:
-    """(low, geometric mean, high) of the spec's static shear-modulus range (Pa)."""
-    g_lo, g_hi = (x * 1e6 for x in spec.wall.shear_modulus_mpa)
-    return g_lo, float(np.sqrt(g_lo * g_hi)), g_hi
-
-
-def dynamic_moduli_pa(spec) -> tuple[float, float, float]:
-    """(low, geometric mean, high) storage shear modulus at kHz (Pa): the static range times the kHz factor."""
-    f_lo, f_hi = spec.wall.khz_modulus_factor
-    g_lo, _, g_hi = shear_moduli_pa(spec)
-    lo, hi = g_lo * f_lo, g_hi * f_hi
-    return lo, float(np.sqrt(lo * hi)), hi
-
-
-def loss_factors(spec) -> tuple[float, float, float]:
-    """(low, mean, high) of the spec's loss-factor range."""
-    lo, hi = spec.wall.loss_factor
-    return lo, 0.5 * (lo + hi), hi
-
-
-def wall_arguments(spec, model: str) -> tuple:
-    """The (modulus, loss) arguments of :func:`evaluate` at the middle of the spec's ranges for a wall model."""
-    if model == "elastic_wall":
-        return dynamic_moduli_pa(spec)[1], loss_factors(spec)[1]
-    if model == "soft_wall":
-        return shear_moduli_pa(spec)[1], 0.0
-    return None, 0.0

@@ -8,19 +8,20 @@ viscous/thermal boundary layers (one-sided: every model here is lossless) and th
 model it refines) with that one input moved to the ends of its tolerance; the silicone line samples the whole
 modulus × loss rectangle, because f is not monotonic in G when wall modes cross f. Lines are independent, so
 lows and highs add in quadrature separately, in ln f (relative shifts), which keeps a wide band above zero.
+
+The budget works on a :class:`~matcad.acoustics.design.Design` of floats (one prediction, with its lines' words)
+or of numpy arrays (a sweep's variants, the rigid closed-form rungs: the same numbers per variant, no words).
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
-from pathlib import Path
 
-from matcad.acoustics.air import boundary_layer_drop
 import numpy as np
 
-from matcad.acoustics.resonator import (CHEAP_MODELS, dynamic_moduli_pa, evaluate, loss_factors, resonator,
-                                        shear_moduli_pa, wall_arguments)
+from matcad.acoustics import registry
+from matcad.acoustics.air import boundary_layer_shift
+from matcad.acoustics.resonator import resonator
 
 NECK_DIAMETER_TOL_MM = {"laser": 0.1, "drilled": 0.02}
 """Laser-cut acrylic holds ±0.1 mm (docs/physics.md); a pilot drilled to size ±0.02 mm."""
@@ -32,11 +33,15 @@ TEMPERATURE_TOL_C = 3.0
 """A lab's day-to-day swing; an explicit speed of sound is taken as exact."""
 MODULUS_SAMPLES = 13
 """Log-spaced moduli across the silicone's range (each at the low and the high loss factor)."""
+TOLERANCES = {"neck.diameter": "neck_diameter", "neck.length": "neck_length", "cavity.diameter": "cavity_diameter",
+              "mold.draft_deg": "draft_deg", "air.temperature_c": "air_temperature_c"}
+"""Spec field of each fabrication and air tolerance → the :class:`Design` field it moves."""
 
 
 @dataclass(frozen=True)
 class BudgetLine:
-    """One source: what varies, by how much, and the f shift at each end (Hz, low ≤ 0 ≤ high)."""
+    """One source: what varies, by how much, and the f shift at each end (Hz, low ≤ 0 ≤ high; arrays of variants
+    in a sweep, where ``tolerance`` is empty)."""
 
     source: str
     tolerance: str
@@ -44,21 +49,21 @@ class BudgetLine:
     high_hz: float
 
 
-def sheet_tolerance_mm(thickness_mm: float, measured: bool) -> float:
+def sheet_tolerance_mm(thickness_mm, measured: bool):
     """± thickness tolerance of an acrylic sheet (mm): a calipered sheet :data:`MEASURED_SHEET_TOL_MM`, else cast
     sheet per ISO 7823-1, ±(0.4 + 0.1 t)."""
     return MEASURED_SHEET_TOL_MM if measured else 0.4 + 0.1 * thickness_mm
 
 
-def model_errors() -> dict:
-    """Relative model errors against the converged FEM, as measured by benchmarks/error_vs_runtime.py."""
-    return json.loads((Path(__file__).parent / "model_errors.json").read_text(encoding="utf-8"))
-
-
-def _replace(spec, section: str, **values):
-    from matcad.spec import variant
-
-    return variant(spec, section, **values)  # a perturbation may leave the user's ranges; it is not input
+def fabrication_tolerances(making, neck_length_mm) -> tuple:
+    """(neck diameter, sheet thickness, cavity diameter) tolerances (± mm) of how a taxel is made
+    (:class:`~matcad.acoustics.design.Making`; its fields may be arrays of variants, each its own)."""
+    if np.ndim(making.neck_drilled) == 0:
+        return (NECK_DIAMETER_TOL_MM["drilled" if making.neck_drilled else "laser"],
+                sheet_tolerance_mm(neck_length_mm, making.sheet_measured), CAVITY_DIAMETER_TOL_MM[making.printer])
+    return (np.where(making.neck_drilled, NECK_DIAMETER_TOL_MM["drilled"], NECK_DIAMETER_TOL_MM["laser"]),
+            np.where(making.sheet_measured, MEASURED_SHEET_TOL_MM, sheet_tolerance_mm(neck_length_mm, False)),
+            np.array([CAVITY_DIAMETER_TOL_MM[p] for p in making.printer]))
 
 
 def tolerance_ends(neck_diameter, neck_length, cavity_diameter, cavity_length, draft_deg, temperature_c,
@@ -86,79 +91,99 @@ def model_error_share(error: dict, valid):
     return np.where(valid, error["max_abs"], error.get("max_abs_all", error["max_abs"]))
 
 
-def budget(spec, res, model: str, f0_hz: float, valid: bool = True) -> list[BudgetLine]:
-    """Every source's contribution for ``model`` at ``f0_hz``; ``res`` is ``resonator(spec)``; ``valid`` False
-    (the model's own checks fail) takes its error over every benchmark case, not only the valid ones."""
-    cheap = model if model in CHEAP_MODELS else ("elastic_wall" if spec.wall.model == "silicone" else
-                                                 "transmission_line")
+def _ends(shifts, array: bool):
+    """(low, high) of the shifts of one line, 0 included (Hz)."""
+    if array:
+        return np.minimum(np.minimum(*shifts), 0.0), np.maximum(np.maximum(*shifts), 0.0)
+    return min(shifts + [0.0]), max(shifts + [0.0])
+
+
+def budget(d, res, model: str, f0_hz, valid=True, reference=None) -> list[BudgetLine]:
+    """Every source's contribution for ``model`` at ``f0_hz`` (Hz) on design ``d`` (``res`` its resonator);
+    ``valid`` False (the model's own checks fail) takes its error over every benchmark case, not only the valid
+    ones; ``reference`` is the measured :class:`~matcad.acoustics.design.Reference` of the 'relative' model."""
+    array = np.ndim(f0_hz) > 0
+    cheap = registry.model(model if model in registry.cheap_models() else registry.CHOSEN[d.wall.model])
     relative = model == "relative"
-    wall = wall_arguments(spec, cheap)
-    base = float(evaluate(res, cheap, *wall))
-    scale = f0_hz / base  # sensitivities of the cheap model, applied to the chosen f0
+    shear, loss = cheap.wall_arguments(d.wall)
+    # the cheap model's sensitivities, applied to the chosen f0 (the same model: a factor of exactly 1)
+    scale = 1.0 if cheap.name == model else f0_hz / float(cheap.f0_hz(res, shear_modulus_pa=shear, loss_factor=loss))
 
     def shifts(variants):
-        fs = [float(evaluate(resonator(v), cheap, *wall)) * scale - f0_hz for v in variants]
-        return min(fs + [0.0]), max(fs + [0.0])
+        fs = [cheap.f0_hz(resonator(v), shear_modulus_pa=shear, loss_factor=loss) for v in variants]
+        return _ends([(f if array else float(f)) * scale - f0_hz for f in fs], array)
+
+    def words(text) -> str:
+        return "" if array else text()
 
     lines = []
-    error = model_errors().get(cheap if relative else model)
+    error = registry.model_errors().get(cheap.name if relative else model)
     if relative:
-        ref = spec.reference
         share = error["ratio_max_abs"] if valid else error.get("ratio_max_abs_all", error["ratio_max_abs"])
-        lines.append(BudgetLine("model ratio", f"{cheap}: max |error| of new/reference {100 * share:.2f} % vs FEM "
-                                               f"over designs near the paper taxel"
+        lines.append(BudgetLine("model ratio", f"{cheap.name}: max |error| of new/reference {100 * share:.2f} % vs "
+                                               f"FEM over designs near the paper taxel"
                                                f"{'' if valid else ', checks failing included'}",
                                 -share * f0_hz, share * f0_hz))
+        ref = reference
         lines.append(BudgetLine("reference measurement", f"{ref.f0_hz:g} +-{ref.f0_tolerance_hz:g} Hz",
                                 -ref.f0_tolerance_hz / ref.f0_hz * f0_hz, ref.f0_tolerance_hz / ref.f0_hz * f0_hz))
     elif error is None:  # only before benchmarks/error_vs_runtime.py has measured a new rung
         lines.append(BudgetLine("model", f"{model}: error not measured yet (run benchmarks/error_vs_runtime.py)",
                                 0.0, 0.0))
     else:
-        worst, cases, where = float(model_error_share(error, valid)), error["cases"], "geometries where its checks pass"
-        if not valid and "max_abs_all" in error:
+        share = model_error_share(error, valid)
+        worst = share if array else float(share)
+        cases, where = error["cases"], "geometries where its checks pass"
+        if not array and not valid and "max_abs_all" in error:
             cases, where = error["of"], "geometries, checks failing included"
-        lines.append(BudgetLine("model", f"{model}: max |error| {100 * worst:.2f} % vs FEM over {cases} {where}",
-                                -worst * f0_hz, worst * f0_hz))
-    drilled = spec.plate.neck_pilot
-    d_tol = NECK_DIAMETER_TOL_MM["drilled" if drilled else "laser"]
-    sheet_tol = sheet_tolerance_mm(spec.neck.length, spec.plate.thickness_measured)
-    cav_tol = CAVITY_DIAMETER_TOL_MM[spec.machine.printer]
-    ends = tolerance_ends(spec.neck.diameter, spec.neck.length, spec.cavity.diameter, spec.cavity.length,
-                          spec.mold.draft_deg, spec.air.temperature_c, d_tol, sheet_tol, cav_tol)
+        lines.append(BudgetLine("model", words(lambda: f"{model}: max |error| {100 * worst:.2f} % vs FEM over {cases} "
+                                                       f"{where}"), -worst * f0_hz, worst * f0_hz))
+    making = d.making
+    drilled = making.neck_drilled
+    d_tol, sheet_tol, cav_tol = fabrication_tolerances(making, d.neck_length)
+    ends = tolerance_ends(d.neck_diameter, d.neck_length, d.cavity_diameter, d.cavity_length, d.draft_deg,
+                          d.air.temperature_c, d_tol, sheet_tol, cav_tol)
 
     def moved(field):
-        section, name = field.split(".")
-        return shifts([_replace(spec, section, **{name: float(x)}) for x in ends[field]])
+        return shifts([d.replace(**{TOLERANCES[field]: x if array else float(x)}) for x in ends[field]])
 
-    what = "measured" if spec.plate.thickness_measured else "ISO 7823-1 cast sheet"
-    lines += [BudgetLine("neck diameter", f"+-{d_tol:g} mm ({'drilled' if drilled else 'laser cut'})",
+    what = "" if array else "measured" if making.sheet_measured else "ISO 7823-1 cast sheet"
+    lines += [BudgetLine("neck diameter", words(lambda: f"+-{d_tol:g} mm ({'drilled' if drilled else 'laser cut'})"),
                          *moved("neck.diameter")),
-              BudgetLine("neck length (sheet)", f"+-{sheet_tol:.3g} mm ({what})", *moved("neck.length")),
-              BudgetLine("cavity diameter (core pin)", f"+-{cav_tol:g} mm ({spec.machine.printer})",
+              BudgetLine("neck length (sheet)", words(lambda: f"+-{sheet_tol:.3g} mm ({what})"), *moved("neck.length")),
+              BudgetLine("cavity diameter (core pin)", words(lambda: f"+-{cav_tol:g} mm ({making.printer})"),
                          *moved("cavity.diameter")),
-              BudgetLine("core-pin draft", f"{spec.mold.draft_deg:g} +-{DRAFT_TOL_DEG:g} deg", *moved("mold.draft_deg"))]
-    if spec.air.speed_of_sound is None:
-        lines.append(BudgetLine("air temperature", f"{spec.air.temperature_c:g} +-{TEMPERATURE_TOL_C:g} C",
+              BudgetLine("core-pin draft", words(lambda: f"{d.draft_deg:g} +-{DRAFT_TOL_DEG:g} deg"),
+                         *moved("mold.draft_deg"))]
+    given = d.air.speed_of_sound_m_s
+    if array:  # a variant with an explicit speed of sound has no temperature line
+        by_temperature = np.isnan(np.asarray(np.nan if given is None else given, dtype=float))
+        low, high = moved("air.temperature_c")
+        lines.append(BudgetLine("air temperature", "", np.where(by_temperature, low, 0.0),
+                                np.where(by_temperature, high, 0.0)))
+    elif given is None:
+        lines.append(BudgetLine("air temperature", f"{d.air.temperature_c:g} +-{TEMPERATURE_TOL_C:g} C",
                                 *moved("air.temperature_c")))
-    drop = boundary_layer_drop(f0_hz, spec.neck.diameter / 2)
-    lines.append(BudgetLine("boundary layers", f"viscous + thermal, not in the lossless models: -{100 * drop:.1f} %",
-                            -drop * f0_hz, 0.0))
-    if cheap == "soft_wall":
-        g_lo, _, g_hi = shear_moduli_pa(spec)
-        fs = [float(evaluate(res, cheap, g)) * scale - f0_hz for g in (g_lo, g_hi)]
+    eps = boundary_layer_shift(f0_hz, d.neck_diameter / 2)
+    eps = eps if array else float(eps)
+    drop = eps / (1.0 + eps)
+    lines.append(BudgetLine("boundary layers", words(lambda: f"viscous + thermal, not in the lossless models: "
+                                                             f"-{100 * drop:.1f} %"), -drop * f0_hz, 0.0))
+    if cheap.name == "soft_wall":
+        g_lo, _, g_hi = d.wall.static_moduli_pa()
+        fs = [float(cheap.f0_hz(res, shear_modulus_pa=g)) * scale - f0_hz for g in (g_lo, g_hi)]
         lines.append(BudgetLine("silicone shear modulus", f"{g_lo / 1e6:g}-{g_hi / 1e6:g} MPa static",
                                 min(fs + [0.0]), max(fs + [0.0])))
-    elif cheap == "elastic_wall":
-        g_lo, _, g_hi = dynamic_moduli_pa(spec)
-        eta_lo, _, eta_hi = loss_factors(spec)
-        fs = [float(evaluate(res, cheap, g, eta)) * scale - f0_hz
+    elif cheap.name == "elastic_wall":
+        g_lo, _, g_hi = d.wall.dynamic_moduli_pa()
+        eta_lo, _, eta_hi = d.wall.loss_factors()
+        fs = [float(cheap.f0_hz(res, shear_modulus_pa=g, loss_factor=eta)) * scale - f0_hz
               for g in np.geomspace(g_lo, g_hi, MODULUS_SAMPLES) for eta in (eta_lo, eta_hi)]
+        static, factor = d.wall.shear_modulus_mpa, d.wall.khz_modulus_factor
         lines.append(BudgetLine("silicone modulus and loss",
-                                f"G {g_lo / 1e6:.3g}-{g_hi / 1e6:.3g} MPa at kHz (static "
-                                f"{spec.wall.shear_modulus_mpa[0]:g}-{spec.wall.shear_modulus_mpa[1]:g} x "
-                                f"{spec.wall.khz_modulus_factor[0]:g}-{spec.wall.khz_modulus_factor[1]:g}), "
-                                f"eta {eta_lo:g}-{eta_hi:g}", min(fs + [0.0]), max(fs + [0.0])))
+                                f"G {g_lo / 1e6:.3g}-{g_hi / 1e6:.3g} MPa at kHz (static {static[0]:g}-{static[1]:g} x "
+                                f"{factor[0]:g}-{factor[1]:g}), eta {eta_lo:g}-{eta_hi:g}",
+                                min(fs + [0.0]), max(fs + [0.0])))
     return lines
 
 

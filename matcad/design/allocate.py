@@ -1,8 +1,8 @@
 """N taxels sharing one microphone: N disjoint bands in [LO, HI], one taxel solved for each, on a grid.
 
 Bands are placed upward from LO. For taxel k the allocation starts at ``start`` (LO, or the previous loaded band's
-top plus the guard, :func:`matcad.acoustics.bands.guard_hz`); its f0 is the lowest target whose solved geometry
-(:func:`matcad.design.solve.solve`) has a loaded band (:func:`matcad.acoustics.bands.taxel_band`: predicted band,
+top plus the guard, :func:`matcad.prediction.bands.guard_hz`); its f0 is the lowest target whose solved geometry
+(:func:`matcad.design.solve.solve`) has a loaded band (:func:`matcad.prediction.bands.taxel_band`: predicted band,
 rise to ``mechanics.max_force_n``) starting at or above ``start``, found by bisection on the target. A band that another taxel's 2f or 3f would land in is moved above that
 harmonic (plus the guard). Every band must end at or below HI; otherwise the message says how far the N bands
 reach. The taxels go on a grid (columns = ceil(√N)) of [[taxel]] entries with the pitch of the largest cap flange
@@ -30,7 +30,7 @@ PER_TAXEL = {"neck.diameter": "neck_diameter", "cavity.diameter": "cavity_diamet
 
 @dataclass(frozen=True)
 class Allocation:
-    """The written array spec, each taxel's band (:class:`matcad.acoustics.bands.TaxelBand`) and solution, the
+    """The written array spec, each taxel's band (:class:`matcad.prediction.bands.TaxelBand`) and solution, the
     guard (Hz), the asked band (Hz) and the run time (s)."""
 
     spec: object
@@ -50,7 +50,7 @@ class Allocation:
 
 def _harmonic_top(placed, band, guard: float) -> float | None:
     """The top (Hz) of the highest harmonic of an earlier band that ``band`` meets within the guard, or None."""
-    from matcad.acoustics.bands import conflicts
+    from matcad.prediction.bands import conflicts
 
     hits = [c for c in conflicts([*placed, band], guard) if c.other == band.name]
     return max(c.band_hz[1] for c in hits) if hits else None
@@ -61,7 +61,7 @@ def _one(base, name: str, start: float, stop: float, vary, ratio: float):
     lowest target f0 whose band clears ``start`` is found by bisection on the target (the band's shape changes
     with the geometry, so its low edge is not a fixed fraction of f0); a target whose solve fails counts as not
     clearing. Raises the last failure when no target up to ``stop`` (Hz) works."""
-    from matcad.acoustics.bands import taxel_band
+    from matcad.prediction.bands import taxel_band
 
     def attempt(target):
         try:
@@ -132,7 +132,7 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     """Allocate ``n`` disjoint bands in [``lo_hz``, ``hi_hz``] and solve one taxel for each (see the module
     docstring); ``vary`` as for :func:`matcad.design.solve.solve`, continuous per-taxel fields only. Raises
     :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
-    from matcad.acoustics.bands import guard_hz, taxel_band
+    from matcad.prediction.bands import guard_hz, taxel_band
     from matcad.rules import check, errors
     from matcad.spec import MAX_TAXELS
     from matcad.taxel import taxel_spec, taxels

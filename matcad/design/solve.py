@@ -78,7 +78,7 @@ def default_range(spec, path: str) -> tuple[float, float]:
     """The search range of one field (mm) when the user gives none: the neck between the laser's smallest feature
     and the cavity; the cavity between the neck and the cap's outside; its length from the flat-cavity limit of the
     1-D models (L/D = 0.3) to :data:`DEFAULT_LENGTH_SPAN` × the start."""
-    from matcad.acoustics.predict import PANCAKE_L_OVER_D
+    from matcad.acoustics.checks import PANCAKE_L_OVER_D
 
     if path == "neck.diameter":
         return spec.machine.laser_min_feature, spec.cavity.diameter
@@ -121,11 +121,14 @@ def parse_vary(spec, items, allowed=FIELDS) -> dict[str, tuple[float, float] | N
 def model_f0(spec, model: str, base: str) -> float:
     """f0 (Hz) of ``spec`` by ``model`` exactly as :func:`matcad.acoustics.predict.predict` computes it: one of
     the cheap models, or 'relative' (the measured reference f0 times ``base``'s ratio, this design / reference)."""
-    from matcad.acoustics.resonator import evaluate, resonator, wall_arguments
+    from matcad.acoustics import registry
+    from matcad.acoustics.design import design
+    from matcad.acoustics.resonator import resonator
     from matcad.spec import reference_spec
 
     def f(s, name):
-        return float(evaluate(resonator(s), name, *wall_arguments(s, name)))
+        d = design(s)
+        return float(registry.model(name).f0_hz(resonator(d), d.wall))
 
     if model == "relative":
         return spec.reference.f0_hz * f(spec, base) / f(reference_spec(spec), base)
@@ -134,7 +137,9 @@ def model_f0(spec, model: str, base: str) -> float:
 
 def chosen_model(spec) -> tuple[str, str]:
     """(model, base): the model `predict` picks for ``spec`` and, for 'relative', the physics model it scales."""
-    base = "elastic_wall" if spec.wall.model == "silicone" else "transmission_line"
+    from matcad.acoustics.registry import CHOSEN
+
+    base = CHOSEN[spec.wall.model]
     return ("relative" if spec.reference is not None else base), base
 
 
@@ -205,7 +210,7 @@ def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -
     """Solve ``spec``'s f0 = ``target_hz`` (Hz) varying the fields of ``vary`` ({field: (lo, hi) mm or None for
     :func:`default_range`}); see the module docstring. Raises :class:`Unreachable` (no geometry in range reaches
     the target) or :class:`RulesFailed` (every solution breaks a design rule)."""
-    from matcad.acoustics.predict import predict
+    from matcad.prediction import predict
     from matcad.rules import check, errors
 
     from matcad.taxel import is_array

@@ -1,7 +1,7 @@
 """A board of taxels heard by one microphone: every taxel's tone tracked at once, assigned to its taxel, and a
 force per taxel over time. Frequencies Hz, times s, forces N.
 
-Assignment by band. Each taxel listens in its own band: the loaded band of :func:`matcad.acoustics.bands.
+Assignment by band. Each taxel listens in its own band: the loaded band of :func:`matcad.prediction.bands.
 taxel_bands` (its predicted unloaded band widened by the rise of f under load up to the spec's maximum force).
 The bands of a valid array are disjoint with a guard and clear of each other's 2f and 3f (the band rules), so a
 tone belongs to the taxel whose band holds it, and one :class:`matcad.loop.analyze.BandTracker` per band — all fed
@@ -48,7 +48,7 @@ class TaxelTrack:
 
 def board_bands(spec) -> list[tuple[str, tuple[float, float]]]:
     """(taxel name, listening band Hz) per taxel of ``spec``, in taxels(spec) order: each taxel's loaded band."""
-    from matcad.acoustics.bands import taxel_bands
+    from matcad.prediction.bands import taxel_bands
 
     return [(b.name, tuple(b.loaded_hz)) for b in taxel_bands(spec)]
 

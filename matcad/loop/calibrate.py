@@ -318,10 +318,11 @@ def fit_from_spec(forces_n, frequencies_hz, spec, k_free: bool = False, cycles=N
                   temperature_c: float | None = None, cycle_std_n: float | None = None) -> CalibrationFit:
     """Fit with K (or V0, when ``k_free``) from the spec's as-built geometry and air; ``temperature_c`` (°C)
     is the air's during calibration (default the spec's [air] temperature_c)."""
+    from matcad.acoustics.design import design
     from matcad.acoustics.load import LoadCalibration, frequency_constant_mm3_hz2
     from matcad.acoustics.resonator import resonator
 
-    res = resonator(spec)
+    res = resonator(design(spec))
     k = float(frequency_constant_mm3_hz2(LoadCalibration(0, 0, 0), res.c_m_s, spec.neck.diameter, spec.neck.length))
     temp = spec.air.temperature_c if temperature_c is None else temperature_c
     return fit(forces_n, frequencies_hz, k, res.volume if k_free else None, cycles, temp, cycle_std_n)

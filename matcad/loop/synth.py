@@ -295,7 +295,7 @@ inside another's band."""
 
 def board_band_hz(f0_hz: float, max_force_n: float = 15.0) -> tuple[float, float]:
     """A taxel's listening band (Hz): 2 % below its unloaded pitch to 1 % above its Eq. 5 pitch at
-    ``max_force_n`` (N) — what matcad.acoustics.bands' loaded band is for a well-predicted taxel."""
+    ``max_force_n`` (N) — what matcad.prediction.bands' loaded band is for a well-predicted taxel."""
     rise = float(frequency_of_force(max_force_n) / frequency_of_force(0.0))
     return 0.98 * f0_hz, 1.01 * rise * f0_hz
 

@@ -15,9 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.acoustics import geometry, models
+from matcad.acoustics import geometry, models, registry
+from matcad.acoustics.design import Design
 from matcad.acoustics.load import LoadCalibration, frequency_constant_mm3_hz2
-from matcad.acoustics.resonator import Resonator, evaluate, resonator
+from matcad.acoustics.resonator import Resonator, resonator
 from matcad.mechanics.solver import CapCurve
 
 
@@ -70,22 +71,23 @@ def deformed_resonator(res: Resonator, volume_mm3: float, length_mm: float, neck
         inner_step=float(models.step_end_correction_mm(neck_diameter_mm, d)))
 
 
-def force_curve(spec, curve: CapCurve, f0_hz: float | None = None, fem_level: int | None = None) -> ForceCurve:
-    """f(F) of ``spec`` along ``curve``; ``f0_hz`` the unloaded ladder's chosen f0 (default: the transmission
+def force_curve(d: Design, curve: CapCurve, f0_hz: float | None = None, fem_level: int | None = None) -> ForceCurve:
+    """f(F) of design ``d`` along ``curve``; ``f0_hz`` the unloaded ladder's chosen f0 (default: the transmission
     line's); ``fem_level`` runs the FEM on every deformed outline and makes it the route of the shift."""
     from matcad.loop.calibrate import LoopError, fit
 
-    res = resonator(spec)
+    res = resonator(d)
+    line = registry.model("transmission_line")
     outlines = [curve.unloaded_outline] + [s.cavity_outline for s in curve.steps]
     forces, xs, vols = curve.column("force_n"), curve.column("displacement_mm"), curve.column("cavity_volume_mm3")
     lengths = [equivalent_length_mm(curve.split(o)[1]) for o in outlines]
-    f_tl = np.array([float(evaluate(deformed_resonator(res, v, le, spec.neck.diameter), "transmission_line"))
+    f_tl = np.array([float(line.f0_hz(deformed_resonator(res, v, le, d.neck_diameter)))
                      for v, le in zip(vols, lengths)])
     f_fem, fem_note = None, ""
     if fem_level is not None:
         from matcad.acoustics import fem
 
-        g = fem.geometry_from_spec(spec)
+        g = fem.geometry(d)
         f_fem = np.full(len(f_tl), np.nan)
         for i, (f_guess, o) in enumerate(zip(f_tl, outlines)):
             try:
@@ -100,7 +102,7 @@ def force_curve(spec, curve: CapCurve, f0_hz: float | None = None, fem_level: in
     slope = np.gradient(f, forces) if len(f) > 1 else np.zeros(1)
     falling = np.flatnonzero(np.diff(f) <= 0)
     turn = float(forces[falling[0]]) if len(falling) else None
-    k = float(frequency_constant_mm3_hz2(LoadCalibration(0, 0, 0), res.c_m_s, spec.neck.diameter, spec.neck.length))
+    k = float(frequency_constant_mm3_hz2(LoadCalibration(0, 0, 0), res.c_m_s, d.neck_diameter, d.neck_length))
     eq5 = eq5_paper = None
     note = ""
     try:
@@ -138,14 +140,14 @@ def at_forces(fc: ForceCurve, forces_n) -> list[tuple[float, float | None, float
     return out
 
 
-def load_points(spec, forces_n, f0_hz: float, fem_level: int | None = None) -> tuple[list[dict], dict]:
+def load_points(d: Design, curve: CapCurve, forces_n, f0_hz: float,
+                fem_level: int | None = None) -> tuple[list[dict], dict]:
     """The cap model's answer to ``matcad predict --force``: one row per force (force_n, f_hz, displacement_mm,
     cavity_volume_mm3, reason, source) and a summary (material, contact, run, df/dF, turn force, Eq. 5 fit, the
-    whole computed curve with each state's deformed cavity outline as [r, z] mm from the wall's foot to the axis). ``f0_hz`` is the unloaded ladder's chosen f0 (Hz); see :func:`force_curve`."""
-    from matcad.mechanics.solver import cap_curve
-
-    curve = cap_curve(spec)
-    fc = force_curve(spec, curve, f0_hz, fem_level)
+    whole computed curve with each state's deformed cavity outline as [r, z] mm from the wall's foot to the axis) for
+    design ``d`` along the cap's ``curve``. ``f0_hz`` is the unloaded ladder's chosen f0 (Hz); see
+    :func:`force_curve`."""
+    fc = force_curve(d, curve, f0_hz, fem_level)
     source = f"cap mechanics ({curve.material.model}, {curve.contact}, G = {curve.material.shear_modulus_mpa:.3g} MPa)"
     rows = [{"force_n": F, "f_hz": f, "displacement_mm": x, "cavity_volume_mm3": v, "reason": why, "source": source}
             for F, f, x, v, why in at_forces(fc, forces_n)]

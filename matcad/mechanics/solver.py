@@ -123,21 +123,9 @@ def _singular_corner(cm: CapMesh, sec: CapSection, point) -> str:
     return ""
 
 
-def cap_curve(spec) -> CapCurve:
-    """The load curve of ``spec``'s cap with its [mechanics] choices and [silicone] grade (see :func:`compress`).
-    Raises SpecError when the plate travel does not fit above the clamp guide."""
-    from matcad.mechanics.material import preset
-    from matcad.mechanics.section import section_from_spec
-    from matcad.spec import SpecError
-
-    mech = spec.mechanics
-    sec = section_from_spec(spec)
-    free = sec.height - sec.flange_thickness
-    if mech.displacement_mm >= free:
-        raise SpecError("mechanics.displacement_mm", mech.displacement_mm,
-                        f"must be < {free:.4g} mm, the cap's height above the clamp guide")
-    return compress(sec, preset(mech.material, spec.silicone.grade, mech.shear_modulus_mpa), mech.contact,
-                    mech.displacement_mm, mech.steps, mech.element_size_mm)
+def cap_curve(case) -> CapCurve:
+    """The load curve of a :class:`~matcad.mechanics.case.CapCase` (see :func:`compress`)."""
+    return compress(case.section, case.material, case.contact, case.displacement_mm, case.steps, case.element_size_mm)
 
 
 def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking", displacement_mm: float = 2.0,

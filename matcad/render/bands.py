@@ -11,7 +11,7 @@ BANDS_PNG = "plot_taxel_bands.png"
 
 
 def bands_markdown(d: dict | None) -> list[str]:
-    """The report's "Taxel bands" section from :func:`matcad.acoustics.bands.summary`'s data."""
+    """The report's "Taxel bands" section from :func:`matcad.prediction.bands.summary`'s data."""
     if not d:
         return []
     lines = ["", "## Taxel bands", "",
@@ -29,7 +29,7 @@ def bands_markdown(d: dict | None) -> list[str]:
 
 
 def band_chart(d: dict, path: Path) -> dict:
-    """Draw :func:`matcad.acoustics.bands.summary`'s data: one row per taxel with its unloaded band, the loaded rise on top, the
+    """Draw :func:`matcad.prediction.bands.summary`'s data: one row per taxel with its unloaded band, the loaded rise on top, the
     guard either side (hatched), its 2f and 3f (light, where they fall near the bands) and any conflict in red."""
     rows = d["taxels"]
     lo = min(t["loaded_hz"][0] for t in rows) - 3 * d["guard_hz"]

@@ -21,9 +21,9 @@ def load_forces_n(spec) -> np.ndarray:
     """Forces (N) at which the build draws Eq. 5 f(F) for ``spec``'s calibration; empty without one (the cap
     mechanics' curve takes seconds and stays with ``matcad predict --load``)."""
     from matcad.acoustics.load import force_at_volume_minimum_n
-    from matcad.acoustics.predict import spec_calibration
+    from matcad.acoustics.design import calibration
 
-    cal = spec_calibration(spec)
+    cal = calibration(spec)
     if cal is None:
         return np.array([])
     lo, hi = spec.calibration.force_range_n or (0.0, LOAD_FORCE_MAX_N)
@@ -34,7 +34,7 @@ def load_forces_n(spec) -> np.ndarray:
 def render_figures(spec, prediction, folder: Path, meshes: dict) -> list[dict]:
     """Write every preview and plot for ``spec`` into ``folder``; ``meshes`` names the STLs written (file →
     checks). Returns [{part, file, caption}] in report order: section, plots, laser parts, printed parts."""
-    from matcad.acoustics.predict import predict
+    from matcad.prediction import predict
     from matcad.parts.catalogue import laser_parts
     from matcad.parts.flat import cut_plan
     from matcad.render.plots import BAND_PNG, LOAD_PNG, band_plot, load_plot

@@ -29,7 +29,7 @@ class Finding:
 def check(spec, prediction=None) -> list[Finding]:
     """Run every rule on ``spec``; ``prediction`` (from acoustics.predict, of a single-taxel spec) is computed when
     not given; a board's acoustic rules run on each taxel's own prediction."""
-    from matcad.acoustics.predict import predict
+    from matcad.prediction import predict
     from matcad.rules import acoustic, bands, board as board_rules, laser, printing, stack
 
     from matcad.taxel import taxel_spec, taxels

@@ -1,7 +1,7 @@
-"""Rules on a board's bands: one microphone must tell every taxel apart (matcad.acoustics.bands).
+"""Rules on a board's bands: one microphone must tell every taxel apart (matcad.prediction.bands).
 
 Each taxel's loaded band (its predicted band plus the rise up to ``mechanics.max_force_n``) must stay the loop's
-guard (:func:`matcad.acoustics.bands.guard_hz`) away from every other taxel's, and the 2nd and 3rd harmonics of its
+guard (:func:`matcad.prediction.bands.guard_hz`) away from every other taxel's, and the 2nd and 3rd harmonics of its
 loaded band must stay that far from every other band: otherwise the tracker cannot say which taxel it hears.
 Single-taxel specs have nothing to separate and skip these rules (so their check never runs the cap mechanics).
 """
@@ -18,7 +18,7 @@ FIX = ("move the taxels apart in frequency (`matcad design --taxels N --band LO 
 def band_separation(spec) -> list[Finding]:
     """Errors for every pair of loaded bands closer than the guard, and every 2f/3f of one taxel's loaded band
     within the guard of another's band; an info line with each taxel's bands (Hz)."""
-    from matcad.acoustics.bands import conflicts, guard_hz, taxel_bands
+    from matcad.prediction.bands import conflicts, guard_hz, taxel_bands
     from matcad.taxel import is_array
 
     if not is_array(spec):

@@ -1,11 +1,12 @@
-"""The closed-form rungs on arrays of variants: f0, validity checks, the uncertainty band and df0/dfield in one
-numpy call each, the same numbers as :func:`matcad.acoustics.predict.predict` one variant at a time (tested to
-1e-9 relative on random variants).
+"""The closed-form rungs on arrays of variants: f0, validity checks, the uncertainty band and df0/dfield, each in a
+few numpy calls. These are the registered models (:mod:`matcad.acoustics.registry`), their checks
+(:mod:`matcad.acoustics.checks`) and the uncertainty budget (:mod:`matcad.acoustics.uncertainty`) evaluated on a
+:class:`~matcad.acoustics.design.Design` whose fields are arrays: the same code `matcad predict` runs on one
+variant, so the numbers are the same (tested to 1e-9 relative on random variants).
 
 Inputs are a dict of arrays keyed by dotted spec field (:data:`FIELDS`; lengths mm, angles deg, temperature °C,
-speed of sound m/s, NaN where the spec leaves it to the temperature). The band is
-:mod:`matcad.acoustics.uncertainty`'s budget evaluated line by line on the arrays: model error (model_errors.json),
-neck diameter, sheet, cavity diameter, draft and temperature tolerances, boundary layers; root-sum-square in ln f.
+speed of sound m/s, NaN where the spec leaves it to the temperature) and what the variants share (the neck's mouth,
+the wall material, how they are made). The closed forms read no cap: its fields are NaN.
 """
 
 from __future__ import annotations
@@ -14,11 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.acoustics import models, registry, uncertainty
-from matcad.acoustics.air import boundary_layer_shift, speed_of_sound_m_s
-from matcad.acoustics.predict import (LUMPED_END_CORRECTION_RATIO, LUMPED_NECK_AIR_RATIO, PANCAKE_L_OVER_D,
-                                      PLANE_WAVE_CUTOFF_KA)
-from matcad.acoustics.resonator import as_built, evaluate
+from matcad.acoustics import checks, registry, uncertainty
+from matcad.acoustics.design import Air, Design, Making, WallMaterial, gap_radius_mm
+from matcad.acoustics.evaluation import Evaluation
 
 VECTORISED = tuple(m.name for m in registry.MODELS if m.cheap and "rigid" in m.walls)
 """The registered rungs that are closed forms of the geometry alone (no wall, no reference, no FEM): lumped,
@@ -27,37 +26,49 @@ FIELDS = ("cavity.diameter", "cavity.length", "neck.diameter", "neck.length", "m
           "air.speed_of_sound", "spacer.height", "plate.width", "plate.depth")
 """The spec fields the closed-form rungs read; df0/dfield of any other field is exactly 0 for them."""
 CHUNK = 16_384
-"""Variants per numpy pass in :func:`f0_hz`: arrays that stay in cache (measured ~2x faster than one 1e6 pass)."""
+"""Variants per numpy pass: arrays that stay in cache (measured ~2x faster than one 1e6 pass)."""
 RELATIVE_STEP = 1e-6
 """Central-difference step of :func:`sensitivity`, relative to the field's value (at least 1e-6 of its unit)."""
+NO_CAP = float("nan")
 
 
 @dataclass(frozen=True)
 class Variants:
-    """Arrays of the :data:`FIELDS` (one entry per variant), the per-variant tolerances of the budget (mm) and
-    the neck mouth they share."""
+    """Arrays of the :data:`FIELDS` (one entry per variant), how each variant is made (a :class:`Making` of
+    arrays) and what every variant shares: the neck's mouth and the wall material (the closed forms ignore it)."""
 
     values: dict[str, np.ndarray]
-    neck_diameter_tol: np.ndarray
-    sheet_tol: np.ndarray
-    cavity_diameter_tol: np.ndarray
     mouth: str
+    wall: WallMaterial
+    making: Making
 
     def __len__(self) -> int:
         return len(self.values["cavity.diameter"])
 
-    def part(self, start: int, stop: int) -> "Variants":
+    def part(self, start: int, stop: int) -> Variants:
         """Variants ``start:stop``."""
-        return Variants({k: x[start:stop] for k, x in self.values.items()}, self.neck_diameter_tol[start:stop],
-                        self.sheet_tol[start:stop], self.cavity_diameter_tol[start:stop], self.mouth)
+        m = self.making
+        making = Making(m.neck_drilled[start:stop], m.sheet_measured[start:stop], m.printer[start:stop])
+        return Variants({k: x[start:stop] for k, x in self.values.items()}, self.mouth, self.wall, making)
 
-    def with_value(self, field: str, array) -> "Variants":
-        return Variants({**self.values, field: np.asarray(array, dtype=float)}, self.neck_diameter_tol,
-                        self.sheet_tol, self.cavity_diameter_tol, self.mouth)
+    def with_value(self, field: str, array) -> Variants:
+        return Variants({**self.values, field: np.asarray(array, dtype=float)}, self.mouth, self.wall, self.making)
+
+    def design(self) -> Design:
+        """The variants as one :class:`Design` of arrays."""
+        x = self.values
+        return Design(cavity_diameter=x["cavity.diameter"], cavity_length=x["cavity.length"],
+                      draft_deg=x["mold.draft_deg"], neck_diameter=x["neck.diameter"], neck_length=x["neck.length"],
+                      mouth=self.mouth, gap_mm=x["spacer.height"],
+                      gap_radius_mm=gap_radius_mm(x["plate.width"], x["plate.depth"]), cap_outer_diameter=NO_CAP,
+                      cap_top_thickness=NO_CAP, cap_clamp_height=NO_CAP,
+                      air=Air(x["air.temperature_c"], x["air.speed_of_sound"]), wall=self.wall, making=self.making)
 
 
 def from_specs(specs) -> Variants:
-    """The arrays of validated specs that share one ``neck.mouth`` (a sweep varies numbers only)."""
+    """The arrays of validated specs that share one ``neck.mouth``."""
+    from matcad.acoustics.design import design
+
     mouths = {s.neck.mouth for s in specs}
     if len(mouths) != 1:
         raise ValueError(f"variants must share one neck.mouth, got {sorted(mouths)}")
@@ -68,75 +79,58 @@ def from_specs(specs) -> Variants:
         return np.nan if value is None else value
 
     values = {key: np.array([get(s, key) for s in specs], dtype=float) for key in FIELDS}
-    d_tol = np.array([uncertainty.NECK_DIAMETER_TOL_MM["drilled" if s.plate.neck_pilot else "laser"] for s in specs])
-    sheet = np.array([uncertainty.sheet_tolerance_mm(s.neck.length, s.plate.thickness_measured) for s in specs])
-    cav_tol = np.array([uncertainty.CAVITY_DIAMETER_TOL_MM[s.machine.printer] for s in specs])
-    return Variants(values, d_tol, sheet, cav_tol, mouths.pop())
+    made = [design(s).making for s in specs]
+    making = Making(np.array([m.neck_drilled for m in made]), np.array([m.sheet_measured for m in made]),
+                    np.array([m.printer for m in made]))
+    return Variants(values, mouths.pop(), design(specs[0]).wall, making)
 
 
-def speed_of_sound(v: Variants) -> np.ndarray:
-    """c per variant (m/s): air.speed_of_sound where given, else from air.temperature_c."""
-    given = v.values["air.speed_of_sound"]
-    return np.where(np.isnan(given), speed_of_sound_m_s(v.values["air.temperature_c"]), given)
+def _chunked(function, v: Variants, *columns):
+    """``function(variants, *columns)`` chunk by chunk of :data:`CHUNK` variants (columns: per-variant arrays),
+    its array results joined."""
+    if len(v) <= CHUNK:
+        return function(v, *columns)
+    parts = [function(v.part(i, i + CHUNK), *(c[i:i + CHUNK] for c in columns)) for i in range(0, len(v), CHUNK)]
+    if isinstance(parts[0], tuple):
+        return tuple(np.concatenate(p) for p in zip(*parts))
+    return np.concatenate(parts)
 
 
-def resonators(v: Variants):
-    """:func:`matcad.acoustics.resonator.as_built` on the arrays (a Resonator of arrays)."""
-    x = v.values
-    return as_built(speed_of_sound(v), x["cavity.diameter"], x["cavity.length"], x["neck.diameter"], x["neck.length"],
-                    x["mold.draft_deg"], v.mouth, x["spacer.height"], np.minimum(x["plate.width"], x["plate.depth"]) / 2)
+def _model(model: str):
+    if model not in VECTORISED:
+        raise ValueError(f"model {model!r} is not vectorised, must be one of {list(VECTORISED)}")
+    return registry.model(model)
 
 
 def f0_hz(v: Variants, model: str) -> np.ndarray:
     """f0 (Hz) of every variant by one of :data:`VECTORISED` (paper Eq. 1; Rayleigh/Ingard; Selamet 1997)."""
-    if model not in VECTORISED:
-        raise ValueError(f"model {model!r} is not vectorised, must be one of {list(VECTORISED)}")
-    if len(v) > CHUNK:
-        return np.concatenate([f0_hz(v.part(i, i + CHUNK), model) for i in range(0, len(v), CHUNK)])
-    return np.asarray(evaluate(resonators(v), model), dtype=float)
+    m = _model(model)
+    return _chunked(lambda part: np.asarray(m.f0_hz(Evaluation(part.design()).res), dtype=float), v)
 
 
 def valid(v: Variants, model: str, f0) -> np.ndarray:
-    """predict's validity checks of ``model`` per variant (True where all pass): lumped neck (A·l/V), end
-    corrections ≪ l, Ingard's ξ < 0.4, plane waves in the cavity (k·D/2 < 1.8412) and L/D ≥ 0.3."""
-    res = resonators(v)
-    air_ratio = res.neck_area * res.neck_length / res.volume
-    if model == "lumped":
-        return (air_ratio < LUMPED_NECK_AIR_RATIO) & \
-            ((res.outer_correction + res.inner_step) / res.neck_length < LUMPED_END_CORRECTION_RATIO)
-    if model == "end_corrected":
-        return (air_ratio < LUMPED_NECK_AIR_RATIO) & (np.sqrt(res.neck_area / res.cavity_area) < models.INGARD_XI_LIMIT)
-    k = 2 * np.pi * np.asarray(f0) / (res.c_m_s * models.MM_PER_M)
-    return (k * res.cavity_diameter / 2 < PLANE_WAVE_CUTOFF_KA) & (res.cavity_length / res.cavity_diameter
-                                                                    >= PANCAKE_L_OVER_D)
+    """The model's validity checks (:mod:`matcad.acoustics.checks`) per variant: True where all pass."""
+    m = _model(model)
+
+    def chunk(part, f):
+        results = checks.evaluate(m.checks, Evaluation(part.design()), np.asarray(f))
+        return np.logical_and.reduce([np.asarray(r, dtype=bool) for r in results.values()])
+
+    return _chunked(chunk, v, np.asarray(f0, dtype=float))
 
 
 def band_hz(v: Variants, model: str, f0, ok) -> tuple[np.ndarray, np.ndarray]:
-    """(low, high) band edges (Hz): :func:`matcad.acoustics.uncertainty.budget` line by line on the arrays: the
-    model's measured error (``ok`` is :func:`valid`), each tolerance moved to both of its
-    :func:`~matcad.acoustics.uncertainty.tolerance_ends`, boundary layers; combined root-sum-square in ln f by
-    :func:`~matcad.acoustics.uncertainty.combine`."""
-    f0 = np.asarray(f0, dtype=float)
-    x = v.values
-    lows, highs = [], []
-    error = uncertainty.model_errors().get(model)
-    if error is not None:
-        worst = uncertainty.model_error_share(error, ok)
-        lows.append(-worst * f0)
-        highs.append(worst * f0)
-    ends = uncertainty.tolerance_ends(x["neck.diameter"], x["neck.length"], x["cavity.diameter"], x["cavity.length"],
-                                      x["mold.draft_deg"], x["air.temperature_c"], v.neck_diameter_tol, v.sheet_tol,
-                                      v.cavity_diameter_tol)
-    by_temperature = np.isnan(x["air.speed_of_sound"])  # an explicit speed of sound has no temperature line
-    for field, (low_end, high_end) in ends.items():
-        fs = [f0_hz(v.with_value(field, end), model) - f0 for end in (low_end, high_end)]
-        applies = by_temperature if field == "air.temperature_c" else True
-        lows.append(np.where(applies, np.minimum(np.minimum(*fs), 0.0), 0.0))
-        highs.append(np.where(applies, np.maximum(np.maximum(*fs), 0.0), 0.0))
-    eps = boundary_layer_shift(f0, x["neck.diameter"] / 2)
-    lows.append(-eps / (1.0 + eps) * f0)
-    low, high = uncertainty.combine(lows, highs, f0)
-    return f0 + low, f0 + high
+    """(low, high) band edges (Hz): the uncertainty budget of ``model`` (:func:`matcad.acoustics.uncertainty.budget`)
+    on the arrays, ``ok`` the variants whose checks pass (:func:`valid`), combined root-sum-square in ln f."""
+    _model(model)
+
+    def chunk(part, f, good):
+        d = part.design()
+        lines = uncertainty.budget(d, Evaluation(d).res, model, f, good)
+        low, high = uncertainty.combine([x.low_hz for x in lines], [x.high_hz for x in lines], f)
+        return f + low, f + high
+
+    return _chunked(chunk, v, np.asarray(f0, dtype=float), np.asarray(ok))
 
 
 def sensitivity(v: Variants, model: str, field: str) -> np.ndarray:

@@ -86,7 +86,9 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     """Sweep the spec ``data`` (raw TOML-like data; each variant is it with the axes' values set, validated like a
     file, so defaults such as the cap's 2.5 × D follow the varied cavity) over the full grid of ``axes``.
     ``model`` defaults to the spec's own choice (:func:`predict`); ``cad`` also builds each variant's end cap."""
-    from matcad.acoustics.predict import predict, spec_calibration
+    from matcad.acoustics.design import calibration
+    from matcad.prediction import predict
+    from matcad.acoustics.air import speed_of_sound_m_s
     from matcad.acoustics.load import frequency_at_force_hz
     from matcad.spec import SpecError, from_dict
 
@@ -118,10 +120,10 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
             rows[i].update(f0_hz=float(f0[j]), band_low_hz=float(low[j]), band_high_hz=float(high[j]),
                            model_valid=bool(valid[j]), **{k: float(s[j]) for k, s in slopes.items()})
     for i in ok:
-        cal = spec_calibration(specs[i])
+        cal = calibration(specs[i])
         if cal is not None:
             s = specs[i]
-            c = s.air.speed_of_sound or float(fast.speed_of_sound_m_s(s.air.temperature_c))
+            c = s.air.speed_of_sound or float(speed_of_sound_m_s(s.air.temperature_c))
             f_zero = float(frequency_at_force_hz(cal, 0.0, c, s.neck.diameter, s.neck.length))
             rows[i][LOAD_SENSITIVITY] = f_zero * cal.b / (2.0 * cal.v0_mm3)
     worker_seconds = 0.0

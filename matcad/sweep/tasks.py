@@ -26,7 +26,7 @@ def run_variant(task: dict) -> dict:
     try:
         prediction = None
         if task.get("predict") or task.get("rules"):
-            from matcad.acoustics.predict import predict
+            from matcad.prediction import predict
 
             prediction = predict(spec, model=task.get("model"), fem_level=task.get("fem_level"), mechanics=False)
         if task.get("predict"):

@@ -1,6 +1,6 @@
 """Each taxel's frequency band: where one microphone must listen for it, unloaded and pressed. Frequencies Hz.
 
-A taxel's band is its unloaded predicted band (:func:`matcad.acoustics.predict.predict`'s ``band_hz``: the chosen
+A taxel's band is its unloaded predicted band (:func:`matcad.prediction.taxel.predict`'s ``band_hz``: the chosen
 model's f0 with the uncertainty budget, root-sum-square in ln f) widened upward by the rise of f under load up to
 ``mechanics.max_force_n``:
 
@@ -116,35 +116,18 @@ def eq5_rise(cal, max_force_n: float) -> tuple[float, float]:
     return float(ratio.min()), float(ratio.max())
 
 
-_CAP_CURVES: dict = {}
-"""Cap mechanics curves by cap (see :func:`_cap_key`): one FElupe run per distinct cap per process."""
-
-
-def _cap_key(spec) -> tuple:
-    """What a cap curve depends on: the cap's geometry (cavity, end cap, flange from the guide, draft), the
-    silicone grade and the [mechanics] law and loading (not the force the band is taken to)."""
-    return (spec.cavity, spec.end_cap, spec.guide, spec.mold.draft_deg, spec.silicone.grade,
-            tuple(getattr(spec.mechanics, f.name) for f in dataclasses.fields(spec.mechanics) if f.name != "max_force_n"))
-
-
-def cap_curve_cached(spec):
-    """:func:`matcad.mechanics.solver.cap_curve` of ``spec``'s cap, computed once per distinct cap."""
-    key = _cap_key(spec)
-    if key not in _CAP_CURVES:
-        from matcad.mechanics.solver import cap_curve
-
-        _CAP_CURVES[key] = cap_curve(spec)
-    return _CAP_CURVES[key]
-
-
 def mechanics_rise(spec, f0_hz: float, max_force_n: float) -> tuple[float, float, str]:
-    """(min, max) of f(F)/f(0) over 0 <= F <= ``max_force_n`` (N) from the cap mechanics, and its source text;
-    SpecError naming ``mechanics.max_force_n`` when the computed curve stops below that force."""
+    """(min, max) of f(F)/f(0) over 0 <= F <= ``max_force_n`` (N) from the cap mechanics of the single-taxel
+    ``spec`` (its curve computed once per distinct cap: :func:`matcad.prediction.taxel.cap_curve`), and its source
+    text; SpecError naming ``mechanics.max_force_n`` when the computed curve stops below that force."""
+    from matcad.acoustics.design import design
+    from matcad.mechanics.case import cap_case
     from matcad.mechanics.frequency import at_forces, force_curve
+    from matcad.prediction.taxel import cap_curve
     from matcad.spec import SpecError
 
-    curve = cap_curve_cached(spec)
-    fc = force_curve(spec, curve, f0_hz)
+    curve = cap_curve(cap_case(spec))
+    fc = force_curve(design(spec), curve, f0_hz)
     forces = np.array([s.force_n for s in fc.states])
     f = np.array([s.f_hz for s in fc.states])
     top = at_forces(fc, [max_force_n])[0][1]
@@ -163,12 +146,13 @@ def taxel_band(spec, name: str = "t1", x_mm: float = 0.0, y_mm: float = 0.0, mec
     without a [calibration] the rise is then not computed (``rise`` 1, ``rise_source`` says so) and FElupe is not
     imported. A maximum force the rise's model does not reach raises SpecError, or with ``strict=False`` leaves the
     rise not computed and says why. ``prediction`` is ``predict(spec)`` when the caller has it."""
-    from matcad.acoustics.predict import predict, spec_calibration
+    from matcad.acoustics.design import calibration
+    from matcad.prediction.taxel import predict
     from matcad.spec import SpecError
 
     p = prediction or predict(spec, mechanics=False)
     force = spec.mechanics.max_force_n
-    cal = spec_calibration(spec)
+    cal = calibration(spec)
     try:
         if cal is not None:
             low, high = eq5_rise(cal, force)

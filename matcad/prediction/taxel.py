@@ -1,0 +1,78 @@
+"""One taxel's prediction under load: the unloaded acoustics composed with Eq. 5 (a calibration) and the cap
+mechanics. Forces N, frequencies Hz, lengths mm.
+
+:func:`predict` is what `matcad predict` prints: the acoustic ladder's unloaded f0 and band
+(:func:`matcad.acoustics.predict.predict`) and, at the asked forces, f(F) from the spec's [calibration] (paper
+Eq. 5) and from the cap pressed by a plate (:mod:`matcad.mechanics`, FElupe, seconds), each point naming its
+source. The cap's curve is computed once per distinct cap in a process (:func:`cap_curve`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from matcad.acoustics import design as adapt
+from matcad.acoustics.load import MAT_PAPER_2024, frequency_at_force_hz, invalid_reason
+from matcad.acoustics.predict import LoadPoint, Prediction
+from matcad.acoustics.predict import predict as predict_unloaded
+
+_CAP_CURVES: dict = {}
+"""Cap mechanics curves by :class:`matcad.mechanics.case.CapCase`: one FElupe run per distinct cap per process."""
+
+
+def cap_curve(case):
+    """:func:`matcad.mechanics.solver.cap_curve` of a cap case, computed once per distinct case."""
+    if case not in _CAP_CURVES:
+        from matcad.mechanics import solver
+
+        _CAP_CURVES[case] = solver.cap_curve(case)
+    return _CAP_CURVES[case]
+
+
+def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None = None,
+            mechanics: bool = True) -> Prediction:
+    """Predict the unloaded resonance of the single-taxel ``spec`` with every model, and f at ``forces_n`` (N) from
+    the cap mechanics (imported only then; ``mechanics=False`` skips it) and, if calibrated, from Eq. 5 too.
+
+    ``model`` overrides the automatic choice: a registered model that serves the spec's wall, or 'relative'
+    (ValueError otherwise); ``fem_level`` sets the FEM's elements across the neck radius (default
+    :data:`matcad.acoustics.fem.DEFAULT_LEVEL`).
+    """
+    if spec.taxel or spec.array is not None:
+        from matcad.spec import SpecError
+        from matcad.taxel import taxel_spec, taxels
+
+        board = taxels(spec)
+        if len(board) > 1:  # a board is predicted taxel by taxel (matcad.prediction.bands)
+            raise SpecError("taxel", f"{len(board)} taxels", "predict answers for one taxel so far")
+        spec = taxel_spec(spec, board[0])
+    d = adapt.design(spec)
+    p = predict_unloaded(d, adapt.reference(spec), model, fem_level)
+    cal = adapt.calibration(spec)
+    warnings = list(p.warnings)
+    curve: tuple[LoadPoint, ...] = ()
+    load_model = None
+    if len(forces_n):
+        if cal is not None:
+            f_at = frequency_at_force_hz(cal, np.asarray(forces_n, dtype=float), p.speed_of_sound_m_s,
+                                         d.neck_diameter, d.neck_length)
+            curve = tuple(LoadPoint(float(force), None if np.isnan(f) else float(f), invalid_reason(cal, force),
+                                    source=f"calibration {cal.name} (Eq. 5)") for force, f in zip(forces_n, f_at))
+            if cal.area_convention == MAT_PAPER_2024.area_convention:
+                warnings.append("load curve uses the paper's A = d^2/4 convention with its fitted V0 (see docs/paper.md); "
+                                "its volumes are not physical cavity volumes")
+    if len(forces_n) and mechanics:
+        from matcad.acoustics.fem import DEFAULT_LEVEL
+        from matcad.mechanics.case import cap_case
+        from matcad.mechanics.frequency import load_points
+
+        # the FEM route on the deformed outlines when the FEM is the chosen model
+        rows, load_model = load_points(d, cap_curve(cap_case(spec)), forces_n, p.f0_hz,
+                                       (fem_level or DEFAULT_LEVEL) if p.model == "fem" else None)
+        curve += tuple(LoadPoint(**row) for row in rows)
+        if load_model["message"]:
+            warnings.append(f"cap mechanics: {load_model['message']}")
+    return dataclasses.replace(p, warnings=tuple(warnings), load_curve=curve, load_model=load_model,
+                               calibration=None if cal is None else f"{cal.name} ({cal.area_convention})")
