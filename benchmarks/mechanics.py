@@ -13,7 +13,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from matcad import spec as spec_mod  # noqa: E402
-from matcad.acoustics.load import MAT_PAPER_2024, frequency_at_force_hz, frequency_constant_mm3_hz2  # noqa: E402
+from matcad.acoustics.eq5 import MAT_PAPER_2024  # noqa: E402
 from matcad.prediction import predict  # noqa: E402
 from matcad.acoustics.design import design  # noqa: E402
 from matcad.mechanics.case import cap_case  # noqa: E402
@@ -46,12 +46,13 @@ def main():
               f"complete: {curve.complete}), f(F) by transmission line {t_tl:.2f} s, total {t_mech + t_tl:.1f} s "
               f"(target < 20 s)")
         c = spec.air.speed_of_sound or 343.21
-        k_d2 = float(frequency_constant_mm3_hz2(MAT_PAPER_2024, c, spec.neck.diameter, spec.neck.length))
+        paper = MAT_PAPER_2024.bound(c, spec.neck.diameter, spec.neck.length)
+        k_d2 = paper.k_mm3_hz2
         print(f"  {'x mm':>5} {'F N':>7} {'paper F':>8} {'V mm3':>7} {'Veff d2/4':>9} {'paper Veff':>10} "
               f"{'f Hz':>7} {'paper Eq5 f':>11} {'df/dF Hz/N':>10} {'peak eps':>8}")
         for s, d, eps in zip(fc.states, fc.sensitivity_hz_per_n, curve.column("peak_strain")):
             x = s.displacement_mm
-            paper_f = float(frequency_at_force_hz(MAT_PAPER_2024, s.force_n, c, spec.neck.diameter, spec.neck.length))
+            paper_f = float(paper.frequency_hz(s.force_n))
             print(f"  {x:5.2f} {s.force_n:7.2f} {8.8719 * x + 2.876:8.2f} {s.cavity_volume_mm3:7.2f} "
                   f"{k_d2 / s.f_hz ** 2:9.2f} {0.5576 * x * x - 3.2659 * x + 30.74:10.2f} {s.f_hz:7.0f} "
                   f"{paper_f:11.0f} {d:10.1f} {eps:8.3f}")
@@ -70,7 +71,7 @@ def main():
         print(f"  relative (independent of f0 and of the area convention): b/V0 = {e.b / e.v0_mm3:.5f} /N, "
               f"a/V0 = {e.a / e.v0_mm3:.3e} /N² (paper: {0.4626 / 32.21:.5f}, {-0.0086 / 32.21:.3e}); f(F)/f0 at "
               + ", ".join(f"{F:g} N: {np.interp(F, force, [s.f_hz for s in fc.states]) / fc.states[0].f_hz:.4f} "
-                          f"(paper {float(frequency_at_force_hz(MAT_PAPER_2024, F, c, spec.neck.diameter, spec.neck.length)) / float(frequency_at_force_hz(MAT_PAPER_2024, 0.0, c, spec.neck.diameter, spec.neck.length)):.4f})"
+                          f"(paper {float(paper.frequency_hz(F) / paper.frequency_hz(0.0)):.4f})"
                           for F in (5.0, 10.0, 15.4, 25.0)))
     spec = paper_spec("ogden")
     curve = cap_curve(cap_case(spec))

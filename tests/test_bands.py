@@ -10,7 +10,6 @@ from matcad import spec as spec_mod
 from matcad.prediction import bands
 from matcad.prediction import taxel as taxel_prediction
 from matcad.prediction.bands import TaxelBand, conflicts, guard_hz, taxel_band
-from matcad.acoustics.load import frequency_at_force_hz
 from matcad.acoustics.design import calibration
 from matcad.prediction import predict
 from matcad.spec import SpecError
@@ -28,7 +27,7 @@ def test_calibrated_band_is_the_predicted_band_raised_by_eq5():
     b = taxel_band(s)
     p = predict(s)
     cal = calibration(s)
-    f = frequency_at_force_hz(cal, [0.0, s.mechanics.max_force_n], 343.0, 2.1, 6.35)  # f(F)/f(0) needs no K
+    f = cal.frequency_hz([0.0, s.mechanics.max_force_n])
     assert b.f0_hz == p.f0_hz and b.unloaded_hz == p.band_hz
     assert b.rise == pytest.approx(f[1] / f[0], rel=1e-12)
     assert b.loaded_hz == (pytest.approx(p.band_hz[0]), pytest.approx(p.band_hz[1] * f[1] / f[0]))

@@ -8,7 +8,6 @@ import pytest
 from matcad import spec as spec_mod
 from matcad.acoustics import fem
 from matcad.acoustics.design import design
-from matcad.acoustics.load import frequency_at_force_hz
 from matcad.prediction import predict
 from matcad.mechanics.frequency import at_forces, equivalent_length_mm, force_curve
 from matcad.mechanics.material import preset
@@ -60,7 +59,7 @@ def test_force_curve_rises_and_starts_at_the_unloaded_ladder(curve):
     # the Eq. 5 fit reproduces the predicted curve it was fitted to within 0.5 %, in both area conventions
     forces = np.array([s.force_n for s in fc.states])
     for cal in (fc.eq5, fc.eq5_paper_convention):
-        back = frequency_at_force_hz(cal, forces, 343.2, PAPER.neck.diameter, PAPER.neck.length)
+        back = cal.bound(343.2, PAPER.neck.diameter, PAPER.neck.length).frequency_hz(forces)
         assert back == pytest.approx(f, rel=5e-3)
 
 

@@ -218,6 +218,51 @@ def test_registry_models_evaluate_their_closed_forms():
         model("fem").f0_hz(res)  # a solver rung is not a closed form
 
 
+def _half_lumped(res, shear_modulus_pa=None, loss_factor=0.0):
+    """A made-up rung for the registration test: half of paper Eq. 1 (Hz)."""
+    from matcad.acoustics import resonator
+
+    return resonator.lumped_hz(res) / 2
+
+
+def test_predict_takes_every_registered_model_or_says_why():
+    """`predict --model M` for every registered model and derived choice, on a rigid and a silicone template:
+    M's own f0 is the answer, or a ValueError that names why M does not apply."""
+    from matcad.acoustics.registry import model_choices
+    from matcad.prediction import predict
+
+    reasons = {"soft_wall": "serves wall.model = 'silicone' only", "elastic_wall": "serves wall.model = 'silicone'",
+               "relative": "needs a [reference] taxel"}
+    for spec in (load_spec(LASER_ONLY), load_spec(PAPER)):
+        for name in model_choices():
+            try:
+                p = predict(spec, model=name, fem_level=2, mechanics=False)
+            except ValueError as exc:
+                assert name in reasons and reasons[name] in str(exc), (spec.wall.model, name, exc)
+                continue
+            assert p.model == name and p.f0_hz == p.models[name].f0_hz > 0
+            assert p.band_hz[0] < p.f0_hz < p.band_hz[1]
+
+
+def test_a_registered_model_is_predicted_and_offered_by_the_cli(monkeypatch, capsys):
+    """Registering a rung is one entry: predict evaluates it, --model offers and picks it, its unmeasured error
+    says so in the budget."""
+    from matcad.acoustics import registry as models
+    from matcad.cli import main
+    from matcad.prediction import predict
+
+    extra = models.AcousticModel("half_lumped", 7, ("rigid",), False, "tests.test_registry:_half_lumped",
+                                 "half of paper Eq. 1 (a test rung)", ("neck_air_ratio_small",))
+    monkeypatch.setattr(models, "MODELS", models.MODELS + (extra,))
+    spec = load_spec(LASER_ONLY)
+    p = predict(spec, model="half_lumped", mechanics=False)
+    assert p.model == "half_lumped" and p.f0_hz == pytest.approx(p.models["lumped"].f0_hz / 2, rel=1e-12)
+    assert p.models["half_lumped"].source == "half of paper Eq. 1 (a test rung)"
+    assert any("error not measured yet" in b.tolerance for b in p.budget)
+    assert main(["predict", str(LASER_ONLY), "--model", "half_lumped", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["model"] == "half_lumped"
+
+
 def test_model_registry_imports_no_solver():
     code = ("import sys; from matcad.acoustics.registry import MODELS, model_choices; model_choices(); "
             "bad = [m for m in ('skfem', 'build123d', 'felupe') if m in sys.modules]; assert not bad, bad")

@@ -9,7 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from matcad import spec as spec_mod
-from matcad.acoustics import fem, load, models
+from matcad.acoustics import fem, models
+from matcad.acoustics.eq5 import MAT_PAPER_2024
 from matcad.acoustics.design import design
 from matcad.prediction import predict
 from matcad.spec import SpecError
@@ -88,14 +89,14 @@ def test_silicone_wall_finite_and_tends_to_rigid():
 
 
 def test_forces_up_to_and_past_eq5_validity():
-    cal = load.MAT_PAPER_2024
+    cal = MAT_PAPER_2024.bound(343.0, d, l)
     forces = np.linspace(-5.0, 60.0, 651)
-    f = load.frequency_at_force_hz(cal, forces, 343.0, d, l)
-    valid = forces <= load.force_at_volume_minimum_n(cal)
+    f = cal.frequency_hz(forces)
+    valid = forces <= cal.turn_force_n
     assert np.all(np.isfinite(f[valid])) and np.all(np.isnan(f[~valid]))
     assert np.all(np.diff(f[valid]) > 0)
     for force in forces[~valid][:: 50]:
-        assert load.invalid_reason(cal, float(force))
+        assert cal.invalid_reason(float(force))
 
 
 def test_unphysical_extremes_are_clear_errors():

@@ -133,20 +133,39 @@ def reference(spec) -> Reference | None:
     return Reference(design(reference_spec(spec)), spec.reference.f0_hz, spec.reference.f0_tolerance_hz)
 
 
-def calibration(spec):
-    """The spec's [calibration] (paper Eq. 5 constants) as a :class:`matcad.acoustics.load.LoadCalibration`, the
-    paper's own named as such; None without one. ``spec`` is a single-taxel spec (a board's taxel through
-    :func:`matcad.spec.taxel_spec`, which carries its own [taxel.calibration])."""
-    from matcad.acoustics.load import MAT_PAPER_2024, LoadCalibration
+def eq5(cal):
+    """A spec's [calibration] table (or a calibration file's) as an :class:`~matcad.acoustics.eq5.Eq5`, the paper's
+    own constants named as such; not yet tied to a neck unless the table carries its K."""
+    from matcad.acoustics.eq5 import MAT_PAPER_2024, Eq5
 
-    cal = spec.calibration
-    if cal is None:
-        return None
-    values = (cal.v0_mm3, cal.a, cal.b, cal.area_convention)
     paper = MAT_PAPER_2024
-    if values == (paper.v0_mm3, paper.a, paper.b, paper.area_convention) and cal.k_mm3_hz2 is None:
+    if (cal.v0_mm3, cal.a, cal.b, cal.area_convention) == (paper.v0_mm3, paper.a, paper.b, paper.area_convention) \
+            and cal.k_mm3_hz2 is None:
         return paper
-    return LoadCalibration(*values, name="spec", k_mm3_hz2=cal.k_mm3_hz2)
+    return Eq5(cal.v0_mm3, cal.a, cal.b, cal.k_mm3_hz2, cal.area_convention, "spec", cal.covariance,
+               cal.residual_std_mm3, cal.dof, cal.force_range_n, cal.cycle_std_mm3 or 0.0, cal.temperature_c)
+
+
+def calibration(spec, d: Design | None = None):
+    """The single-taxel ``spec``'s [calibration] (a board's taxel through :func:`matcad.spec.taxel_spec` carries its
+    own [taxel.calibration]) as an :class:`~matcad.acoustics.eq5.Eq5` tied to its neck and air (``d``: its design,
+    when the caller has it); None without one."""
+    if spec.calibration is None:
+        return None
+    d = design(spec) if d is None else d
+    return eq5(spec.calibration).bound(speed_of_sound(d.air), d.neck_diameter, d.neck_length)
+
+
+def speed_of_sound(air: Air):
+    """The air's speed of sound (m/s): the given one, else from its temperature (°C); arrays of variants too
+    (NaN: not given)."""
+    from matcad.acoustics.air import speed_of_sound_m_s
+
+    given = air.speed_of_sound_m_s
+    if np.ndim(air.temperature_c) == 0 and np.ndim(given) == 0:
+        return float(given or speed_of_sound_m_s(air.temperature_c))
+    given = np.asarray(np.nan if given is None else given, dtype=float)
+    return np.where(np.isnan(given), speed_of_sound_m_s(air.temperature_c), given)
 
 
 def gap_radius_mm(plate_width_mm, plate_depth_mm):

@@ -15,8 +15,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from matcad.acoustics import geometry, models, wall
-from matcad.acoustics.air import speed_of_sound_m_s
-from matcad.acoustics.design import Design
+from matcad.acoustics.design import Design, speed_of_sound
 
 
 @dataclass(frozen=True)
@@ -69,14 +68,8 @@ def as_built(c_m_s, cavity_diameter, cavity_length, neck_diameter, neck_length, 
 def resonator(d: Design) -> Resonator:
     """The as-built acoustic quantities of a :class:`~matcad.acoustics.design.Design` (:func:`as_built` plus the
     cap): floats for a design of scalars, arrays for a design of arrays (a sweep's variants)."""
-    given = d.air.speed_of_sound_m_s
-    if np.ndim(d.cavity_diameter) == 0:
-        c = float(given or speed_of_sound_m_s(d.air.temperature_c))
-    else:
-        given = np.asarray(np.nan if given is None else given, dtype=float)
-        c = np.where(np.isnan(given), speed_of_sound_m_s(d.air.temperature_c), given)
-    res = as_built(c, d.cavity_diameter, d.cavity_length, d.neck_diameter, d.neck_length, d.draft_deg, d.mouth,
-                   d.gap_mm, d.gap_radius_mm)
+    res = as_built(speed_of_sound(d.air), d.cavity_diameter, d.cavity_length, d.neck_diameter, d.neck_length,
+                   d.draft_deg, d.mouth, d.gap_mm, d.gap_radius_mm)
     cap = dict(cap_outer_diameter=d.cap_outer_diameter, cap_top_thickness=d.cap_top_thickness,
                cap_clamp_height=d.cap_clamp_height, silicone_density=d.wall.density_kg_m3)
     if np.ndim(d.cavity_diameter) == 0:

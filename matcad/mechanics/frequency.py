@@ -17,7 +17,7 @@ import numpy as np
 
 from matcad.acoustics import geometry, models, registry
 from matcad.acoustics.design import Design
-from matcad.acoustics.load import LoadCalibration, frequency_constant_mm3_hz2
+from matcad.acoustics.eq5 import Eq5, frequency_constant_mm3_hz2
 from matcad.acoustics.resonator import Resonator, resonator
 from matcad.mechanics.solver import CapCurve
 
@@ -46,8 +46,8 @@ class ForceCurve:
     states: tuple[ForceState, ...]
     sensitivity_hz_per_n: tuple[float, ...]
     turn_force_n: float | None
-    eq5: LoadCalibration | None
-    eq5_paper_convention: LoadCalibration | None
+    eq5: Eq5 | None
+    eq5_paper_convention: Eq5 | None
     fit_note: str
     route: str
     fem_note: str
@@ -102,14 +102,14 @@ def force_curve(d: Design, curve: CapCurve, f0_hz: float | None = None, fem_leve
     slope = np.gradient(f, forces) if len(f) > 1 else np.zeros(1)
     falling = np.flatnonzero(np.diff(f) <= 0)
     turn = float(forces[falling[0]]) if len(falling) else None
-    k = float(frequency_constant_mm3_hz2(LoadCalibration(0, 0, 0), res.c_m_s, d.neck_diameter, d.neck_length))
+    k = float(frequency_constant_mm3_hz2(res.c_m_s, d.neck_diameter, d.neck_length))
     eq5 = eq5_paper = None
     note = ""
     try:
         cal = fit(forces, f, k)
-        eq5 = LoadCalibration(cal.v0_mm3, cal.a, cal.b, "pi_d2/4", name="mechanics")
+        eq5 = Eq5(cal.v0_mm3, cal.a, cal.b, area_convention="pi_d2/4", name="mechanics")
         # A = d²/4 is A(πd²/4)/π: every volume of the fit scales by 1/π
-        eq5_paper = LoadCalibration(cal.v0_mm3 / np.pi, cal.a / np.pi, cal.b / np.pi, "d2/4", name="mechanics")
+        eq5_paper = Eq5(cal.v0_mm3 / np.pi, cal.a / np.pi, cal.b / np.pi, area_convention="d2/4", name="mechanics")
     except LoopError as exc:
         note = f"no Eq. 5 fit: {exc}"
     states = tuple(ForceState(float(F), float(x), float(v), float(le), float(a),

@@ -4,7 +4,7 @@ A taxel's band is its unloaded predicted band (:func:`matcad.prediction.taxel.pr
 model's f0 with the uncertainty budget, root-sum-square in ln f) widened upward by the rise of f under load up to
 ``mechanics.max_force_n``:
 
-- with a ``[calibration]``: paper Eq. 5 (:mod:`matcad.acoustics.load`), f(F)/f(0) = sqrt(V_eff(0)/V_eff(F)); the
+- with a ``[calibration]``: paper Eq. 5 (:mod:`matcad.acoustics.eq5`), f(F)/f(0) = sqrt(V_eff(0)/V_eff(F)); the
   ratio does not depend on the calibration's area convention or K;
 - without one: the cap mechanics (:mod:`matcad.mechanics`, FElupe; docs/mechanics.md), f(F)/f(0) from the
   transmission line on the deformed cavity. One run takes seconds, so each distinct cap (cavity, end cap, flange,
@@ -103,17 +103,16 @@ def conflicts(bands, guard: float, harmonics=HARMONICS) -> list[Conflict]:
 
 
 def eq5_rise(cal, max_force_n: float) -> tuple[float, float]:
-    """(min, max) of f(F)/f(0) over 0 <= F <= ``max_force_n`` (N) by paper Eq. 5, f ∝ V_eff^(-1/2); SpecError
-    naming ``mechanics.max_force_n`` where the fit has no meaning (past its V_eff minimum, V_eff <= 0)."""
-    from matcad.acoustics.load import effective_volume_mm3, invalid_reason
+    """(min, max) of f(F)/f(0) over 0 <= F <= ``max_force_n`` (N) by paper Eq. 5 (:meth:`matcad.acoustics.eq5.Eq5.rise`,
+    f ∝ V_eff^(-1/2)); SpecError naming ``mechanics.max_force_n`` where the fit has no meaning (past its V_eff
+    minimum, V_eff <= 0)."""
     from matcad.spec import SpecError
 
-    why = invalid_reason(cal, max_force_n)
-    if why:
-        raise SpecError("mechanics.max_force_n", max_force_n, f"must stay where the calibration's Eq. 5 holds: {why}")
-    v = effective_volume_mm3(cal, np.linspace(0.0, max_force_n, EQ5_POINTS))
-    ratio = np.sqrt(v[0] / v)
-    return float(ratio.min()), float(ratio.max())
+    try:
+        return cal.rise(max_force_n, EQ5_POINTS)
+    except ValueError as exc:
+        raise SpecError("mechanics.max_force_n", max_force_n,
+                        f"must stay where the calibration's Eq. 5 holds: {exc}") from None
 
 
 def mechanics_rise(spec, f0_hz: float, max_force_n: float) -> tuple[float, float, str]:

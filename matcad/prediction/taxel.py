@@ -14,7 +14,7 @@ import dataclasses
 import numpy as np
 
 from matcad.acoustics import design as adapt
-from matcad.acoustics.load import MAT_PAPER_2024, frequency_at_force_hz, invalid_reason
+from matcad.acoustics.eq5 import MAT_PAPER_2024
 from matcad.acoustics.predict import LoadPoint, Prediction
 from matcad.acoustics.predict import predict as predict_unloaded
 
@@ -50,15 +50,14 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
         spec = taxel_spec(spec, board[0])
     d = adapt.design(spec)
     p = predict_unloaded(d, adapt.reference(spec), model, fem_level)
-    cal = adapt.calibration(spec)
+    cal = adapt.calibration(spec, d)
     warnings = list(p.warnings)
     curve: tuple[LoadPoint, ...] = ()
     load_model = None
     if len(forces_n):
         if cal is not None:
-            f_at = frequency_at_force_hz(cal, np.asarray(forces_n, dtype=float), p.speed_of_sound_m_s,
-                                         d.neck_diameter, d.neck_length)
-            curve = tuple(LoadPoint(float(force), None if np.isnan(f) else float(f), invalid_reason(cal, force),
+            f_at = cal.frequency_hz(np.asarray(forces_n, dtype=float))
+            curve = tuple(LoadPoint(float(force), None if np.isnan(f) else float(f), cal.invalid_reason(force),
                                     source=f"calibration {cal.name} (Eq. 5)") for force, f in zip(forces_n, f_at))
             if cal.area_convention == MAT_PAPER_2024.area_convention:
                 warnings.append("load curve uses the paper's A = d^2/4 convention with its fitted V0 (see docs/paper.md); "

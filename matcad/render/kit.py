@@ -20,14 +20,13 @@ past Eq. 5's V_eff minimum."""
 def load_forces_n(spec) -> np.ndarray:
     """Forces (N) at which the build draws Eq. 5 f(F) for ``spec``'s calibration; empty without one (the cap
     mechanics' curve takes seconds and stays with ``matcad predict --load``)."""
-    from matcad.acoustics.load import force_at_volume_minimum_n
     from matcad.acoustics.design import calibration
 
     cal = calibration(spec)
     if cal is None:
         return np.array([])
     lo, hi = spec.calibration.force_range_n or (0.0, LOAD_FORCE_MAX_N)
-    hi = min(hi, force_at_volume_minimum_n(cal))
+    hi = min(hi, cal.turn_force_n)
     return np.linspace(max(lo, 0.0), hi, LOAD_POINTS) if hi > max(lo, 0.0) else np.array([])
 
 

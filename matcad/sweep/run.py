@@ -7,7 +7,8 @@ Frequencies Hz; sensitivities in Hz per the varied field's unit (Hz/mm for lengt
 - Any other model (elastic_wall, soft_wall, relative, fem) runs :func:`matcad.acoustics.predict.predict` per
   variant on the executor; df0/dfield is then the slope of f0 along that axis of the grid (``numpy.gradient``:
   central differences inside, one-sided at the ends and next to a failed variant; blank for an axis of one value).
-- df0/dF (Hz/N) is paper Eq. 5's slope at 0 N, f(0)·b/(2·V0), from the spec's [calibration] (blank without one):
+- df0/dF (Hz/N) is paper Eq. 5's slope at 0 N, f(0)·b/(2·V0) (:meth:`matcad.acoustics.eq5.Eq5.slope_hz_per_n`), from
+  the spec's [calibration] (blank without one):
   it follows the neck and the air, not the cavity, because V0 is the calibrated taxel's. The cap mechanics
   (FElupe, seconds per variant) is not run in a sweep.
 - The design rules run per variant on the executor (on the sweep model's prediction) unless ``rules=False``.
@@ -88,8 +89,6 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     ``model`` defaults to the spec's own choice (:func:`predict`); ``cad`` also builds each variant's end cap."""
     from matcad.acoustics.design import calibration
     from matcad.prediction import predict
-    from matcad.acoustics.air import speed_of_sound_m_s
-    from matcad.acoustics.load import frequency_at_force_hz
     from matcad.spec import SpecError, from_dict
 
     start = time.perf_counter()
@@ -122,10 +121,7 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     for i in ok:
         cal = calibration(specs[i])
         if cal is not None:
-            s = specs[i]
-            c = s.air.speed_of_sound or float(speed_of_sound_m_s(s.air.temperature_c))
-            f_zero = float(frequency_at_force_hz(cal, 0.0, c, s.neck.diameter, s.neck.length))
-            rows[i][LOAD_SENSITIVITY] = f_zero * cal.b / (2.0 * cal.v0_mm3)
+            rows[i][LOAD_SENSITIVITY] = float(cal.slope_hz_per_n(0.0))
     worker_seconds = 0.0
     if not vectorised or rules or cad:
         tasks = [{"index": i, "data": datas[i], "model": model, "fem_level": fem_level, "predict": not vectorised,
