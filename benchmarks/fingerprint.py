@@ -29,6 +29,8 @@ sys.path.insert(0, str(ROOT))
 from matcad.loop import synth  # noqa: E402
 
 TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
+UNHASHED = ("kit.zip", ".matcad-manifest.json")
+"""Derived from the files hashed one by one (and holding their unmasked run times)."""
 SECONDS_RE = re.compile(r"\d+(\.\d+)? ?(s|ms)\b")
 
 
@@ -46,7 +48,7 @@ def _digest(data: bytes, name: str, tmp: str) -> str:
         text = data.decode("utf-8", "replace").replace(tmp, "<tmp>")
         if name.endswith(".json"):
             try:
-                text = json.dumps(_mask_json(json.loads(text)), sort_keys=True)
+                text = json.dumps(_mask_json(json.loads(text)), sort_keys=True, ensure_ascii=False)
             except ValueError:
                 pass
         data = SECONDS_RE.sub("<t>", text).encode()
@@ -55,7 +57,7 @@ def _digest(data: bytes, name: str, tmp: str) -> str:
 
 def _folder(path: Path, tmp: str) -> dict:
     return {p.relative_to(path).as_posix(): _digest(p.read_bytes(), p.name, tmp)
-            for p in sorted(path.rglob("*")) if p.is_file() and p.name != "kit.zip"}
+            for p in sorted(path.rglob("*")) if p.is_file() and p.name not in UNHASHED}
 
 
 def _run(args, tmp: str) -> dict:
@@ -63,9 +65,10 @@ def _run(args, tmp: str) -> dict:
     proc = subprocess.run([sys.executable, "-m", "matcad", *map(str, args)], capture_output=True, cwd=tmp, env=env)
     out = proc.stdout.decode("utf-8", "replace").replace(tmp, "<tmp>")
     try:
-        out = json.dumps(_mask_json(json.loads(out)), sort_keys=True)
+        out = json.dumps(_mask_json(json.loads(out)), sort_keys=True, ensure_ascii=False)
     except ValueError:
-        out = SECONDS_RE.sub("<t>", out)
+        pass
+    out = SECONDS_RE.sub("<t>", out)
     err = SECONDS_RE.sub("<t>", re.sub(r"/tmp/matcad-internal-error-\S+", "<log>",
                                        proc.stderr.decode("utf-8", "replace").replace(tmp, "<tmp>")))
     return {"exit": proc.returncode, "stdout": hashlib.sha256(out.encode()).hexdigest(), "stderr": err[-400:]}
