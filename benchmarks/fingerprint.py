@@ -48,7 +48,7 @@ def _mask_json(value, digits=None):
 def _digest(data: bytes, name: str, tmp: str) -> str:
     """SHA-256 of a file's bytes, after masking run times (JSON/text) and the temporary root."""
     if name.endswith((".json", ".md", ".html", ".csv", ".toml", ".txt")):
-        text = data.decode("utf-8", "replace").replace(tmp, "<tmp>")
+        text = data.decode("utf-8", "replace").replace(tmp, "<tmp>").replace(str(ROOT), "<root>")
         if name.endswith(".json"):
             try:
                 text = json.dumps(_mask_json(json.loads(text)), sort_keys=True, ensure_ascii=False)
@@ -66,14 +66,15 @@ def _folder(path: Path, tmp: str) -> dict:
 def _run(args, tmp: str, digits=None) -> dict:
     env = {**os.environ, "PYTHONPATH": str(ROOT)}  # this checkout's matcad, whatever the interpreter has installed
     proc = subprocess.run([sys.executable, "-m", "matcad", *map(str, args)], capture_output=True, cwd=tmp, env=env)
-    out = proc.stdout.decode("utf-8", "replace").replace(tmp, "<tmp>")
+    out = proc.stdout.decode("utf-8", "replace").replace(tmp, "<tmp>").replace(str(ROOT), "<root>")
     try:
         out = json.dumps(_mask_json(json.loads(out), digits), sort_keys=True, ensure_ascii=False)
     except ValueError:
         pass
     out = SECONDS_RE.sub("<t>", out)
     err = SECONDS_RE.sub("<t>", re.sub(r"/tmp/matcad-internal-error-\S+", "<log>",
-                                       proc.stderr.decode("utf-8", "replace").replace(tmp, "<tmp>")))
+                                       proc.stderr.decode("utf-8", "replace").replace(tmp, "<tmp>")
+                                       .replace(str(ROOT), "<root>")))
     return {"exit": proc.returncode, "stdout": hashlib.sha256(out.encode()).hexdigest(), "stderr": err[-400:]}
 
 
