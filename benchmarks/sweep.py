@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from matcad.spec_input import read_spec_data  # noqa: E402
+from matcad.spec import read_spec_data  # noqa: E402
 from matcad.sweep import Executor, parse_axes, sweep  # noqa: E402
 from matcad.acoustics.design import Making, WallMaterial  # noqa: E402
 from matcad.sweep import fast  # noqa: E402

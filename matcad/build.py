@@ -107,7 +107,7 @@ def board_bands(spec) -> dict:
     path (no FElupe) and never fails on its rise: without a calibration, or past where it holds, the loaded rise
     is marked not computed and says why (`matcad predict --load` gives the mechanics curve)."""
     from matcad.prediction.bands import summary, taxel_bands
-    from matcad.taxel import is_array
+    from matcad.spec import is_array
 
     board = is_array(spec)
     return summary(spec, taxel_bands(spec, mechanics=board, strict=board))
@@ -129,7 +129,7 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
     from matcad.render.bands import BANDS_PNG, band_chart
     from matcad.render.kit import render_figures
     from matcad.report import KIT_ARCHIVE, make_report, write_report
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import taxel_spec, taxels
 
     board = taxels(spec)
     predictions = [predict(taxel_spec(spec, t)) for t in board]

@@ -39,8 +39,7 @@ def _print_json(data) -> None:
 def _load_spec(path, args):
     """The validated spec at ``path`` (TOML or a build's report.json) with ``--set`` applied; likely unit slips
     and silent defaults are printed to stderr as notes (never changing a value)."""
-    from matcad.plausibility import spec_notes
-    from matcad.spec_input import load_spec
+    from matcad.spec import load_spec, spec_notes
 
     spec, data = load_spec(path, getattr(args, "set", None))
     for note in spec_notes(spec, data):
@@ -115,7 +114,7 @@ def cmd_predict(args) -> int:
         print("matcad: note: predict --force is deprecated (it clashed with build --force); use --load",
               file=sys.stderr)
     spec = _load_spec(args.spec, args)
-    from matcad.taxel import is_array
+    from matcad.spec import is_array
 
     if is_array(spec):
         return _predict_array(spec, args)
@@ -131,9 +130,9 @@ def cmd_predict(args) -> int:
 def _predict_array(spec, args) -> int:
     """`predict` of an array spec: each taxel's f0, unloaded and loaded band (matcad.prediction.bands), and the
     band conflicts; --json adds each taxel's whole prediction."""
-    from matcad.prediction.bands import summary, taxel_band
     from matcad.prediction import predict
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.prediction.bands import summary, taxel_band
+    from matcad.spec import taxel_spec, taxels
 
     bands, predictions = [], {}
     for t in taxels(spec):
@@ -311,7 +310,7 @@ def _board_spec(args):
     """The spec of ``--spec`` when it names an array (and no --band is given), else None."""
     if not getattr(args, "spec", None) or getattr(args, "band", None):
         return None
-    from matcad.taxel import is_array
+    from matcad.spec import is_array
 
     spec = _load_spec(args.spec, args)
     return spec if is_array(spec) else None
@@ -373,7 +372,7 @@ def _analyze_board(args, named_bands) -> int:
 def cmd_calibrate(args) -> int:
     from matcad.loop.calibrate import fit_from_spec, plot, read_csv
     from matcad.output import staged_output
-    from matcad.plausibility import frequency_notes
+    from matcad.spec import frequency_notes
 
     spec = _one_taxel(_load_spec(args.spec, args), args.taxel)
     if args.temperature_c is not None and not -60.0 <= args.temperature_c <= 100.0:
@@ -415,7 +414,7 @@ def cmd_calibrate(args) -> int:
 
 def _one_taxel(spec, name):
     """The single-taxel spec of taxel ``name`` of an array (a calibration is one taxel's); a one-taxel spec as is."""
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import taxel_spec, taxels
 
     board = taxels(spec)
     names = ", ".join(t.name for t in board)
@@ -565,7 +564,7 @@ def _sense_board(args, spec) -> int:
 
 
 def cmd_sweep(args) -> int:
-    from matcad.spec_input import apply_sets, read_spec_data
+    from matcad.spec import apply_sets, read_spec_data
     from matcad.sweep import Executor, parse_axes, sweep
     from matcad.sweep.outputs import write
 

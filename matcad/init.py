@@ -28,8 +28,7 @@ def new_spec(name: str, template: str = DEFAULT_TEMPLATE, path: Path | None = No
     """Write ``path`` (default ``NAME.toml``) from ``template`` with its ``name`` set to ``name``; the template's
     comments (each number's source) are kept. Raises SpecError for a bad name, ValueError for an unknown
     template, FileExistsError rather than overwrite."""
-    from matcad.spec import from_dict
-    from matcad.spec_input import read_spec_data
+    from matcad.spec import from_dict, read_spec_data
 
     source = template_path(template)
     text = source.read_text(encoding="utf-8")

@@ -95,7 +95,7 @@ def casting(spec) -> dict | None:
         "vent_reach_mm": spec.mold.vent_reach, "base_face_reach_mm": plan.reach_base_mm,
         "pin_end_reach_mm": plan.reach_tip_mm, "base_face_vents_per_cap": len(plan.inner) + len(plan.outer),
         "pin_vents_per_cap": 1, "vent_diameter_mm": spec.mold.vent}}
-    from matcad.taxel import is_array, taxels
+    from matcad.spec import is_array, taxels
 
     if is_array(spec):  # which caps each mold holds, and how many pours (or molds) one board takes
         from matcad.parts.mold_layout import pours_per_board
@@ -108,7 +108,7 @@ def needle_bom(spec) -> dict:
     """The needle to buy and how deep it goes (mm); a board needs one per taxel, each on its own air line (the
     mount offers no manifold), and its per-taxel needle rows sit in report.json's ``taxels``."""
     from matcad.parts.features import nearest_needle_gauge, needle_protrusion_mm, needle_tip_mm
-    from matcad.taxel import taxels
+    from matcad.spec import taxels
 
     gauge, od = nearest_needle_gauge(spec.needle.outer_diameter)
     sin_t = math.sin(math.radians(spec.needle.theta_deg))

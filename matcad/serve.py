@@ -50,7 +50,7 @@ def _spec(payload: dict):
 def predict_json(payload: dict) -> dict:
     """The prediction for the request's spec, as plain data (Hz, mm)."""
     from matcad.prediction import predict
-    from matcad.plausibility import spec_notes
+    from matcad.spec import spec_notes
 
     spec = _spec(payload)
     p = predict(spec)

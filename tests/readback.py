@@ -57,7 +57,7 @@ def assert_laser_files(spec, out: Path) -> None:
 def expected_bodies(spec, stl_name: str) -> int:
     """Separate bodies in an exported STL: one, except a board's cap reference (its distinct caps side by side)."""
     from matcad.parts.mold_layout import cap_groups
-    from matcad.taxel import taxels
+    from matcad.spec import taxels
 
     return len(cap_groups(taxels(spec))) if stl_name == "end_cap.stl" else 1
 

@@ -2,6 +2,7 @@
 
 import dataclasses
 import sys
+import tomllib
 
 import numpy as np
 import pytest
@@ -46,7 +47,7 @@ def test_max_force_past_the_eq5_minimum_names_the_field():
 
 
 def test_cheap_path_without_calibration_skips_felupe():
-    s = spec_mod.from_dict(spec_mod.tomllib.loads(MINIMAL))
+    s = spec_mod.from_dict(tomllib.loads(MINIMAL))
     b = taxel_band(s, mechanics=False)
     assert b.loaded_hz == b.unloaded_hz and b.rise == 1.0 and "not computed" in b.rise_source
 
@@ -59,7 +60,7 @@ def test_mechanics_rise_once_per_cap_and_equal_to_predict_load(monkeypatch):
     real = solver.cap_curve
     monkeypatch.setattr(solver, "cap_curve", lambda s: calls.append(1) or real(s))
     monkeypatch.setattr(taxel_prediction, "_CAP_CURVES", {})
-    s = spec_mod.from_dict(spec_mod.tomllib.loads(FAST))
+    s = spec_mod.from_dict(tomllib.loads(FAST))
     wide = dataclasses.replace(s, neck=dataclasses.replace(s.neck, diameter=2.6))
     b1, b2 = taxel_band(s), taxel_band(wide)
     assert len(calls) == 1 and b2.f0_hz > b1.f0_hz * 1.1
@@ -71,7 +72,7 @@ def test_mechanics_rise_once_per_cap_and_equal_to_predict_load(monkeypatch):
 
 
 def test_max_force_beyond_the_mechanics_curve_names_the_field(monkeypatch):
-    s = spec_mod.from_dict(spec_mod.tomllib.loads(FAST.replace("max_force_n = 6.0", "max_force_n = 500.0")))
+    s = spec_mod.from_dict(tomllib.loads(FAST.replace("max_force_n = 6.0", "max_force_n = 500.0")))
     with pytest.raises(SpecError) as err:
         taxel_band(s)
     assert err.value.field == "mechanics.max_force_n" and "displacement_mm" in str(err.value)
@@ -127,7 +128,7 @@ def test_identical_taxels_overlap_and_check_names_both(write_spec):
     from matcad.rules import check
     from tests.conftest import run_cli
 
-    s = spec_mod.from_dict(spec_mod.tomllib.loads(BOARD + "[array]\ncolumns = 2\npitch_x = 14.0\n"))
+    s = spec_mod.from_dict(tomllib.loads(BOARD + "[array]\ncolumns = 2\npitch_x = 14.0\n"))
     b1, b2 = bands.taxel_bands(s)
     assert (b1.name, b1.x_mm, b2.name, b2.x_mm) == ("t1", -7.0, "t2", 7.0) and b1.loaded_hz == b2.loaded_hz
     (f,) = [f for f in check(s) if f.id == "bands.overlap"]
@@ -142,10 +143,10 @@ def test_a_taxel_at_twice_anothers_f0_breaks_the_harmonic_rule():
     from matcad.design.solve import parse_vary, solve
     from matcad.rules import check
 
-    one = spec_mod.from_dict(spec_mod.tomllib.loads(BOARD))
+    one = spec_mod.from_dict(tomllib.loads(BOARD))
     low = solve(one, 3000.0, parse_vary(one, ["cavity.length"])).spec.cavity.length
     high = solve(one, 6000.0, parse_vary(one, ["neck.diameter"])).spec.neck.diameter
-    s = spec_mod.from_dict(spec_mod.tomllib.loads(
+    s = spec_mod.from_dict(tomllib.loads(
         BOARD + f"[[taxel]]\nx = -7.0\ny = 0.0\ncavity_length = {low!r}\n"
                 f"[[taxel]]\nx = 7.0\ny = 0.0\nneck_diameter = {high!r}\n"))
     b1, b2 = bands.taxel_bands(s)

@@ -16,7 +16,7 @@ from matcad.parts.features import cap_flange_diameter_mm, needle_axis_mm, pin_ho
 from matcad.parts.guide import BODY_CLEARANCE_MM
 from matcad.parts.mold_layout import layout, mold_slots, pours_per_board
 from matcad.rules import board as board_rules
-from matcad.taxel import taxels
+from matcad.spec import taxels
 from tests.conftest import ROOT
 
 ARRAY = ROOT / "templates" / "mat-array-4.toml"

@@ -17,7 +17,7 @@ from matcad.output import MANIFEST
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.features import cap_volume_mm3
 from matcad.parts.mold_layout import cap_groups
-from matcad.taxel import taxel_spec, taxels
+from matcad.spec import taxel_spec, taxels
 from matcad.report import KIT_ARCHIVE, REPORT_FILES
 from tests.conftest import TEMPLATES
 from tests.readback import expected_bodies

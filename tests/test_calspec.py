@@ -13,7 +13,7 @@ import pytest
 from matcad import spec as spec_mod
 from matcad.loop import synth
 from matcad.loop.board import LiveFrames, board_bands
-from matcad.taxel import taxels
+from matcad.spec import taxels
 from tests.conftest import ROOT, run_cli
 
 TAXELS = [("low", -6.0, 10.0), ("high", 6.0, 3.0)]  # name, x (mm), cavity length (mm)

@@ -15,7 +15,7 @@ import pytest
 from matcad import spec as spec_mod
 from matcad.prediction import predict
 from matcad.build import build
-from matcad.plausibility import frequency_notes, spec_notes
+from matcad.spec import frequency_notes, spec_notes
 from tests.conftest import MINIMAL, PAPER, ROOT, run_cli
 
 LASER_ONLY = ROOT / "templates" / "mat-laser-only.toml"

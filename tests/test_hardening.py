@@ -14,6 +14,7 @@ import pytest
 from scipy.io import wavfile
 
 from matcad import spec as spec_mod
+from matcad.inputs import SPEC_MAX_BYTES
 from tests.conftest import MINIMAL, PAPER, run_cli
 
 K = 2.2e8
@@ -49,7 +50,7 @@ def test_hostile_spec_is_exit_2(cause, write_spec, tmp_path):
 
 
 def test_spec_above_size_limit_refused_before_parsing(write_spec, tmp_path):
-    path = write_spec(MINIMAL + "#" * (spec_mod.SPEC_MAX_BYTES + 10) + "\n")
+    path = write_spec(MINIMAL + "#" * (SPEC_MAX_BYTES + 10) + "\n")
     code, _, err = run_cli("check", path)
     _assert_clean(code, err, 2, "spec file", "larger than")
 

@@ -177,7 +177,7 @@ def test_a_diverging_newton_step_is_refused_before_the_sparse_solver():
 
 def test_a_short_stiff_cap_prints_no_blas_warnings(capfd):
     """mat-array-4's t3 (D 3.18, L 2.3 mm) cuts its load steps; no BLAS warning reaches the user's terminal."""
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import taxel_spec, taxels
 
     spec = spec_mod.load(PAPER_TOML.parent / "mat-array-4.toml")
     curve = cap_curve(cap_case(taxel_spec(spec, taxels(spec)[2])))

@@ -11,8 +11,7 @@ import pytest
 
 from matcad.acoustics.design import calibration
 from matcad.prediction import predict
-from matcad.spec import from_dict
-from matcad.spec_input import read_spec_data
+from matcad.spec import from_dict, read_spec_data
 from matcad.sweep import MAX_POINTS, Executor, parse_axes, sweep
 from matcad.sweep import fast
 from matcad.sweep.run import LOAD_SENSITIVITY, sensitivity_column

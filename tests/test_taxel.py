@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from matcad import spec as spec_mod
-from matcad.taxel import field_path, taxel_spec, taxels
+from matcad.spec import field_path, taxel_spec, taxels
 
 from tests.conftest import SINGLE_TEMPLATES
 

@@ -134,8 +134,7 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
     from matcad.prediction.bands import guard_hz, taxel_band
     from matcad.rules import check, errors
-    from matcad.spec import MAX_TAXELS
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import MAX_TAXELS, taxel_spec, taxels
 
     start_time = time.perf_counter()
     if not 2 <= n <= MAX_TAXELS:

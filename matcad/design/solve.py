@@ -213,7 +213,7 @@ def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -
     from matcad.prediction import predict
     from matcad.rules import check, errors
 
-    from matcad.taxel import is_array
+    from matcad.spec import is_array
 
     start = time.perf_counter()
     if not (math.isfinite(target_hz) and target_hz > 0):

@@ -92,8 +92,7 @@ def board_calibrations(spec, values) -> dict:
     """{taxel name: (source text, :class:`matcad.spec.Calibration`)} for a board: each taxel's [taxel.calibration]
     from ``spec``, overridden by ``--calibration NAME=FILE`` ``values`` (:func:`parse_calibrations`). ValueError
     (exit 2) when neither gives any calibration, or naming the file or field when one is bad."""
-    from matcad.spec import load_calibration
-    from matcad.taxel import taxels
+    from matcad.spec import load_calibration, taxels
 
     board = taxels(spec)
     names = [t.name for t in board]

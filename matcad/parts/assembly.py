@@ -40,7 +40,7 @@ def drilled(plate, neck_diameters: tuple[float, ...]):
 def assembled_parts(spec) -> dict[str, object]:
     """Name → solid in the assembly frame (mm). Spacers are numbered when laser-cut; a board's caps and needles
     are named after their taxels (end_cap_t1, needle_t1, ...)."""
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import taxel_spec, taxels
 
     board = taxels(spec)
     plate_t = spec.neck.length
@@ -83,7 +83,7 @@ def assembly(spec, parts=None) -> Compound:
 def section_plane(spec):
     """The section's plane: XZ through the first taxel's neck axis (a row of necks, and the needles' plane:
     every needle is tilted in its own XZ plane) (mm)."""
-    from matcad.taxel import taxels
+    from matcad.spec import taxels
 
     y = taxels(spec)[0].y
     return Plane.XZ if y == 0.0 else Plane(origin=(0, y, 0), x_dir=(1, 0, 0), z_dir=(0, -1, 0))
@@ -93,7 +93,7 @@ def write_section_svg(spec, path, parts=None) -> None:
     """Section of the assembly through the first taxel's row of necks in the XZ plane (the needles' plane), to
     scale in mm, with part labels and, for a single taxel, the design's dimensions
     (:func:`matcad.render.section.annotate_section`; a board's section carries the labels only)."""
-    from matcad.taxel import is_array
+    from matcad.spec import is_array
 
     parts = parts or assembled_parts(spec)
     plane = section_plane(spec)

@@ -80,7 +80,7 @@ class CastingGuide:
 
 def casting_guide(spec: Spec) -> CastingGuide:
     """The pour for ``spec``: batch = max(cast volume × waste factor × density, :data:`MIN_BATCH_G`) (g)."""
-    from matcad.taxel import taxel_spec
+    from matcad.spec import taxel_spec
 
     g = grade(spec.silicone.grade)
     mold = MOLD_MATERIALS[spec.machine.printer]

@@ -42,7 +42,7 @@ def board_caps(spec):
 
     from matcad.parts.features import cap_flange_diameter_mm
     from matcad.parts.mold_layout import cap_x_mm, cap_groups
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import taxel_spec, taxels
 
     caps = [taxel_spec(spec, g[0]) for g in cap_groups(taxels(spec))]
     if len(caps) == 1:

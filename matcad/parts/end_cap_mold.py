@@ -33,7 +33,7 @@ def _key(spec, grow: float, x: float, y: float):
 
 def _slot_specs(spec, lay: MoldLayout) -> list[tuple[float, object]]:
     """(x, single-taxel spec of the cap it casts) for every cap position of the mold (mm)."""
-    from matcad.taxel import taxel_spec
+    from matcad.spec import taxel_spec
 
     return [(x, taxel_spec(spec, t)) for x, t in zip(lay.cap_x, lay.slots)]
 

@@ -140,7 +140,7 @@ def needle_axis_mm(spec) -> tuple[tuple[float, float, float], tuple[float, float
     measured in that plane, from that point to the nearest edge of the neck opening (−d/2, 0, 0) — the
     paper's "distance between air supply and nearest edge of cavity opening" (Fig. 2).
     Returns (point on the mouth plane, unit direction). ``spec`` may be a Spec or a
-    :class:`matcad.taxel.Taxel`: a taxel's axis is moved to its neck at (taxel.x, taxel.y).
+    :class:`matcad.spec.Taxel`: a taxel's axis is moved to its neck at (taxel.x, taxel.y).
     """
     import math
 

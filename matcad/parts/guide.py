@@ -29,7 +29,7 @@ def cap_holes(board, role: str) -> tuple[Hole, ...]:
 def guide(spec, role: str) -> Flat:
     """Guide layer ``role`` ('locator' or 'clamp'): same outline and stack holes as the neck plate, one cap hole
     per taxel (mm)."""
-    from matcad.taxel import taxels
+    from matcad.spec import taxels
 
     holes = (*cap_holes(taxels(spec), role), *laser_stack_holes(spec))
     return Flat(name=f"guide_{role}", thickness=spec.guide.thickness,

@@ -187,7 +187,7 @@ def cap_x_mm(flanges: list[float], wall: float) -> tuple[float, ...]:
 def layout(spec) -> MoldLayout:
     """Positions of caps, keys, bolts, fill ports and vents in the mold frame (mm): ``mold.count`` caps of the
     board (:func:`mold_slots`) in a row, each slot with its own flange, fill radius and vent plan."""
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import taxel_spec, taxels
 
     m = spec.mold
     slots = mold_slots(taxels(spec), m.count)

@@ -21,7 +21,7 @@ def plate_label_text(board) -> str:
 def neck_plate(spec) -> Flat:
     """Neck plate: outline plate.width x plate.depth, every taxel's neck hole (or undersize pilot) at its
     position, dowel and bolt holes (mm)."""
-    from matcad.taxel import taxels
+    from matcad.spec import taxels
 
     board = taxels(spec)
     label = ()

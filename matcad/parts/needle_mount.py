@@ -49,7 +49,7 @@ def needle_mount(spec):
     from build123d import Box, Pos
 
     from matcad.parts.solid import BOTTOM, TOP, cylinder_up
-    from matcad.taxel import taxels
+    from matcad.spec import taxels
 
     gap, thick = spec.spacer.height, spec.mount.thickness
     top = -gap

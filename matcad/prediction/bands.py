@@ -172,9 +172,9 @@ def taxel_band(spec, name: str = "t1", x_mm: float = 0.0, y_mm: float = 0.0, mec
 
 
 def taxel_bands(spec, mechanics: bool = True, strict: bool = True) -> list[TaxelBand]:
-    """One :class:`TaxelBand` per taxel of ``spec``, in :func:`matcad.taxel.taxels` order (Hz, mm); ``mechanics``
+    """One :class:`TaxelBand` per taxel of ``spec``, in :func:`matcad.spec.taxels` order (Hz, mm); ``mechanics``
     and ``strict`` as for :func:`taxel_band`."""
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import taxel_spec, taxels
 
     return [taxel_band(taxel_spec(spec, t), t.name, t.x, t.y, mechanics, strict=strict) for t in taxels(spec)]
 

@@ -41,8 +41,7 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
     :data:`matcad.acoustics.fem.DEFAULT_LEVEL`).
     """
     if spec.taxel or spec.array is not None:
-        from matcad.spec import SpecError
-        from matcad.taxel import taxel_spec, taxels
+        from matcad.spec import SpecError, taxel_spec, taxels
 
         board = taxels(spec)
         if len(board) > 1:  # a board is predicted taxel by taxel (matcad.prediction.bands)

@@ -38,7 +38,7 @@ def render_figures(spec, prediction, folder: Path, meshes: dict) -> list[dict]:
     from matcad.parts.flat import cut_plan
     from matcad.render.plots import BAND_PNG, LOAD_PNG, band_plot, load_plot
     from matcad.render.previews import flat_preview, preview_name, printed_preview
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import taxel_spec, taxels
 
     figures = []
     if (folder / "section.svg").is_file():

@@ -32,7 +32,7 @@ def check(spec, prediction=None) -> list[Finding]:
     from matcad.prediction import predict
     from matcad.rules import acoustic, bands, board as board_rules, laser, printing, stack
 
-    from matcad.taxel import taxel_spec, taxels
+    from matcad.spec import taxel_spec, taxels
 
     board = taxels(spec)
     findings: list[Finding] = []

@@ -29,7 +29,7 @@ jet."""
 
 
 def _board(spec):
-    from matcad.taxel import taxels
+    from matcad.spec import taxels
 
     board = taxels(spec)
     return board if len(board) > 1 else ()

@@ -36,7 +36,7 @@ def needle_bore(spec) -> list[Finding]:
     needle (θ near 0, or |y| beyond the block). A taxel's axis meets the block's top face (z = −spacer.height) at
     x_top and its underside at x_bot; the block spans |x| <= plate.width/2 and |y| <= plate.depth/2 (mm)."""
     from matcad.parts.features import needle_axis_mm
-    from matcad.taxel import taxels
+    from matcad.spec import taxels
 
     board = taxels(spec)
     gap, thick, half = spec.spacer.height, spec.mount.thickness, spec.plate.width / 2

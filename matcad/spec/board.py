@@ -4,6 +4,9 @@ A spec describes one taxel at the plate centre (no [array], no [[taxel]]), a gri
 or taxels that differ ([[taxel]] entries, each overriding the shared [cavity], [neck], [end_cap] and [needle]
 tables). :func:`taxels` turns any of them into the same tuple of :class:`Taxel` values; physics written for one
 taxel is applied to each through :func:`taxel_spec`.
+
+``spec`` is a :class:`matcad.spec.model.Spec`, taken as it is (duck-typed): the Spec's own checks go through
+:func:`taxels`, so this module cannot import the Spec class.
 """
 
 from __future__ import annotations
@@ -11,7 +14,8 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from matcad.spec import Calibration, Cavity, EndCap, Neck, Needle, Spec, TaxelEntry
+from matcad.spec.calibration import Calibration
+from matcad.spec.sections import Cavity, EndCap, Neck, Needle, TaxelEntry
 
 ENTRY_FIELDS = {
     "cavity.diameter": "cavity_diameter", "cavity.length": "cavity_length", "neck.diameter": "neck_diameter",
@@ -42,7 +46,7 @@ def _override(section, prefix: str, entry: TaxelEntry):
     return dataclasses.replace(section, **values) if values else section
 
 
-def _from_entry(spec: Spec, index: int, entry: TaxelEntry) -> Taxel:
+def _from_entry(spec, index: int, entry: TaxelEntry) -> Taxel:
     return Taxel(name=entry.name or f"t{index}", x=entry.x, y=entry.y,
                  cavity=_override(spec.cavity, "cavity", entry), neck=_override(spec.neck, "neck", entry),
                  end_cap=_override(spec.end_cap, "end_cap", entry), needle=_override(spec.needle, "needle", entry),
@@ -56,7 +60,7 @@ def grid_positions_mm(columns: int, rows: int, pitch_x: float | None, pitch_y: f
     return [((c - (columns - 1) / 2) * px, ((rows - 1) / 2 - r) * py) for r in range(rows) for c in range(columns)]
 
 
-def taxels(spec: Spec) -> tuple[Taxel, ...]:
+def taxels(spec) -> tuple[Taxel, ...]:
     """Every taxel of ``spec`` in order (names t1, t2, ... unless [[taxel]] names them); one taxel "t1" at (0, 0)
     for a spec without [array] or [[taxel]]."""
     if spec.taxel:
@@ -70,12 +74,12 @@ def taxels(spec: Spec) -> tuple[Taxel, ...]:
                  for i, (x, y) in enumerate(points, 1))
 
 
-def is_array(spec: Spec) -> bool:
+def is_array(spec) -> bool:
     """Whether ``spec`` describes more than one taxel."""
     return len(taxels(spec)) > 1
 
 
-def field_path(spec: Spec, index: int, key: str) -> str:
+def field_path(spec, index: int, key: str) -> str:
     """The spec field that sets ``key`` (e.g. 'neck.diameter') for the taxel at 0-based ``index``: its [[taxel]]
     override when it has one, else the shared table's field."""
     if spec.taxel and key in ENTRY_FIELDS and getattr(spec.taxel[index], ENTRY_FIELDS[key]) is not None:
@@ -83,7 +87,7 @@ def field_path(spec: Spec, index: int, key: str) -> str:
     return key
 
 
-def taxel_spec(spec: Spec, taxel: Taxel) -> Spec:
+def taxel_spec(spec, taxel: Taxel):
     """A single-taxel spec with ``taxel``'s geometry (its position dropped) and its own calibration when it has
     one (else the spec's [calibration]): how per-taxel physics (predict, wall modes, cap mechanics) is applied to
     one taxel of a board."""

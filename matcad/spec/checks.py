@@ -1,0 +1,52 @@
+"""The cross-field checks of a whole spec: what makes a design impossible although every table is valid. Lengths mm.
+
+They run from ``Spec.__post_init__``, so a spec changed with ``dataclasses.replace`` is checked too; the spec is
+taken as it is (duck-typed), so this module needs no import of the Spec class.
+"""
+
+from __future__ import annotations
+
+import math
+
+from matcad.spec.board import field_path, taxels
+from matcad.spec.derive import reference_spec
+from matcad.spec.fields import SpecError
+
+
+def cross_checks(spec) -> None:
+    """What no single table can check of a whole ``spec`` (a :class:`matcad.spec.model.Spec`): the reference's band
+    and geometry, [array] or [[taxel]] but not both, unique taxel names, and every taxel's geometry. Raises
+    SpecError naming the field that sets the bad value."""
+    if spec.reference is not None and not spec.reference.f0_tolerance_hz < spec.reference.f0_hz:
+        raise SpecError("reference.f0_tolerance_hz", spec.reference.f0_tolerance_hz,
+                        f"must be < reference.f0_hz = {spec.reference.f0_hz:g} Hz (a band in ln f needs f0 - tol > 0)")
+    if spec.reference is not None:
+        try:
+            reference_spec(spec)
+        except SpecError as err:
+            raise SpecError(f"reference ({err.field})", err.value, err.allowed) from None
+    if spec.array is not None and spec.taxel:
+        raise SpecError("array", "[array] and [[taxel]]", "give either an [array] grid or [[taxel]] entries, not both")
+    names = [entry.name for entry in spec.taxel]
+    for i, name in enumerate(names, 1):
+        if name is not None and name in names[:i - 1]:
+            raise SpecError(f"taxel[{i}].name", name, "must be unique among the [[taxel]] entries")
+    for index, t in enumerate(taxels(spec)):
+        _geometry_checks(t, lambda key, i=index: field_path(spec, i, key), spec.mold.draft_deg)
+
+
+def _geometry_checks(t, path, draft_deg: float) -> None:
+    """What makes one taxel's geometry impossible (``t`` a :class:`matcad.spec.board.Taxel`; ``path(key)`` names the
+    spec field that sets ``key``, e.g. 'neck.diameter' or 'taxel[2].neck_diameter')."""
+    if t.neck.diameter > t.cavity.diameter:
+        raise SpecError(path("neck.diameter"), t.neck.diameter,
+                        f"must be <= {path('cavity.diameter')} = {t.cavity.diameter:g} mm (a neck cannot be "
+                        "wider than its cavity)")
+    tip = t.cavity.diameter - 2 * t.cavity.length * math.tan(math.radians(draft_deg))
+    if tip <= 0:
+        raise SpecError("mold.draft_deg", draft_deg,
+                        f"must leave the cavity open: draft closes a {t.cavity.diameter:g} mm cavity within "
+                        f"its {t.cavity.length:g} mm length ({path('cavity.length')})")
+    if t.end_cap.outer_diameter is not None and t.end_cap.outer_diameter <= t.cavity.diameter:
+        raise SpecError(path("end_cap.outer_diameter"), t.end_cap.outer_diameter,
+                        f"must be > {path('cavity.diameter')} = {t.cavity.diameter:g} mm")

@@ -1,0 +1,125 @@
+"""Reading a spec: TOML files within size and nesting limits, a build's report.json, and ``--set`` overrides.
+
+``--set key=value`` sets one dotted spec key (``neck.diameter=2.0``, ``wall.model=silicone``); the value is
+parsed as TOML (``true``, ``[0.2, 0.6]``, ``"text"``) and, when it is not valid TOML, taken as a bare string.
+The result is validated exactly like a file. A report.json written by ``matcad build`` carries the resolved
+spec, so ``matcad build out/NAME/report.json --out again`` rebuilds the same kit. Lengths in the spec are mm.
+"""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from matcad.errors import InputError
+from matcad.inputs import CALIBRATION_MAX_BYTES, SPEC_MAX_BYTES, read_text
+from matcad.spec.calibration import Calibration
+from matcad.spec.fields import SpecError, read_section
+from matcad.spec.model import Spec, from_dict
+
+MAX_NESTING = 32
+"""Deepest TOML nesting a spec document may have (a spec needs 2); deeper is refused before Python recursion."""
+REPORT_MAX_BYTES = 16 << 20
+"""A report.json holds the spec plus the manifest and findings: allow more than a spec file."""
+
+
+def load(path: str | Path) -> Spec:
+    """Read and validate a spec TOML file. Raises SpecError naming the field on bad input."""
+    return from_dict(read_toml(path, "spec file", SPEC_MAX_BYTES))
+
+
+def load_calibration(path: str | Path) -> Calibration:
+    """The [calibration] table of a calibration file or of a whole spec, validated like a spec's."""
+    p = Path(path)
+    data = read_toml(p, "calibration file", CALIBRATION_MAX_BYTES)
+    if "cavity" in data:
+        cal = from_dict(data).calibration
+        if cal is None:
+            raise SpecError("calibration", None, f"is required: {p} has no [calibration] table")
+        return cal
+    if "calibration" not in data:
+        raise SpecError("calibration", None, f"is required: {p} has no [calibration] table")
+    return read_section(Calibration, "calibration", data["calibration"])
+
+
+def _depth(value: Any, limit: int) -> int:
+    """Nesting depth of parsed TOML data, stopping once it passes ``limit``."""
+    if limit < 0 or not isinstance(value, (dict, list)):
+        return 0
+    items = value.values() if isinstance(value, dict) else value
+    return 1 + max((_depth(v, limit - 1) for v in items), default=0)
+
+
+def read_toml(path: str | Path, what: str, limit: int) -> dict:
+    """A size-limited regular file parsed as TOML; any failure is a SpecError naming the file."""
+    p = Path(path)
+    try:
+        text = read_text(p, what, limit)
+    except InputError as exc:
+        raise SpecError(what, str(p), str(exc).split(": ", 1)[-1]) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(what, str(p), f"must be valid TOML ({exc})") from None
+    except (RecursionError, ValueError, MemoryError) as exc:  # nesting or integer digits beyond the parser's limits
+        raise SpecError(what, str(p), f"must be valid TOML within the parser's limits ({exc.__class__.__name__})") \
+            from None
+    if _depth(data, MAX_NESTING) > MAX_NESTING:
+        raise SpecError(what, str(p), f"nests tables or arrays deeper than {MAX_NESTING} levels")
+    return data
+
+
+def read_spec_data(path: str | Path) -> dict:
+    """The raw (unvalidated) spec data of a TOML file, or the resolved spec inside a build's report.json."""
+    import json
+
+    p = Path(path)
+    if p.suffix.lower() != ".json":
+        return read_toml(p, "spec file", SPEC_MAX_BYTES)
+    try:
+        report = json.loads(read_text(p, "report file", REPORT_MAX_BYTES))
+    except InputError as exc:
+        raise SpecError("report file", str(p), str(exc).split(": ", 1)[-1]) from None
+    except (ValueError, RecursionError) as exc:
+        raise SpecError("report file", str(p), f"must be valid JSON ({exc.__class__.__name__})") from None
+    if not isinstance(report, dict) or not isinstance(report.get("spec"), dict):
+        raise SpecError("report file", str(p), "must be a report.json written by `matcad build` (no \"spec\" table)")
+    return report["spec"]
+
+
+def parse_assignment(text: str) -> tuple[list[str], object]:
+    """``key=value`` → (dotted key split, value parsed as TOML or else the bare string)."""
+    key, sep, raw = text.partition("=")
+    parts = key.strip().split(".")
+    if not sep or not all(parts) or len(parts) > 2:
+        raise SpecError("--set", text, "must be KEY=VALUE with KEY a spec field such as neck.diameter or name")
+    try:
+        value = tomllib.loads(f"v = {raw.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw.strip()
+    return parts, value
+
+
+def apply_sets(data: dict, assignments) -> dict:
+    """A copy of ``data`` with every ``key=value`` of ``assignments`` set (validation is the caller's)."""
+    out = copy.deepcopy(data)
+    for text in assignments or ():
+        parts, value = parse_assignment(text)
+        if len(parts) == 1:
+            out[parts[0]] = value
+            continue
+        section = out.get(parts[0])
+        if section is None:
+            section = out[parts[0]] = {}
+        if not isinstance(section, dict):
+            raise SpecError(parts[0], section, f"must be a table to set {'.'.join(parts)}")
+        section[parts[1]] = value
+    return out
+
+
+def load_spec(path: str | Path, assignments=()) -> tuple[Spec, dict]:
+    """(validated Spec, the raw data it came from) for ``path`` with ``assignments`` applied."""
+    data = apply_sets(read_spec_data(path), assignments)
+    return from_dict(data), data

@@ -1,0 +1,148 @@
+"""The whole spec: the :class:`Spec` of every table, and a parsed TOML document to a resolved Spec and back.
+
+:func:`from_dict` validates each table, runs the cross-field checks (:mod:`matcad.spec.checks`) and fills the
+defaults that depend on other fields (the cap body proportional to the cavity, the key clearance by printer,
+silicone values from its grade); :func:`to_dict` gives the resolved spec as plain data. Lengths in mm.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+from matcad.materials import GRADES
+from matcad.spec.calibration import Calibration
+from matcad.spec.checks import cross_checks
+from matcad.spec.fields import SpecError, convert, did_you_mean, param, read_section
+from matcad.spec.sections import (CAP_OUTER_PER_D, CAP_TOP_PER_D, MAX_TAXELS, Air, Array, Cavity, EndCap,
+                                  Fasteners, Guide, Machine, Mechanics, Microphone, Mold, Mount, Neck, Needle,
+                                  Outputs, Plate, Reference, Silicone, Spacer, TaxelEntry, Wall)
+
+
+@dataclass(frozen=True)
+class Spec:
+    """A whole taxel design. Lengths in mm."""
+
+    name: str = param("design name; the build folder is out/<name>", kind="name")
+    cavity: Cavity = field(default=None)  # type: ignore[assignment]
+    neck: Neck = field(default=None)  # type: ignore[assignment]
+    plate: Plate = field(default_factory=Plate)
+    guide: Guide = field(default_factory=Guide)
+    spacer: Spacer = field(default_factory=Spacer)
+    end_cap: EndCap = field(default_factory=EndCap)
+    fasteners: Fasteners = field(default_factory=Fasteners)
+    needle: Needle = field(default_factory=Needle)
+    mount: Mount = field(default_factory=Mount)
+    mold: Mold = field(default_factory=Mold)
+    machine: Machine = field(default_factory=Machine)
+    outputs: Outputs = field(default_factory=Outputs)
+    air: Air = field(default_factory=Air)
+    wall: Wall = field(default_factory=Wall)
+    microphone: Microphone = field(default_factory=Microphone)
+    silicone: Silicone = field(default_factory=Silicone)
+    calibration: Calibration | None = None
+    mechanics: Mechanics = field(default_factory=Mechanics)
+    reference: Reference | None = None
+    array: Array | None = None
+    taxel: tuple[TaxelEntry, ...] = ()
+
+    def __post_init__(self) -> None:
+        name_meta = dict(dataclasses.fields(Spec)[0].metadata)
+        object.__setattr__(self, "name", convert("name", self.name, name_meta))
+        for section, cls in SECTIONS.items():
+            value = getattr(self, section)
+            if value is None and section in REQUIRED_SECTIONS:
+                raise SpecError(section, None, f"is required: add a [{section}] table")
+            if value is not None and not isinstance(value, cls):
+                raise SpecError(section, value, f"must be a {cls.__name__} section")
+        object.__setattr__(self, "taxel", tuple(self.taxel))
+        if not all(isinstance(entry, TaxelEntry) for entry in self.taxel):
+            raise SpecError("taxel", self.taxel, "must be [[taxel]] entries")
+        cross_checks(self)
+
+
+SECTIONS: dict[str, type] = {
+    "cavity": Cavity, "neck": Neck, "plate": Plate, "guide": Guide, "spacer": Spacer, "end_cap": EndCap,
+    "fasteners": Fasteners, "needle": Needle, "mount": Mount, "mold": Mold, "machine": Machine,
+    "outputs": Outputs, "air": Air, "wall": Wall, "microphone": Microphone, "silicone": Silicone,
+    "calibration": Calibration, "mechanics": Mechanics, "reference": Reference, "array": Array}
+REQUIRED_SECTIONS = ("cavity", "neck")
+
+
+def from_dict(data: dict) -> Spec:
+    """Validate a parsed TOML document into a :class:`Spec` (lengths in mm). Raises SpecError."""
+    known = ["name", *SECTIONS, "taxel"]
+    for key in data:
+        if key not in known:
+            raise SpecError(key, data[key], did_you_mean(key, known))
+    name_meta = dict(dataclasses.fields(Spec)[0].metadata)
+    if "name" not in data:
+        raise SpecError("name", None, f"is required ({name_meta['doc']})")
+    values: dict[str, Any] = {"name": convert("name", data["name"], name_meta)}
+    for section, cls in SECTIONS.items():
+        if section in data and data[section] is None and section not in REQUIRED_SECTIONS:
+            continue
+        if section in data:
+            values[section] = read_section(cls, section, data[section])
+        elif section in REQUIRED_SECTIONS:
+            raise SpecError(section, None, f"is required: add a [{section}] table")
+    if "taxel" in data:
+        values["taxel"] = _taxel_entries(data["taxel"])
+    return _resolve_defaults(Spec(**values))  # Spec.__post_init__ runs the cross-field checks
+
+
+def _taxel_entries(data: Any) -> tuple[TaxelEntry, ...]:
+    if not isinstance(data, (list, tuple)) or not all(isinstance(item, dict) for item in data):
+        raise SpecError("taxel", data, "must be [[taxel]] tables, one per taxel")
+    if not 1 <= len(data) <= MAX_TAXELS:
+        raise SpecError("taxel", f"{len(data)} entries", f"must be 1 to {MAX_TAXELS} [[taxel]] entries")
+    return tuple(read_section(TaxelEntry, f"taxel[{i}]", item) for i, item in enumerate(data, 1))
+
+
+KEY_CLEARANCE_MM = {"fdm": 0.2, "sla": 0.1}
+"""Registration-key clearance per side by printer process (docs/physics.md, shop practice)."""
+
+
+def _resolve_defaults(spec: Spec) -> Spec:
+    """Fill defaults that depend on other fields (cap body proportional to the cavity; key clearance; silicone
+    values from its grade)."""
+    cap = spec.end_cap
+    entries = tuple(dataclasses.replace(
+        e, cap_outer_diameter=_proportional(e.cap_outer_diameter, cap.outer_diameter, CAP_OUTER_PER_D,
+                                            e.cavity_diameter or spec.cavity.diameter),
+        cap_top_thickness=_proportional(e.cap_top_thickness, cap.top_thickness, CAP_TOP_PER_D,
+                                        e.cavity_diameter or spec.cavity.diameter)) for e in spec.taxel)
+    d = spec.cavity.diameter
+    cap = dataclasses.replace(
+        cap, outer_diameter=cap.outer_diameter if cap.outer_diameter is not None else CAP_OUTER_PER_D * d,
+        top_thickness=cap.top_thickness if cap.top_thickness is not None else CAP_TOP_PER_D * d)
+    machine = spec.machine
+    if machine.key_clearance is None:
+        machine = dataclasses.replace(machine, key_clearance=KEY_CLEARANCE_MM[machine.printer])
+    grade = GRADES[spec.silicone.grade]
+    silicone = spec.silicone
+    if silicone.density_g_cm3 is None:
+        silicone = dataclasses.replace(silicone, density_g_cm3=grade.density_kg_m3 / 1000.0)
+    wall = spec.wall
+    if wall.shear_modulus_mpa is None:
+        wall = dataclasses.replace(wall, shear_modulus_mpa=grade.shear_modulus_mpa)
+    if wall.loss_factor is None:
+        wall = dataclasses.replace(wall, loss_factor=grade.loss_factor)
+    if wall.khz_modulus_factor is None:
+        wall = dataclasses.replace(wall, khz_modulus_factor=grade.khz_modulus_factor)
+    return dataclasses.replace(spec, end_cap=cap, machine=machine, silicone=silicone, wall=wall, taxel=entries)
+
+
+def _proportional(own: float | None, shared: float | None, per_d: float, cavity_diameter: float) -> float:
+    """A taxel's cap size: its own, else the shared [end_cap] value the user gave, else ``per_d`` x its D (mm)."""
+    if own is not None:
+        return own
+    return shared if shared is not None else per_d * cavity_diameter
+
+
+def to_dict(spec: Spec) -> dict:
+    """The resolved spec (defaults filled in) as plain TOML-like data; ``taxel`` only when it has entries."""
+    data = dataclasses.asdict(spec)
+    entries = data.pop("taxel")
+    return data | ({"taxel": list(entries)} if entries else {})

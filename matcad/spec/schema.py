@@ -1,0 +1,37 @@
+"""``matcad schema``: every spec field with its unit (mm for lengths), default, allowed values and meaning, read
+from the one declaration of each field.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from matcad.spec.fields import allowed_text
+from matcad.spec.model import REQUIRED_SECTIONS, SECTIONS, Spec
+from matcad.spec.sections import TaxelEntry
+
+
+def schema() -> list[dict]:
+    """Every spec field: key, unit, default, allowed values (as text, and as kind, choices, lo, hi) and meaning."""
+    rows = []
+    name_meta = dataclasses.fields(Spec)[0].metadata
+    rows.append({"key": "name", "unit": "", "default": None, "allowed": "A-Z a-z 0-9 . _ - (1-64)",
+                 "required": True, "doc": name_meta["doc"], "kind": "name", "choices": [], "lo": None,
+                 "hi": None, "lo_open": True, "required_in_table": True})
+    tables = [*SECTIONS.items(), ("taxel[]", TaxelEntry)]
+    tables += [(f"{name}.{f.name}", f.metadata["section"]) for name, cls in tables for f in dataclasses.fields(cls)
+               if f.metadata["kind"] == "section"]  # sub-tables, e.g. taxel[].calibration
+    for section, cls in tables:
+        for f in dataclasses.fields(cls):
+            meta = f.metadata
+            if meta["kind"] == "section":
+                continue
+            allowed = allowed_text(dict(meta))
+            default = None if f.default is dataclasses.MISSING else f.default
+            required = f.default is dataclasses.MISSING and section in REQUIRED_SECTIONS
+            rows.append({"key": f"{section}.{f.name}", "unit": meta["unit"],
+                         "default": list(default) if isinstance(default, tuple) else default,
+                         "allowed": allowed, "required": required, "doc": meta["doc"], "kind": meta["kind"],
+                         "choices": list(meta["choices"]), "lo": meta["lo"], "hi": meta["hi"],
+                         "lo_open": meta["lo_open"], "required_in_table": f.default is dataclasses.MISSING})
+    return rows
