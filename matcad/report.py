@@ -11,9 +11,10 @@ from pathlib import Path
 from matcad import __version__
 from matcad.acoustics.geometry import drafted_cavity_volume_mm3, drafted_tip_diameter_mm
 from matcad.parts.catalogue import laser_parts
-from matcad.parts.features import (sheet_kerf_mm, bolt_nominal_mm, cap_flange_thickness_mm, cap_volume_mm3,
-                                   plate_bolt_positions_mm, plate_dowel_positions_mm)
+from matcad.parts.features import (sheet_kerf_mm, bolt_nominal_mm, cap_volume_mm3, plate_bolt_positions_mm,
+                                   plate_dowel_positions_mm)
 from matcad.parts.fabrication import fabrication
+from matcad.parts.stack import bolt_span_mm
 from matcad.spec import to_dict
 
 KIT_ARCHIVE = "kit.zip"
@@ -60,7 +61,7 @@ def bill_of_materials(spec) -> dict:
     cap = cap_volume_mm3(spec)
     needed_g = cap * spec.mold.count * spec.silicone.waste_factor / 1000 * spec.silicone.density_g_cm3
     batch_g = max(needed_g, MIN_BATCH_G)
-    stack = spec.neck.length + cap_flange_thickness_mm(spec) + spec.guide.thickness + spec.spacer.height
+    stack = bolt_span_mm(spec)
     bolt_d = bolt_nominal_mm(spec.fasteners.bolt)
     engage = min(THREAD_ENGAGEMENT_PER_D * bolt_d, spec.mount.thickness)
     return {

@@ -8,13 +8,14 @@ squeeze shows as a gap that the bolts close).
 from build123d import Compound, ExportSVG, Plane, Pos, Rot
 
 from matcad.parts.end_cap import end_cap
-from matcad.parts.features import cap_flange_thickness_mm, plate_bolt_positions_mm
+from matcad.parts.features import plate_bolt_positions_mm
 from matcad.parts.guide import guide
 from matcad.parts.neck_plate import neck_plate
 from matcad.parts.needle_mount import needle, needle_mount, taxel_needle
 from matcad.parts.registry import parts as registered_parts
 from matcad.parts.solid import flat_solid
 from matcad.parts.spacer import spacer
+from matcad.parts.stack import clamp_seat_z_mm
 from matcad.render.section import annotate_section
 
 NEEDLE_COLOUR = "#404040"
@@ -47,7 +48,7 @@ def assembled_parts(spec) -> dict[str, object]:
     parts = {
         "neck_plate": flat_solid(drilled(neck_plate(spec), tuple(t.neck.diameter for t in board))),
         "guide_locator": flat_solid(guide(spec, "locator"), plate_t),
-        "guide_clamp": flat_solid(guide(spec, "clamp"), plate_t + cap_flange_thickness_mm(spec)),
+        "guide_clamp": flat_solid(guide(spec, "clamp"), clamp_seat_z_mm(spec)),
     }
     if len(board) == 1:
         parts |= {"end_cap": Pos(0, 0, plate_t) * end_cap(spec), "needle_mount": needle_mount(spec),

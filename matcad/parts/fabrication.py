@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.registry import Kind, wanted
+from matcad.parts.stack import squeeze_range_mm
 
 if TYPE_CHECKING:
     from matcad.spec import Spec
@@ -38,8 +39,6 @@ def sheets_to_caliper(spec: Spec) -> list[dict]:
 
 def seal(spec: Spec) -> dict:
     """Flange squeeze over the guide sheet's tolerance (mm), as the rule ``seal.squeeze`` judges it."""
-    from matcad.rules.stack import squeeze_range_mm
-
     lo, hi, tol = squeeze_range_mm(spec)
     return {"flange_squeeze_mm": spec.end_cap.flange_squeeze, "guide_sheet_mm": spec.guide.thickness,
             "guide_measured": spec.guide.thickness_measured, "sheet_tolerance_mm": tol,

@@ -78,6 +78,7 @@ class _Drawing:
 
 def _dimensions(spec, draw: _Drawing) -> None:
     from matcad.parts.features import cap_height_mm, needle_axis_mm
+    from matcad.parts.stack import mount_depth_mm
 
     D, L = spec.cavity.diameter, spec.cavity.length
     d, l = spec.neck.diameter, spec.neck.length
@@ -111,7 +112,7 @@ def _dimensions(spec, draw: _Drawing) -> None:
     draw.line(px, 0.0, px - (r + f), 0.0, colour="#7080a0")
     draw.line(px, 0.0, px - (r + f) * ux, -(r + f) * uz, colour="#7080a0")
     draw.text(px - r - 1.3 * f, -0.9 * f, f"θ = {theta:g}°", anchor="end")  # left of the arc, clear of the needle
-    z_y = -gap - spec.mount.thickness - 1.2 * f
+    z_y = -mount_depth_mm(spec) - 1.2 * f
     for x in (px, -d / 2):
         draw.line(x, 0.0, x, z_y - 0.3 * f, colour="#7080a0")
     draw.dimension(px, -d / 2, z_y, f"y = {spec.needle.y:g}", vertical=False)
@@ -119,15 +120,15 @@ def _dimensions(spec, draw: _Drawing) -> None:
 
 def _label_points(spec) -> dict[str, tuple[float, float]]:
     """A point inside each part of the section to start its leader from (assembly frame x, z; mm)."""
-    from matcad.parts.features import cap_flange_thickness_mm, cap_height_mm, needle_tip_mm
+    from matcad.parts.features import cap_height_mm, needle_tip_mm
+    from matcad.parts.stack import clamp_seat_z_mm
 
-    w, l, g = spec.plate.width, spec.neck.length, spec.guide.thickness
-    tf, gap = cap_flange_thickness_mm(spec), spec.spacer.height
+    w, l, g, gap = spec.plate.width, spec.neck.length, spec.guide.thickness, spec.spacer.height
     tip_x, _, tip_z = needle_tip_mm(spec)
     t = math.radians(spec.needle.theta_deg)
     return {
         "neck_plate": (-w / 2 + 1.0, l / 2), "guide_locator": (-w / 2 + 1.0, l + g / 2),
-        "guide_clamp": (-w / 2 + 1.0, l + tf + g / 2),
+        "guide_clamp": (-w / 2 + 1.0, clamp_seat_z_mm(spec) + g / 2),
         "end_cap": (-spec.end_cap.outer_diameter / 4, l + cap_height_mm(spec) - spec.end_cap.top_thickness / 2),
         "needle_mount": (-w / 2 + 1.0, -gap - spec.mount.thickness / 2),
         "needle": (tip_x - 6.0 * math.cos(t), tip_z - 6.0 * math.sin(t)), "spacer": (w / 2 - 1.0, -gap / 2),
