@@ -80,7 +80,8 @@ def _write_solids(spec, folder: Path) -> dict[str, dict]:
     checks = {f"{name}.stl": write_printed_part(name, solid, spec, folder)
               for name, solid in printed_parts(spec).items()}
     if spec.outputs.assembly:
-        from matcad.parts.assembly import assembled_parts, assembly, write_section_svg
+        from matcad.parts.assembly import assembled_parts, assembly
+        from matcad.render.section import write_section_svg
 
         parts = assembled_parts(spec)
         write_step(assembly(spec, parts), folder / "assembly.step")
