@@ -44,13 +44,19 @@ def default_out_dir(spec, suffix: str = "", root: Path = Path("out")) -> Path:
     return root / f"{spec.name}{suffix}"
 
 
+def write_cut_plan(plan, folder: Path) -> list[dict]:
+    """DXF + SVG of one laser part's cut plan (kerf compensated); returns each hole as cut, with its
+    compensation."""
+    name = plan.flat.name
+    write_dxf(plan, folder / f"{name}.dxf")
+    write_svg(plan, folder / f"{name}.svg")
+    return [{"part": name, "purpose": c.purpose, "x_mm": c.x, "y_mm": c.y, "finished_mm": c.finished_diameter,
+             "drawn_mm": c.diameter, "compensation_mm": c.compensation} for c in plan.circles]
+
+
 def write_laser_part(flat, spec, folder: Path) -> list[dict]:
     """DXF + SVG of one laser part, kerf compensated; returns each hole as cut, with its compensation."""
-    plan = cut_plan(flat, spec.outputs.reference_square)
-    write_dxf(plan, folder / f"{flat.name}.dxf")
-    write_svg(plan, folder / f"{flat.name}.svg")
-    return [{"part": flat.name, "purpose": c.purpose, "x_mm": c.x, "y_mm": c.y, "finished_mm": c.finished_diameter,
-             "drawn_mm": c.diameter, "compensation_mm": c.compensation} for c in plan.circles]
+    return write_cut_plan(cut_plan(flat, spec.outputs.reference_square), folder)
 
 
 def write_printed_part(name: str, solid, spec, folder: Path, pose: str | None = None) -> dict:
@@ -69,9 +75,9 @@ def write_printed_part(name: str, solid, spec, folder: Path, pose: str | None = 
                                "design_to_print": matrix, "chordal_tolerance_mm": tolerance}
 
 
-def _write_laser(spec, folder: Path) -> list[dict]:
-    """DXF + SVG per laser part; returns every hole as cut."""
-    return [hole for flat in laser_parts(spec) for hole in write_laser_part(flat, spec, folder)]
+def _write_laser(plans, folder: Path) -> list[dict]:
+    """DXF + SVG per laser part's cut plan; returns every hole as cut."""
+    return [hole for plan in plans for hole in write_cut_plan(plan, folder)]
 
 
 def _write_solids(spec, folder: Path) -> dict[str, dict]:
@@ -81,7 +87,8 @@ def _write_solids(spec, folder: Path) -> dict[str, dict]:
     checks = {f"{name}.stl": write_printed_part(name, solid, spec, folder)
               for name, solid in printed_parts(spec).items()}
     if spec.outputs.assembly:
-        from matcad.parts.assembly import assembled_parts, assembly, write_section_svg
+        from matcad.parts.assembly import assembled_parts, assembly
+        from matcad.render.section import write_section_svg
 
         parts = assembled_parts(spec)
         write_step(assembly(spec, parts), folder / "assembly.step")
@@ -126,6 +133,7 @@ def board_report(spec, board, predictions) -> list[dict]:
 
 def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:
     """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
+    from matcad.parts.mold_layout import layout
     from matcad.render.bands import BANDS_PNG, band_chart
     from matcad.render.kit import render_figures
     from matcad.report import KIT_ARCHIVE, make_report, write_report
@@ -141,10 +149,14 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
     bands = board_bands(spec)
     with staged_output(target) as tmp:
-        holes = _write_laser(spec, tmp)
+        flats = laser_parts(spec)
+        plans = [cut_plan(flat, spec.outputs.reference_square) for flat in flats]
+        holes = _write_laser(plans, tmp)
         meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
-        figures = render_figures(spec, prediction, tmp, meshes) + [band_chart(bands, tmp / BANDS_PNG)]
-        report = make_report(spec, prediction, findings, holes, meshes, tmp) | {"figures": figures, "bands": bands}
+        figures = render_figures(spec, prediction, tmp, meshes, plans) + [band_chart(bands, tmp / BANDS_PNG)]
+        mold = layout(spec) if spec.outputs.end_cap_mold else None
+        report = make_report(spec, prediction, findings, holes, meshes, tmp, flats=flats, mold=mold) | {
+            "figures": figures, "bands": bands}
         if len(board) > 1:
             report["taxels"] = board_report(spec, board, predictions)
         write_report(report, tmp)

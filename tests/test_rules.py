@@ -83,3 +83,20 @@ def test_sla_mold_gets_the_inhibition_warning_and_no_pla_wording():
     assert found["mold.cure_inhibition"].level == "warning" and "platinum" in found["mold.cure_inhibition"].message
     assert "PLA" not in found["silicone.batch"].message and "SLA resin" in found["silicone.batch"].message
     assert "mold.cure_inhibition" not in {f.id for f in check(spec_mod.load(PAPER))}
+
+
+def test_every_rule_module_is_registered_once():
+    """check() runs the modules of matcad.rules.registry: every module of matcad/rules/ that declares RULES is
+    there exactly once (a forgotten module would fail silently), and each TAXEL_RULES is a subset of its RULES."""
+    import importlib
+    import pkgutil
+
+    import matcad.rules
+    from matcad.rules.registry import PREDICTION_MODULES, SPEC_MODULES
+
+    registered = [m.__name__ for m in SPEC_MODULES + PREDICTION_MODULES]
+    declaring = sorted(name for _, name, _ in pkgutil.iter_modules(matcad.rules.__path__, "matcad.rules.")
+                       if hasattr(importlib.import_module(name), "RULES"))
+    assert sorted(registered) == declaring and len(set(registered)) == len(registered)
+    for module in SPEC_MODULES:
+        assert set(getattr(module, "TAXEL_RULES", ())) <= set(module.RULES), module.__name__

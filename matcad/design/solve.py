@@ -2,7 +2,7 @@
 
 The model is the one `matcad predict` chooses for the spec (transmission line, elastic wall, or the measured
 reference times its ratio), evaluated on its own (milliseconds); the answer is then confirmed by
-:func:`matcad.acoustics.predict.predict` and held to the design rules (:func:`matcad.rules.check`).
+:func:`matcad.prediction.predict` and held to the design rules (:func:`matcad.rules.check`).
 
 With several continuous fields there are many solutions; the solver moves them together along the steepest
 route in log space, x_i(t) = x_i0 · exp(t · g_i) with g_i = ∂ln f/∂ln x_i at the start (the least relative change
@@ -119,7 +119,7 @@ def parse_vary(spec, items, allowed=FIELDS) -> dict[str, tuple[float, float] | N
 
 
 def model_f0(spec, model: str, base: str) -> float:
-    """f0 (Hz) of ``spec`` by ``model`` exactly as :func:`matcad.acoustics.predict.predict` computes it: one of
+    """f0 (Hz) of ``spec`` by ``model`` exactly as :func:`matcad.prediction.predict` computes it: one of
     the cheap models, or 'relative' (the measured reference f0 times ``base``'s ratio, this design / reference)."""
     from matcad.acoustics import registry
     from matcad.acoustics.design import design

@@ -30,12 +30,11 @@ def load_forces_n(spec) -> np.ndarray:
     return np.linspace(max(lo, 0.0), hi, LOAD_POINTS) if hi > max(lo, 0.0) else np.array([])
 
 
-def render_figures(spec, prediction, folder: Path, meshes: dict) -> list[dict]:
+def render_figures(spec, prediction, folder: Path, meshes: dict, plans: list) -> list[dict]:
     """Write every preview and plot for ``spec`` into ``folder``; ``meshes`` names the STLs written (file →
-    checks). Returns [{part, file, caption}] in report order: section, plots, laser parts, printed parts."""
+    checks), ``plans`` are the laser parts' cut plans (:func:`matcad.parts.flat.cut_plan`) the build drew. Returns
+    [{part, file, caption}] in report order: section, plots, laser parts, printed parts."""
     from matcad.prediction import predict
-    from matcad.parts.catalogue import laser_parts
-    from matcad.parts.flat import cut_plan
     from matcad.render.plots import BAND_PNG, LOAD_PNG, band_plot, load_plot
     from matcad.render.previews import flat_preview, preview_name, printed_preview
     from matcad.spec import taxel_spec, taxels
@@ -54,9 +53,8 @@ def render_figures(spec, prediction, folder: Path, meshes: dict) -> list[dict]:
         figure = load_plot(predict(first, forces_n=forces, mechanics=False).to_dict(), folder / LOAD_PNG)
         if figure:
             figures.append(figure)
-    for flat in laser_parts(spec):
-        plan = cut_plan(flat, spec.outputs.reference_square)
-        figures.append(flat_preview(plan, folder / preview_name(flat.name)))
+    for plan in plans:
+        figures.append(flat_preview(plan, folder / preview_name(plan.flat.name)))
     for stl in sorted(meshes):
         name = Path(stl).stem
         figures.append(printed_preview(name, folder / stl, folder / preview_name(name)))

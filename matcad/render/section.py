@@ -1,10 +1,10 @@
-"""Labels and dimensions on the assembly section (section.svg), drawn in the section's own mm coordinates.
+"""The assembly section (section.svg): the assembled parts cut by a plane, labelled and dimensioned in mm.
 
-The section (:func:`matcad.parts.assembly.write_section_svg`) is the assembly cut by the XZ plane (neck and
-needle axis), plate underside z = 0. Here every part present in it gets a name with a leader, and the
-design's dimensions are drawn to scale from the spec: D, L (cavity), d, l (neck), the cap's outer diameter and
-top thickness, the spacer gap, the needle angle θ and its offset y (paper Fig. 2 names). SVG user unit = 1 mm;
-the drawing's y axis points down, so a point (x, z) of the assembly frame is drawn at (x, −z).
+The section (:func:`write_section_svg`) is the assembly (:func:`matcad.parts.assembly.assembled_parts`) cut by
+the XZ plane (neck and needle axis), plate underside z = 0. Every part present in it gets a name with a leader,
+and the design's dimensions are drawn to scale from the spec: D, L (cavity), d, l (neck), the cap's outer
+diameter and top thickness, the spacer gap, the needle angle θ and its offset y (paper Fig. 2 names). SVG user
+unit = 1 mm; the drawing's y axis points down, so a point (x, z) of the assembly frame is drawn at (x, −z).
 """
 
 from __future__ import annotations
@@ -17,6 +17,8 @@ from pathlib import Path
 SVG_NS = "http://www.w3.org/2000/svg"
 INK = "#203060"
 NEEDLE_LABEL = "air-supply needle"
+NEEDLE_COLOUR = "#404040"
+"""Section fill of the bought needle (drawn for clearance; not a registered part)."""
 
 
 @dataclass
@@ -78,6 +80,7 @@ class _Drawing:
 
 def _dimensions(spec, draw: _Drawing) -> None:
     from matcad.parts.features import cap_height_mm, needle_axis_mm
+    from matcad.parts.stack import mount_depth_mm
 
     D, L = spec.cavity.diameter, spec.cavity.length
     d, l = spec.neck.diameter, spec.neck.length
@@ -111,7 +114,7 @@ def _dimensions(spec, draw: _Drawing) -> None:
     draw.line(px, 0.0, px - (r + f), 0.0, colour="#7080a0")
     draw.line(px, 0.0, px - (r + f) * ux, -(r + f) * uz, colour="#7080a0")
     draw.text(px - r - 1.3 * f, -0.9 * f, f"θ = {theta:g}°", anchor="end")  # left of the arc, clear of the needle
-    z_y = -gap - spec.mount.thickness - 1.2 * f
+    z_y = -mount_depth_mm(spec) - 1.2 * f
     for x in (px, -d / 2):
         draw.line(x, 0.0, x, z_y - 0.3 * f, colour="#7080a0")
     draw.dimension(px, -d / 2, z_y, f"y = {spec.needle.y:g}", vertical=False)
@@ -119,15 +122,15 @@ def _dimensions(spec, draw: _Drawing) -> None:
 
 def _label_points(spec) -> dict[str, tuple[float, float]]:
     """A point inside each part of the section to start its leader from (assembly frame x, z; mm)."""
-    from matcad.parts.features import cap_flange_thickness_mm, cap_height_mm, needle_tip_mm
+    from matcad.parts.features import cap_height_mm, needle_tip_mm
+    from matcad.parts.stack import clamp_seat_z_mm
 
-    w, l, g = spec.plate.width, spec.neck.length, spec.guide.thickness
-    tf, gap = cap_flange_thickness_mm(spec), spec.spacer.height
+    w, l, g, gap = spec.plate.width, spec.neck.length, spec.guide.thickness, spec.spacer.height
     tip_x, _, tip_z = needle_tip_mm(spec)
     t = math.radians(spec.needle.theta_deg)
     return {
         "neck_plate": (-w / 2 + 1.0, l / 2), "guide_locator": (-w / 2 + 1.0, l + g / 2),
-        "guide_clamp": (-w / 2 + 1.0, l + tf + g / 2),
+        "guide_clamp": (-w / 2 + 1.0, clamp_seat_z_mm(spec) + g / 2),
         "end_cap": (-spec.end_cap.outer_diameter / 4, l + cap_height_mm(spec) - spec.end_cap.top_thickness / 2),
         "needle_mount": (-w / 2 + 1.0, -gap - spec.mount.thickness / 2),
         "needle": (tip_x - 6.0 * math.cos(t), tip_z - 6.0 * math.sin(t)), "spacer": (w / 2 - 1.0, -gap / 2),
@@ -182,3 +185,58 @@ def annotate_section(spec, path: Path, dimensions: bool = True) -> None:
     root.set("height", f"{y1 - y0:.4f}mm")
     ET.indent(tree, space="  ")
     tree.write(path, encoding="utf-8", xml_declaration=True)
+
+
+def section_colours() -> dict[str, str]:
+    """Section fill per layer: each registered part's colour, and the needle's."""
+    from matcad.parts.registry import parts
+
+    return {p.name: p.colour for p in parts()} | {"needle": NEEDLE_COLOUR}
+
+
+def layer_of(name: str) -> str:
+    """The section layer (registered part or needle) of an assembled solid's name (spacer_2, end_cap_t3, ...)."""
+    for numbered in ("spacer", "end_cap", "needle"):
+        if name.startswith(numbered + "_") and name != "needle_mount":
+            return numbered
+    return name
+
+
+def section_plane(spec):
+    """The section's plane: XZ through the first taxel's neck axis (a row of necks, and the needles' plane:
+    every needle is tilted in its own XZ plane) (mm)."""
+    from build123d import Plane
+
+    from matcad.spec import taxels
+
+    y = taxels(spec)[0].y
+    return Plane.XZ if y == 0.0 else Plane(origin=(0, y, 0), x_dir=(1, 0, 0), z_dir=(0, -1, 0))
+
+
+def write_section_svg(spec, path, parts=None) -> None:
+    """Section of the assembly (``parts``, name → solid in the assembly frame; ``assembled_parts`` unless given)
+    through the first taxel's row of necks in the XZ plane (the needles' plane), to scale in mm, with part labels
+    and, for a single taxel, the design's dimensions (:func:`annotate_section`; a board's section carries the
+    labels only)."""
+    from build123d import ExportSVG, Pos, Rot
+
+    from matcad.parts.assembly import assembled_parts
+    from matcad.spec import is_array
+
+    parts = parts or assembled_parts(spec)
+    plane = section_plane(spec)
+    svg = ExportSVG(margin=2.0, line_weight=0.05)
+    layers, colours = set(), section_colours()
+    for name, solid in parts.items():
+        cut = solid & plane
+        if not cut or not cut.faces():
+            continue
+        layer = layer_of(name)
+        if layer not in layers:
+            svg.add_layer(layer, fill_color=colours[layer], line_color="#000000")
+            layers.add(layer)
+        if plane.origin.Y:
+            cut = Pos(0, -plane.origin.Y, 0) * cut
+        svg.add_shape(Rot(-90, 0, 0) * cut, layer=layer)  # XZ plane → drawing plane, z up
+    svg.write(str(path))
+    annotate_section(spec, path, dimensions=not is_array(spec))

@@ -1,43 +1,31 @@
 """Design rules: small functions of the validated spec returning findings; none imports a CAD kernel.
 
-Levels: ``error`` (the part will not work or cannot be made: `build` refuses without --force), ``warning``
-(likely trouble; fix or accept knowingly), ``info`` (numbers worth knowing before casting).
+The face: :class:`~matcad.rules.finding.Finding` (and its levels: ``error`` — `build` refuses without --force —,
+``warning``, ``info``), :func:`check`, which runs every rule module of :mod:`matcad.rules.registry`, and
+:func:`errors`. A rule module imports ``Finding`` from :mod:`matcad.rules.finding`, never from this face.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+from dataclasses import replace
 
-LEVELS = ("error", "warning", "info")
+from matcad.rules.finding import LEVELS, Finding
+from matcad.rules.registry import PREDICTION_MODULES, SPEC_MODULES
 
-
-@dataclass(frozen=True)
-class Finding:
-    """One rule's verdict: id, level, the measured value, the limit it was held to, message and fix."""
-
-    id: str
-    level: str
-    value: object
-    limit: object
-    message: str
-    fix: str = ""
-
-    def to_dict(self) -> dict:
-        return asdict(self)
+__all__ = ["Finding", "check", "errors"]
 
 
 def check(spec, prediction=None) -> list[Finding]:
-    """Run every rule on ``spec``; ``prediction`` (from acoustics.predict, of a single-taxel spec) is computed when
+    """Run every rule on ``spec``; ``prediction`` (:func:`matcad.prediction.predict` of a single-taxel spec) is computed when
     not given; a board's acoustic rules run on each taxel's own prediction."""
     from matcad.prediction import predict
-    from matcad.rules import acoustic, bands, board as board_rules, laser, printing, stack
-
     from matcad.spec import taxel_spec, taxels
 
     board = taxels(spec)
     findings: list[Finding] = []
-    per_taxel = [rule for module in (printing, stack) for rule in module.TAXEL_RULES] if len(board) > 1 else []
-    for module in (laser, printing, stack, bands, board_rules):
+    per_taxel = ([rule for module in SPEC_MODULES for rule in getattr(module, "TAXEL_RULES", ())]
+                 if len(board) > 1 else [])
+    for module in SPEC_MODULES:
         for rule in module.RULES:
             if rule not in per_taxel:
                 findings += rule(spec)
@@ -48,12 +36,14 @@ def check(spec, prediction=None) -> list[Finding]:
     for taxel in board:  # the sound rules per taxel, on its own prediction; a board's messages name the taxel
         one = taxel_spec(spec, taxel)
         p = (prediction or predict(one)) if len(board) == 1 else predict(one)
-        for rule in acoustic.RULES:
-            findings += [f if len(board) == 1 else replace(f, message=f"{taxel.name}: {f.message}")
-                         for f in rule(one, p)]
+        for module in PREDICTION_MODULES:
+            for rule in module.RULES:
+                findings += [f if len(board) == 1 else replace(f, message=f"{taxel.name}: {f.message}")
+                             for f in rule(one, p)]
     order = {level: i for i, level in enumerate(LEVELS)}
     return sorted(findings, key=lambda f: order[f.level])
 
 
 def errors(findings: list[Finding]) -> list[Finding]:
+    """The findings at level ``error``."""
     return [f for f in findings if f.level == "error"]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from matcad.rules import Finding
+from matcad.rules.finding import Finding
 
 NYQUIST_MARGIN = 0.45
 """Keep the band below 0.45 × sample rate: anti-alias filters roll off above ~0.45 fs."""

@@ -8,7 +8,7 @@ Single-taxel specs have nothing to separate and skip these rules (so their check
 
 from __future__ import annotations
 
-from matcad.rules import Finding
+from matcad.rules.finding import Finding
 
 FIX = ("move the taxels apart in frequency (`matcad design --taxels N --band LO HI` allocates disjoint bands), "
        "lower mechanics.max_force_n, or narrow the bands: a calipered sheet (plate.thickness_measured) and a "

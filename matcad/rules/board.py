@@ -11,7 +11,8 @@ import math
 
 from matcad.parts.features import (bolt_clearance_mm, cap_flange_diameter_mm, needle_axis_mm, needle_tip_mm,
                                    pin_hole_diameter_mm, plate_bolt_positions_mm, plate_dowel_positions_mm)
-from matcad.rules import Finding
+from matcad.parts.stack import mount_depth_mm
+from matcad.rules.finding import Finding
 
 JET_HALF_ANGLE_DEG = 12.0
 """Opening half-angle of the needle's free jet, to where its speed falls to ~10 % of the centre line's. A round
@@ -182,8 +183,7 @@ def mold_slots(spec) -> list[Finding]:
 def _bore_points(spec, taxel, samples: int = 240):
     """Points along ``taxel``'s needle axis from the plate underside down to the mount's underside (mm)."""
     mouth, u = needle_axis_mm(taxel)
-    depth = spec.spacer.height + spec.mount.thickness
-    run = depth / max(u[2], 1e-9)
+    run = mount_depth_mm(spec) / max(u[2], 1e-9)
     return [tuple(m - run * k / samples * c for m, c in zip(mouth, u)) for k in range(samples + 1)]
 
 

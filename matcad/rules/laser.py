@@ -8,7 +8,7 @@ from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.features import is_stock_sheet
 from matcad.parts.flat import Flat, drawn_holes
-from matcad.rules import Finding
+from matcad.rules.finding import Finding
 
 TAPER_RATIO = 0.7
 """CO₂-laser holes smaller than ~0.7 × sheet thickness come out visibly tapered (docs/physics.md)."""

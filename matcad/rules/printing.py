@@ -5,7 +5,7 @@ from __future__ import annotations
 from matcad.parts.casting import MIN_BATCH_G, MOLD_MATERIALS, casting_guide
 from matcad.parts.coupon import FDM_THETA_MIN_DEG
 from matcad.parts.mold_layout import pin_tip_radius_mm, plan_vents
-from matcad.rules import Finding
+from matcad.rules.finding import Finding
 
 MIN_WALL_SLA_MM = 0.8
 KEY_CLEARANCE_MIN_MM = {"fdm": 0.15, "sla": 0.05}

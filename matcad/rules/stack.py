@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.parts.features import cap_flange_thickness_mm, needle_tip_mm
-from matcad.rules import Finding
+from matcad.parts.stack import mount_depth_mm, squeeze_range_mm
+from matcad.rules.finding import Finding
 
 PAPER_THETA_DEG = (30.0, 75.0)
 PAPER_Y_MM = (0.0, 3.47)
@@ -23,7 +23,7 @@ def needle_clearance(spec) -> list[Finding]:
         out.append(Finding("needle.collision", "error", n.tip_clearance, "> 0",
                            "the needle end touches the neck plate", "set needle.tip_clearance > 0"))
     tip_z = needle_tip_mm(spec)[2]
-    bottom = -(spec.spacer.height + spec.mount.thickness)
+    bottom = -mount_depth_mm(spec)
     if tip_z <= bottom:
         out.append(Finding("needle.collision", "error", round(-tip_z, 4), round(-bottom, 4),
                            f"the needle tip sits {-tip_z:.2f} mm below the plate, under the mount: nothing "
@@ -39,12 +39,12 @@ def needle_bore(spec) -> list[Finding]:
     from matcad.spec import taxels
 
     board = taxels(spec)
-    gap, thick, half = spec.spacer.height, spec.mount.thickness, spec.plate.width / 2
+    gap, depth, half = spec.spacer.height, mount_depth_mm(spec), spec.plate.width / 2
     out = []
     for t in board:
         (px, py, _), (ux, _, uz) = needle_axis_mm(t if len(board) > 1 else spec)
         run = ux / uz if uz > 0 else float("inf")  # x travelled per mm of descent along the axis
-        x_top, x_bot = px - gap * run, px - (gap + thick) * run
+        x_top, x_bot = px - gap * run, px - depth * run
         if uz > 0 and x_bot <= half and x_top >= -half and abs(py) <= spec.plate.depth / 2:
             continue
         who = f"{t.name}: " if len(board) > 1 else ""
@@ -67,16 +67,6 @@ def needle_window(spec) -> list[Finding]:
                            f"y = {y:g} mm is outside the paper's tested 0-3.47 mm; it may not sound",
                            "stay within 0-3.47 mm"))
     return out
-
-
-def squeeze_range_mm(spec) -> tuple[float, float, float]:
-    """Flange squeeze the clamp can produce over the guide sheet's tolerance: (low, high, tolerance) in mm.
-
-    The flange is cast guide.thickness + squeeze thick; the clamp bottoms out on the locator, cut from the same
-    sheet, so the real squeeze is the flange minus the real sheet (nominal ± :func:`sheet_tolerance_mm`)."""
-    tol = sheet_tolerance_mm(spec.guide.thickness, spec.guide.thickness_measured)
-    s = spec.end_cap.flange_squeeze
-    return s - tol, s + tol, tol
 
 
 def seal_squeeze(spec) -> list[Finding]:

@@ -4,7 +4,7 @@ Frequencies Hz; sensitivities in Hz per the varied field's unit (Hz/mm for lengt
 
 - The closed-form rungs (:data:`matcad.sweep.fast.VECTORISED`) are evaluated on all variants at once; their
   df0/dfield is the model's own derivative (central difference at each variant).
-- Any other model (elastic_wall, soft_wall, relative, fem) runs :func:`matcad.acoustics.predict.predict` per
+- Any other model (elastic_wall, soft_wall, relative, fem) runs :func:`matcad.prediction.predict` per
   variant on the executor; df0/dfield is then the slope of f0 along that axis of the grid (``numpy.gradient``:
   central differences inside, one-sided at the ends and next to a failed variant; blank for an axis of one value).
 - df0/dF (Hz/N) is paper Eq. 5's slope at 0 N, f(0)·b/(2·V0) (:meth:`matcad.acoustics.eq5.Eq5.slope_hz_per_n`), from

@@ -1,7 +1,7 @@
 """report.md and report.html: one Markdown text rendered from the report data, and that same text as a page.
 
-The Markdown (:func:`matcad.report._markdown` plus the pictures and any report section this module does not
-know, rendered generically) is the single source; the HTML is the Markdown through markdown-it (CommonMark +
+The Markdown (:func:`matcad.report.markdown.sections` plus the pictures and any report section this module does
+not know, rendered generically) is the single source; the HTML is the Markdown through markdown-it (CommonMark +
 tables) in a self-contained page — inline style, images as relative files beside it, no script, no network —
 so the two cannot drift.
 """
@@ -10,13 +10,12 @@ from __future__ import annotations
 
 import html
 
+from matcad.report.markdown import cell, part_anchor, sections
+
 KNOWN_KEYS = frozenset({"matcad_version", "name", "spec", "as_built", "prediction", "findings", "verdict", "bom",
                         "meshes", "files", "figures", "casting", "fabrication", "bands", "taxels"})
-"""Report keys rendered by :func:`matcad.report._markdown` or as pictures; every other key is rendered
+"""Report keys rendered by :func:`matcad.report.markdown.sections` or as pictures; every other key is rendered
 generically (a list as a numbered list, a list of tables as a table, a table as key: value lines)."""
-RULE_PARTS = {"needle.": "needle_mount", "fit.dowel_printed": "needle_mount", "mold.": "end_cap_mold_base",
-              "print.": "end_cap_mold_base", "cap.": "end_cap", "silicone.": "end_cap", "acoustic.": "prediction"}
-"""Rule id prefix → the part (picture) it concerns, for findings whose message does not start with a part."""
 STYLE = """
 body { font-family: system-ui, sans-serif; max-width: 68rem; margin: 2rem auto; padding: 0 1rem; color: #1a1a1a;
        line-height: 1.45; }
@@ -29,23 +28,6 @@ code { font-size: 0.85rem; }
 h2 { border-bottom: 1px solid #ddd; margin-top: 2rem; }
 :target + h3 { background: #fff3c4; }
 """
-
-
-def part_anchor(part: str) -> str:
-    """HTML id of a part's picture."""
-    return f"part-{part}"
-
-
-def finding_part(finding: dict, r: dict) -> str | None:
-    """The pictured part a finding concerns: the part its message starts with, else by its rule id."""
-    pictured = {f["part"] for f in r.get("figures", ())}
-    head = finding["message"].split(":", 1)[0].strip()
-    if head in pictured:
-        return head
-    for prefix, part in RULE_PARTS.items():
-        if finding["id"].startswith(prefix) and part in pictured:
-            return part
-    return None
 
 
 def _pictures(r: dict) -> list[str]:
@@ -64,26 +46,24 @@ def _title(key: str) -> str:
 
 def _generic(key: str, value) -> list[str]:
     """A report section this module does not know, as Markdown."""
-    from matcad.report import _cell
-
     lines = [f"## {_title(key)}", ""]
     if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
         cols = list(dict.fromkeys(k for v in value for k in v))
         lines += ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-        lines += ["| " + " | ".join(_cell(v.get(c, "")) for c in cols) + " |" for v in value]
+        lines += ["| " + " | ".join(cell(v.get(c, "")) for c in cols) + " |" for v in value]
     elif isinstance(value, list):
-        lines += [f"{i}. {_cell(v)}" for i, v in enumerate(value, 1)]
+        lines += [f"{i}. {cell(v)}" for i, v in enumerate(value, 1)]
     elif isinstance(value, dict):
-        lines += [f"- {_title(k)}: {_cell(v)}" for k, v in value.items()]
+        lines += [f"- {_title(k)}: {cell(v)}" for k, v in value.items()]
     else:
-        lines.append(_cell(value))
+        lines.append(cell(value))
     return lines + [""]
 
 
-def render_markdown(r: dict, body: str) -> str:
-    """The report as Markdown: ``body`` (the known sections) with the pictures after its title block and every
-    unknown report key appended as its own section."""
-    head, sep, rest = body.partition("\n## ")
+def render_markdown(r: dict) -> str:
+    """The report ``r`` as Markdown: its known sections (:func:`matcad.report.markdown.sections`) with the
+    pictures after their title block and every unknown report key appended as its own section."""
+    head, sep, rest = sections(r).partition("\n## ")
     lines = [head.rstrip("\n"), ""] + _pictures(r)
     text = "\n".join(lines) + (sep.lstrip("\n") + rest if sep else "")
     extra = [line for key, value in r.items() if key not in KNOWN_KEYS for line in _generic(key, value)]

@@ -1,7 +1,8 @@
 """What to measure, make and assemble, in order: the fabrication plan the report renders (pure data, mm).
 
 Sheets first (they decide the flange the mold casts), then cutting, printing, casting, assembly. Every step
-names its sheet or file, so report.md/report.html read as a checklist.
+names its sheet or file, so report.md/report.html read as a checklist. Read from the laser parts the build cut
+(``flats``), not made again.
 """
 
 from __future__ import annotations
@@ -9,10 +10,11 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
-from matcad.parts.catalogue import laser_parts
 from matcad.parts.registry import Kind, wanted
+from matcad.parts.stack import squeeze_range_mm
 
 if TYPE_CHECKING:
+    from matcad.parts.flat import Flat
     from matcad.spec import Spec
 
 WHY_CALIPER = {
@@ -23,10 +25,11 @@ WHY_CALIPER = {
 }
 
 
-def sheets_to_caliper(spec: Spec) -> list[dict]:
-    """Each laser sheet once: thickness, tolerance (mm), whether it is marked measured, and why it matters."""
+def sheets_to_caliper(flats: list[Flat]) -> list[dict]:
+    """Each sheet of the laser parts ``flats`` once: thickness, tolerance (mm), whether it is marked measured, and
+    why it matters."""
     rows, seen = [], set()
-    for flat in laser_parts(spec):
+    for flat in flats:
         if flat.thickness in seen:  # parts listed plate, guides, spacer: a shared sheet keeps its first use
             continue
         seen.add(flat.thickness)
@@ -38,20 +41,18 @@ def sheets_to_caliper(spec: Spec) -> list[dict]:
 
 def seal(spec: Spec) -> dict:
     """Flange squeeze over the guide sheet's tolerance (mm), as the rule ``seal.squeeze`` judges it."""
-    from matcad.rules.stack import squeeze_range_mm
-
     lo, hi, tol = squeeze_range_mm(spec)
     return {"flange_squeeze_mm": spec.end_cap.flange_squeeze, "guide_sheet_mm": spec.guide.thickness,
             "guide_measured": spec.guide.thickness_measured, "sheet_tolerance_mm": tol,
             "squeeze_low_mm": lo, "squeeze_high_mm": hi}
 
 
-def fits(spec: Spec) -> list[dict]:
+def fits(spec: Spec, flats: list[Flat]) -> list[dict]:
     """The fits the kit relies on, as designed (mm): hole, what goes in it, and the clearance claimed (diametral;
-    negative = interference). Each names the files a check reads it back from."""
+    negative = interference), the locator's hole read from the laser parts ``flats``. Each names the files a check
+    reads it back from."""
     from matcad.parts.features import (SELF_TAP_PILOT_MM, bolt_nominal_mm, cap_flange_diameter_mm,
                                        pin_hole_diameter_mm)
-    from matcad.parts.guide import guide
 
     rows = []
     if spec.outputs.end_cap_mold:
@@ -60,7 +61,8 @@ def fits(spec: Spec) -> list[dict]:
                      "hole_mm": k + 2 * spec.machine.key_clearance, "pin_mm": k, "clearance_mm": 2 * spec.machine.key_clearance,
                      "files": ["end_cap_mold_lid.stl", "end_cap_mold_base.stl"]})
     if spec.outputs.guides:
-        hole = next(h for h in guide(spec, "locator").holes if h.purpose == "cap").diameter
+        locator = next(flat for flat in flats if flat.name == "guide_locator")
+        hole = next(h for h in locator.holes if h.purpose == "cap").diameter
         rows.append({"id": "flange", "fit": "cap flange in locator guide (line-to-line: the silicone centres "
                      "itself)", "hole_mm": hole, "pin_mm": cap_flange_diameter_mm(spec),
                      "clearance_mm": hole - cap_flange_diameter_mm(spec), "files": ["guide_locator.dxf", "end_cap.stl"]})
@@ -75,8 +77,9 @@ def fits(spec: Spec) -> list[dict]:
     return rows
 
 
-def steps(spec: Spec) -> list[dict]:
-    """The kit made and assembled in order: each step with what to do, on which sheet or machine, which files."""
+def steps(spec: Spec, caliper: list[dict]) -> list[dict]:
+    """The kit made and assembled in order: each step with what to do, on which sheet or machine, which files;
+    ``caliper`` is :func:`sheets_to_caliper` of the laser parts."""
     from matcad.parts.features import SHEETS, sheet_kerf_mm, sheet_thickness_mm
 
     o, out = spec.outputs, []
@@ -84,7 +87,7 @@ def steps(spec: Spec) -> list[dict]:
     def step(where: str, files: list[str], do: str) -> None:
         out.append({"where": where, "files": files, "do": do})
 
-    unmeasured = [c for c in sheets_to_caliper(spec) if not c["measured"]]
+    unmeasured = [c for c in caliper if not c["measured"]]
     step("calipers", [], "Caliper every sheet (table above) in several places; enter the values (neck.length, "
          "guide.thickness, spacer.height), set *_measured = true and rebuild"
          + (f" — still nominal: {', '.join(str(c['sheet_mm']) + ' mm' for c in unmeasured)}" if unmeasured else ""))
@@ -122,6 +125,8 @@ def steps(spec: Spec) -> list[dict]:
     return out
 
 
-def fabrication(spec: Spec) -> dict:
-    """The report's fabrication section: sheets to caliper, the seal, the fits, the ordered steps."""
-    return {"caliper": sheets_to_caliper(spec), "seal": seal(spec), "fits": fits(spec), "steps": steps(spec)}
+def fabrication(spec: Spec, flats: list[Flat]) -> dict:
+    """The report's fabrication section for the laser parts ``flats``: sheets to caliper, the seal, the fits, the
+    ordered steps."""
+    caliper = sheets_to_caliper(flats)
+    return {"caliper": caliper, "seal": seal(spec), "fits": fits(spec, flats), "steps": steps(spec, caliper)}

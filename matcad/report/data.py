@@ -1,0 +1,170 @@
+"""The report's data (report.json): resolved spec, as-built geometry, prediction, findings, BOM, casting,
+fabrication plan, file manifest. Lengths in mm, volumes in mm³, masses in g.
+
+Built from what the build already made — the laser parts it cut, the mold's layout — rather than making them
+again.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from matcad import __version__
+from matcad.acoustics.geometry import drafted_cavity_volume_mm3, drafted_tip_diameter_mm
+from matcad.parts.features import (sheet_kerf_mm, bolt_nominal_mm, cap_volume_mm3, plate_bolt_positions_mm,
+                                   plate_dowel_positions_mm)
+from matcad.parts.stack import bolt_span_mm
+from matcad.report.fabrication import fabrication
+from matcad.report.files import manifest
+from matcad.spec import to_dict
+
+if TYPE_CHECKING:
+    from matcad.parts.flat import Flat
+    from matcad.parts.mold_layout import MoldLayout
+
+HUB_CLEARANCE_MM = 3.0
+"""Needle left below the mount's underside so the hub clears it."""
+NUT_HEIGHT_PER_D = 0.8
+"""ISO 4032 hex nut height ≈ 0.8 d."""
+THREAD_ENGAGEMENT_PER_D = 2.0
+"""Self-tapping screws into printed plastic want ~2 x diameter of engagement."""
+
+
+def as_built(spec) -> dict:
+    """Geometry as it will be made: drafted cavity, neck as cut and as finished (mm, mm³)."""
+    cav = spec.cavity
+    pilot = spec.plate.neck_pilot
+    return {
+        "cavity_diameter_mm": cav.diameter, "cavity_length_mm": cav.length, "draft_deg": spec.mold.draft_deg,
+        "cavity_tip_diameter_mm": float(drafted_tip_diameter_mm(cav.diameter, cav.length, spec.mold.draft_deg)),
+        "cavity_volume_mm3": float(drafted_cavity_volume_mm3(cav.diameter, cav.length, spec.mold.draft_deg)),
+        "draft_volume_change_pct": 100 * float(drafted_cavity_volume_mm3(cav.diameter, cav.length, spec.mold.draft_deg)
+                                               / drafted_cavity_volume_mm3(cav.diameter, cav.length, 0.0) - 1),
+        "neck_diameter_as_cut_mm": spec.neck.diameter - spec.plate.pilot_undersize if pilot else spec.neck.diameter,
+        "neck_diameter_finished_mm": spec.neck.diameter,
+        "neck_finish": "drill pilot to size" if pilot else "as cut (kerf compensated)",
+        "neck_length_mm": spec.neck.length, "neck_length_measured": spec.plate.thickness_measured,
+        "laser_kerf_mm": sheet_kerf_mm(spec, "plate"),
+        "cap_volume_mm3": cap_volume_mm3(spec),
+    }
+
+
+def bill_of_materials(spec, flats: list[Flat], mold: MoldLayout | None) -> dict:
+    """Sheets, silicone, pins, bolts and needle needed for one taxel (plus the mold's batch); ``flats`` are the
+    laser parts the build cut, ``mold`` the mold's layout when it builds one (else None)."""
+    sheets = defaultdict(lambda: {"parts": [], "area_mm2": 0.0, "measured": False})
+    for flat in flats:
+        s = sheets[flat.thickness]
+        s["parts"].append(f"{flat.quantity} x {flat.name}")
+        s["area_mm2"] += flat.area_mm2 * flat.quantity
+        s["measured"] = s["measured"] or flat.thickness_measured
+    from matcad.parts.casting import MIN_BATCH_G
+
+    cap = cap_volume_mm3(spec)
+    needed_g = cap * spec.mold.count * spec.silicone.waste_factor / 1000 * spec.silicone.density_g_cm3
+    batch_g = max(needed_g, MIN_BATCH_G)
+    stack = bolt_span_mm(spec)
+    bolt_d = bolt_nominal_mm(spec.fasteners.bolt)
+    engage = min(THREAD_ENGAGEMENT_PER_D * bolt_d, spec.mount.thickness)
+    return {
+        "sheets": [{"thickness_mm": t, **v} for t, v in sorted(sheets.items())],
+        "silicone": {"cap_volume_mm3": cap, "cap_mass_g": cap / 1000 * spec.silicone.density_g_cm3,
+                     "caps_per_pour": spec.mold.count, "needed_mass_g": needed_g, "batch_mass_g": batch_g,
+                     "batch_ml": batch_g / spec.silicone.density_g_cm3,
+                     "density_g_cm3": spec.silicone.density_g_cm3},
+        "dowels": {"count": len(plate_dowel_positions_mm(spec)), "diameter_mm": spec.fasteners.dowel_diameter,
+                   "min_length_mm": stack + engage},
+        "bolts": {"count": len(plate_bolt_positions_mm(spec)), "size": spec.fasteners.bolt,
+                  "min_length_mm": stack + engage, "note": "self-tapping into the printed mount"},
+        "spacers": ({"count": len(plate_bolt_positions_mm(spec)), "style": "laser",
+                     "note": f"{spec.spacer.size:g} mm squares cut from {spec.spacer.height:g} mm sheet"}
+                    if spec.spacer.style == "laser" else
+                    {"count": len(plate_bolt_positions_mm(spec)), "style": "standoff",
+                     "note": f"printed on the needle mount, {spec.spacer.height:g} mm tall"}),
+        "needle": needle_bom(spec),
+        **kit_hardware(spec, mold),
+    }
+
+
+def casting(spec, mold: MoldLayout | None) -> dict | None:
+    """The pour guide and the venting of the mold laid out as ``mold`` (mm, g, min, h, °C); None without a mold."""
+    if mold is None:
+        return None
+    from matcad.parts.casting import casting_guide
+
+    plan = mold.plan
+    out = casting_guide(spec).to_dict() | {"venting": {
+        "vent_reach_mm": spec.mold.vent_reach, "base_face_reach_mm": plan.reach_base_mm,
+        "pin_end_reach_mm": plan.reach_tip_mm, "base_face_vents_per_cap": len(plan.inner) + len(plan.outer),
+        "pin_vents_per_cap": 1, "vent_diameter_mm": spec.mold.vent}}
+    from matcad.spec import is_array, taxels
+
+    if is_array(spec):  # which caps each mold holds, and how many pours (or molds) one board takes
+        from matcad.parts.mold_layout import pours_per_board
+
+        out["molds"] = pours_per_board(taxels(spec), spec.mold.count)
+    return out
+
+
+def needle_bom(spec) -> dict:
+    """The needle to buy and how deep it goes (mm); a board needs one per taxel, each on its own air line (the
+    mount offers no manifold), and its per-taxel needle rows sit in report.json's ``taxels``."""
+    from matcad.parts.features import nearest_needle_gauge, needle_protrusion_mm, needle_tip_mm
+    from matcad.spec import taxels
+
+    gauge, od = nearest_needle_gauge(spec.needle.outer_diameter)
+    sin_t = math.sin(math.radians(spec.needle.theta_deg))
+    through = (needle_tip_mm(spec)[2] + spec.spacer.height + spec.mount.thickness) / sin_t
+    count = len(taxels(spec))
+    board = (f" A board takes {count} needles, one bore per taxel; the mount has no manifold: feed each needle "
+             "from its own regulated air line (or a splitter with a valve per line) so every jet can be set "
+             "alone" if count > 1 else "")
+    return {"count": count, "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
+            "y_mm": spec.needle.y, "gauge": gauge, "gauge_od_mm": od, "hub": "Luer-lock hub, blunt (dispensing) tip",
+            "min_length_mm": through + HUB_CLEARANCE_MM, "protrusion_mm": needle_protrusion_mm(spec),
+            "note": f"nearest standard: {gauge} G ({od:.3f} mm, ISO 9626); measure yours and enter "
+                    "needle.outer_diameter. Push it up the bore until its tip stands the stated protrusion out of "
+                    "the mount's top face (along the needle; a caliper depth rod), then fix the hub" + board}
+
+
+def kit_hardware(spec, mold: MoldLayout | None) -> dict:
+    """Mold clamp bolts and nuts (for the mold laid out as ``mold``, when there is one), release agent, mount
+    fixing screws (mm)."""
+    from matcad.parts.casting import RELEASE_AGENT
+    from matcad.parts.features import EAR_THICKNESS_MM, FIXING_BOLT, ear_holes_mm
+
+    out = {}
+    if mold is not None:
+        d = bolt_nominal_mm(spec.mold.bolt)
+        out["mold_clamp"] = {"count": len(mold.bolts), "size": spec.mold.bolt,
+                             "min_length_mm": mold.base_height + spec.mold.lid_thickness + NUT_HEIGHT_PER_D * d + 1.0,
+                             "nuts": len(mold.bolts), "washers": 2 * len(mold.bolts)}
+        out["release_agent"] = RELEASE_AGENT
+    if spec.outputs.needle_mount:
+        out["mount_fixing"] = {"count": len(ear_holes_mm(spec)), "size": FIXING_BOLT,
+                               "note": f"through the mount's ears ({EAR_THICKNESS_MM:g} mm) into a bench bracket or "
+                                       "robot plate, on standoffs taller than the needle's hub"}
+    return out
+
+
+def make_report(spec, prediction, findings, holes, meshes, folder: Path, *, flats: list[Flat],
+                mold: MoldLayout | None) -> dict:
+    """The report's data for ``spec`` built into ``folder``: ``holes`` as cut and ``meshes`` (STL read-back
+    checks) from the writers, ``flats`` the laser parts cut, ``mold`` the mold's layout (None without a mold)."""
+    return {
+        "matcad_version": __version__,
+        "name": spec.name,
+        "spec": to_dict(spec),
+        "as_built": as_built(spec) | {"laser_holes": holes},
+        "prediction": prediction.to_dict(),
+        "findings": [f.to_dict() for f in findings],
+        "verdict": "fail" if any(f.level == "error" for f in findings) else "pass",
+        "bom": bill_of_materials(spec, flats, mold),
+        "casting": casting(spec, mold),
+        "fabrication": fabrication(spec, flats),
+        "meshes": meshes,
+        "files": manifest(folder),
+    }

@@ -1,0 +1,173 @@
+"""The report's known sections as Markdown (one text: report.md, and report.html through it), and the helpers the
+page shares: table-cell escaping and the link from a finding to the picture of the part it concerns."""
+
+from __future__ import annotations
+
+RULE_PARTS = {"needle.": "needle_mount", "fit.dowel_printed": "needle_mount", "mold.": "end_cap_mold_base",
+              "print.": "end_cap_mold_base", "cap.": "end_cap", "silicone.": "end_cap", "acoustic.": "prediction"}
+"""Rule id prefix → the part (picture) it concerns, for findings whose message does not start with a part."""
+
+
+def cell(text) -> str:
+    """Free text made safe for a Markdown table cell."""
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def part_anchor(part: str) -> str:
+    """HTML id of a part's picture."""
+    return f"part-{part}"
+
+
+def finding_part(finding: dict, r: dict) -> str | None:
+    """The pictured part a finding concerns: the part its message starts with, else by its rule id."""
+    pictured = {f["part"] for f in r.get("figures", ())}
+    head = finding["message"].split(":", 1)[0].strip()
+    if head in pictured:
+        return head
+    for prefix, part in RULE_PARTS.items():
+        if finding["id"].startswith(prefix) and part in pictured:
+            return part
+    return None
+
+
+def _part_link(finding: dict, r: dict) -> str:
+    """The part a finding concerns, linked to its preview in the report ('–' when it names none)."""
+    part = finding_part(finding, r)
+    return f"[{part}](#{part_anchor(part)})" if part else "–"
+
+
+def _fabrication_markdown(f: dict | None) -> list[str]:
+    if not f:
+        return []
+    s = f["seal"]
+    lines = ["", "## Fabrication", "", "Caliper these sheets before cutting — the guide sheet before printing the mold:",
+             "", "| sheet [mm] | first part | tolerance [mm] | measured | why |", "|---:|---|---:|---|---|"]
+    lines += [f"| {c['sheet_mm']:g} | {c['part']} | ±{c['tolerance_mm']:.2f} | {'yes' if c['measured'] else '**no**'} | "
+              f"{cell(c['why'])} |" for c in f["caliper"]]
+    lines += ["", f"Seal: the flange is cast {s['guide_sheet_mm']:g} + {s['flange_squeeze_mm']:g} mm thick; over the "
+              f"guide sheet's ±{s['sheet_tolerance_mm']:.2f} mm the clamp squeezes it {s['squeeze_low_mm']:+.2f} … "
+              f"{s['squeeze_high_mm']:+.2f} mm ({'measured' if s['guide_measured'] else 'nominal'} sheet)."]
+    lines += ["", "Steps, in order:", ""]
+    lines += [f"{i}. **{cell(s['where'])}** — {cell(s['do'])}" + (f" (`{'`, `'.join(s['files'])}`)" if s["files"] else "")
+              for i, s in enumerate(f["steps"], 1)]
+    if f["fits"]:
+        lines += ["", "| fit | hole [mm] | part in it [mm] | clearance [mm] |", "|---|---:|---:|---:|"]
+        lines += [f"| {cell(x['fit'])} | {x['hole_mm']:.3f} | {x['pin_mm']:.3f} | {x['clearance_mm']:+.3f} |"
+                  for x in f["fits"]]
+    return lines
+
+
+def _casting_markdown(c: dict | None) -> list[str]:
+    if not c:
+        return []
+    v = c["venting"]
+    lines = ["", "## Casting guide", "",
+             f"{c['caps']} cap(s) of {c['grade']} in a {c['mold_material']} mold: mix **{c['batch_g']:.1f} g** "
+             f"({c['mix_ratio']}) — {c['batch_reason']}. Pot life {c['pot_life_min']:g} min; cure "
+             f"{c['cure_h_room']:g} h at 23 °C or warm at most {c['max_cure_c']:g} °C.", "",
+             f"Venting: every ceiling of each cavity in pour orientation reaches an opening within "
+             f"{v['vent_reach_mm']:g} mm — base face {v['base_face_reach_mm']:.2f} mm ({v['base_face_vents_per_cap']} "
+             f"vents + the fill port), core-pin end over the membrane {v['pin_end_reach_mm']:.2f} mm (a vent along "
+             "the pin).", ""]
+    if c["inhibition"]:
+        lines += [f"**SLA cure inhibition:** {c['inhibition']}.", ""]
+    lines += [f"{i}. {step}" for i, step in enumerate(c["steps"], 1)]
+    lines += ["", "Trim:", ""] + [f"- {t}" for t in c["trim"]]
+    return lines
+
+
+def _taxels_markdown(board: list[dict] | None) -> list[str]:
+    """A board's taxels: position, geometry, needle and unloaded prediction, one row each (mm, deg, Hz)."""
+    if not board:
+        return []
+    lines = ["", "## Taxels", "",
+             "| taxel | x, y [mm] | cavity D × L [mm] | neck d [mm] | cap outer / top [mm] | needle θ, y | "
+             "f0 [Hz] (model) | band [Hz] |", "|---|---|---|---:|---|---|---|---|"]
+    for t in board:
+        c, n, e, nd, p = t["cavity"], t["neck"], t["end_cap"], t["needle"], t["prediction"]
+        lines.append(f"| {t['name']} | {t['x_mm']:g}, {t['y_mm']:g} | {c['diameter']:g} × {c['length']:g} | "
+                     f"{n['diameter']:g} | {e['outer_diameter']:g} / {e['top_thickness']:g} | "
+                     f"{nd['theta_deg']:g}°, {nd['y']:g} mm | {p['f0_hz']:.0f} ({p['model']}) | "
+                     f"{p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} |")
+    return lines
+
+
+def sections(r: dict) -> str:
+    """The report's known sections (:data:`matcad.report.page.KNOWN_KEYS`) as Markdown: title and verdict, as
+    built, prediction, bands, design rules, BOM, fabrication, casting, taxels, files, mesh checks."""
+    from matcad.render.bands import bands_markdown
+
+    p, ab, bom = r["prediction"], r["as_built"], r["bom"]
+    board = r.get("taxels")
+    if board:  # the top-level prediction and as-built numbers are the first taxel's: say so
+        headline = f"{len(board)} taxels: " + ", ".join(
+            f"{t['name']} {t['f0_hz']:.0f} Hz ({t['unloaded_hz'][0]:.0f}–{t['unloaded_hz'][1]:.0f})"
+            for t in r["bands"]["taxels"])
+        scope = f" of taxel {board[0]['name']} (every taxel: Taxel bands, Taxels)"
+    else:
+        headline = f"f0 = {p['f0_hz']:.0f} Hz ({p['model']}), band {p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz"
+        scope = ""
+    lines = [f"# {r['name']} — matcad {r['matcad_version']} build report", "",
+             f"**Verdict: {r['verdict']}** · {headline}", "",
+             f"## As built{scope}", "",
+             f"- cavity: D {ab['cavity_diameter_mm']:g} × L {ab['cavity_length_mm']:g} mm, draft "
+             f"{ab['draft_deg']:g}° (closed-end D {ab['cavity_tip_diameter_mm']:.3f} mm), volume "
+             f"{ab['cavity_volume_mm3']:.3f} mm³",
+             f"- neck: {ab['neck_diameter_finished_mm']:g} mm finished ({ab['neck_finish']}; cut at "
+             f"{ab['neck_diameter_as_cut_mm']:g} mm, kerf {ab['laser_kerf_mm']:g} mm), length "
+             f"{ab['neck_length_mm']:g} mm ({'measured' if ab['neck_length_measured'] else 'nominal'})",
+             f"- neck area {p['neck_area_mm2']:.4f} mm², A·l/V {p['neck_air_ratio']:.3f}, c "
+             f"{p['speed_of_sound_m_s']:.2f} m/s", "",
+             f"## Prediction{scope}", "", "| model | f0 [Hz] | valid | failed checks |", "|---|---:|---|---|"]
+    for name, m in p["models"].items():
+        failed = ", ".join(k for k, ok in m["checks"].items() if not ok) or "–"
+        lines.append(f"| {name}{' (chosen)' if name == p['model'] else ''} | {m['f0_hz']:.1f} | "
+                     f"{'yes' if m['valid'] else 'no'} | {failed} |")
+    lines += ["", f"Band {p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz, root-sum-square in ln f of:", "",
+              "| source | tolerance | low [Hz] | high [Hz] |", "|---|---|---:|---:|"]
+    lines += [f"| {b['source']} | {cell(b['tolerance'])} | {b['low_hz']:+.1f} | {b['high_hz']:+.1f} |"
+              for b in p["budget"]]
+    if p["warnings"]:  # what the physics says and where a model does not hold (e.g. the paper's measured 4.0 kHz)
+        lines += ["", "Prediction notes:", ""] + [f"- {w}" for w in p["warnings"]]
+    lines += bands_markdown(r.get("bands"))
+    lines += ["", "## Design rules", "", "| level | rule | part | message | fix |", "|---|---|---|---|---|"]
+    lines += [f"| {f['level']} | {f['id']} | {_part_link(f, r)} | {cell(f['message'])} | {cell(f['fix'])} |"
+              for f in r["findings"]]
+    s = bom["silicone"]
+    lines += ["", "## Bill of materials", ""]
+    lines += [f"- acrylic {sh['thickness_mm']:g} mm{' (measured)' if sh['measured'] else ''}: "
+              f"{', '.join(sh['parts'])} — {sh['area_mm2'] / 100:.1f} cm²" for sh in bom["sheets"]]
+    lines += [f"- silicone: {s['cap_volume_mm3']:.1f} mm³ ({s['cap_mass_g']:.2f} g) per cap; mix "
+              f"{s['batch_mass_g']:.1f} g ({s['batch_ml']:.1f} ml) for {s['caps_per_pour']} cap(s), of which "
+              f"{s['needed_mass_g']:.2f} g fills caps, sprues and cup",
+              f"- {bom['dowels']['count']} dowel pins Ø{bom['dowels']['diameter_mm']:g} mm, ≥ "
+              f"{bom['dowels']['min_length_mm']:.1f} mm long",
+              f"- {bom['spacers']['count']} spacers: {bom['spacers']['note']}",
+              f"- {bom['bolts']['count']} × {bom['bolts']['size']} bolts, ≥ {bom['bolts']['min_length_mm']:.1f} mm "
+              f"({bom['bolts']['note']})",
+              f"- needle Ø{bom['needle']['outer_diameter_mm']:g} mm ({bom['needle']['gauge']} G), "
+              f"{bom['needle']['hub']}, ≥ {bom['needle']['min_length_mm']:.1f} mm long, at θ = "
+              f"{bom['needle']['theta_deg']:g}°, y = {bom['needle']['y_mm']:g} mm; tip "
+              f"{bom['needle']['protrusion_mm']:.2f} mm out of the mount's top face ({bom['needle']['note']})"]
+    if "mold_clamp" in bom:
+        c = bom["mold_clamp"]
+        lines += [f"- mold clamp: {c['count']} × {c['size']} bolts ≥ {c['min_length_mm']:.0f} mm, {c['nuts']} nuts, "
+                  f"{c['washers']} washers", f"- release agent: {bom['release_agent']}"]
+    if "mount_fixing" in bom:
+        f = bom["mount_fixing"]
+        lines.append(f"- mount fixing: {f['count']} × {f['size']} screws {f['note']}")
+    lines += _fabrication_markdown(r.get("fabrication"))
+    lines += _casting_markdown(r.get("casting"))
+    lines += _taxels_markdown(board)
+    lines += ["", "## Files", "", "| file | bytes | sha256 |", "|---|---:|---|"]
+    lines += [f"| {f['file']} | {f['bytes']} | `{f['sha256'][:16]}…` |" for f in r["files"]]
+    if r["meshes"]:
+        lines += ["", "## Mesh checks (STL read back)", "",
+                  "| file | watertight | is_volume | bodies | STL vs B-rep volume | print orientation (on the bed) |",
+                  "|---|---|---|---:|---:|---|"]
+        for name, m in r["meshes"].items():
+            dev = m["volume_mm3"] / m["brep_volume_mm3"] - 1
+            turn = f"turned {m['rotation_x_deg']:g}° about x; " if m["rotation_x_deg"] else "as modelled; "
+            lines.append(f"| {name} | {m['watertight']} | {m['is_volume']} | {m['bodies']} | {dev:+.4%} | "
+                         f"{cell(turn + m['bed_face'])} |")
+    return "\n".join(lines) + "\n"

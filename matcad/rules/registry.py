@@ -1,0 +1,16 @@
+"""The design-rule modules :func:`matcad.rules.check` runs, in the order their findings are listed within a level.
+
+Adding a rule is one function in a module's ``RULES`` tuple; adding a rule module is that module and one entry
+here (docs/extending.md). A module of :data:`SPEC_MODULES` may also name, in ``TAXEL_RULES``, those of its
+``RULES`` that read one taxel's own geometry: a board runs them on each taxel instead of on the whole spec.
+"""
+
+from __future__ import annotations
+
+from matcad.rules import acoustic, bands, board, laser, printing, stack
+
+SPEC_MODULES = (laser, printing, stack, bands, board)
+"""Modules whose ``RULES`` are functions of the spec: ``rule(spec) -> list[Finding]``."""
+PREDICTION_MODULES = (acoustic,)
+"""Modules whose ``RULES`` judge one taxel's predicted sound: ``rule(taxel_spec, prediction) -> list[Finding]``,
+run on every taxel with its own prediction."""
