@@ -12,10 +12,11 @@ import ezdxf
 import pytest
 
 from matcad import spec as spec_mod
-from matcad.parts.features import cap_flange_diameter_mm, needle_axis_mm, pin_hole_diameter_mm
+from matcad.parts.features import needle_axis_mm, pin_hole_diameter_mm
 from matcad.parts.guide import BODY_CLEARANCE_MM
 from matcad.parts.mold_layout import layout, mold_slots, pours_per_board
 from matcad.rules import board as board_rules
+from matcad.spec import cap_flange_diameter_mm
 from matcad.spec import taxels
 from tests.conftest import ROOT
 

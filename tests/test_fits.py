@@ -10,7 +10,8 @@ import trimesh
 
 from matcad import spec as spec_mod
 from matcad.build import build
-from matcad.parts.features import cap_flange_thickness_mm, plate_bolt_positions_mm
+from matcad.parts.features import plate_bolt_positions_mm
+from matcad.spec import cap_flange_thickness_mm
 from tests.conftest import SINGLE_TEMPLATES
 from tests.readback import nearest_circle, section_circles
 

@@ -8,7 +8,7 @@ from build123d import GeomType
 
 from matcad import spec as spec_mod
 from matcad.parts.end_cap_mold import layout, mold_base
-from matcad.parts.features import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
+from matcad.spec import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
 from matcad.spec import taxel_spec
 from tests.conftest import TEMPLATES
 

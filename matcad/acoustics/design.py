@@ -101,6 +101,8 @@ def design(spec, taxel=None) -> Design:
     """The :class:`Design` of ``spec``'s taxel ``taxel`` (a :class:`matcad.spec.board.Taxel`; default: the spec's
     own tables, i.e. a single-taxel spec). The mouth's gap is the spacer height and its vent radius half the plate's
     smaller side; the cap is clamped over the flange's thickness (guide sheet + squeeze)."""
+    from matcad.spec import cap_flange_thickness_mm
+
     cavity, neck, cap = (spec.cavity, spec.neck, spec.end_cap) if taxel is None else \
         (taxel.cavity, taxel.neck, taxel.end_cap)
     wall = spec.wall
@@ -108,7 +110,7 @@ def design(spec, taxel=None) -> Design:
         cavity_diameter=cavity.diameter, cavity_length=cavity.length, draft_deg=spec.mold.draft_deg,
         neck_diameter=neck.diameter, neck_length=neck.length, mouth=neck.mouth, gap_mm=spec.spacer.height,
         gap_radius_mm=float(gap_radius_mm(spec.plate.width, spec.plate.depth)), cap_outer_diameter=cap.outer_diameter,
-        cap_top_thickness=cap.top_thickness, cap_clamp_height=spec.guide.thickness + cap.flange_squeeze,
+        cap_top_thickness=cap.top_thickness, cap_clamp_height=cap_flange_thickness_mm(spec),
         air=Air(spec.air.temperature_c, spec.air.speed_of_sound),
         wall=WallMaterial(wall.model, wall.shear_modulus_mpa, wall.khz_modulus_factor, wall.loss_factor,
                           spec.silicone.density_g_cm3 * 1000.0),

@@ -105,7 +105,7 @@ def board_base(base, n: int):
     the laser's smallest web (the varied fields leave the cap's footprint alone: its outside is resolved), and the
     plate grows by the grid's extent — before solving, because the mount mouth's end correction depends on the
     plate (mm)."""
-    from matcad.parts.features import cap_flange_diameter_mm
+    from matcad.spec import cap_flange_diameter_mm
 
     points = grid(n, cap_flange_diameter_mm(base) + base.machine.laser_min_feature)
     xs, ys = [p[0] for p in points], [p[1] for p in points]

@@ -37,7 +37,7 @@ def section_from_spec(spec) -> CapSection:
     """The cap of ``spec`` (mm): the dimension functions :mod:`matcad.parts.end_cap` builds the solid from (the
     drafted tip through :func:`matcad.acoustics.geometry.drafted_tip_diameter_mm`, without the CAD kernel)."""
     from matcad.acoustics.geometry import drafted_tip_diameter_mm
-    from matcad.parts.features import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
+    from matcad.spec import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
 
     tip = float(drafted_tip_diameter_mm(spec.cavity.diameter, spec.cavity.length, spec.mold.draft_deg)) / 2
     return CapSection(cavity_radius=spec.cavity.diameter / 2, cavity_tip_radius=tip,

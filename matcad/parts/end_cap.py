@@ -5,8 +5,8 @@ Own frame: base on z = 0 (it sits on the neck plate), axis along +z, cavity open
 
 import math
 
-from matcad.parts.features import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
 from matcad.parts.registry import Kind, Part, PrintPose
+from matcad.spec import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
 
 
 def cavity_tip_radius_mm(spec) -> float:
@@ -40,7 +40,6 @@ def board_caps(spec):
     spacing; a single taxel's cap at the origin (mm). The reference shape of what the mold casts."""
     from build123d import Compound, Pos
 
-    from matcad.parts.features import cap_flange_diameter_mm
     from matcad.parts.mold_layout import cap_x_mm, cap_groups
     from matcad.spec import taxel_spec, taxels
 

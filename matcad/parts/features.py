@@ -105,14 +105,6 @@ def plate_dowel_positions_mm(spec) -> list[tuple[float, float]]:
     return [(spec.plate.width * 0.1, y), (-spec.plate.width * 0.1, -y)]
 
 
-def cap_flange_diameter_mm(spec) -> float:
-    """Diameter of the end cap's base flange, which the locator guide surrounds (mm); ``spec`` may be a Taxel."""
-    return spec.end_cap.outer_diameter + 2 * spec.end_cap.flange_width
-
-
-def cap_flange_thickness_mm(spec) -> float:
-    """Flange thickness: the guide thickness plus the clamp squeeze (mm)."""
-    return spec.guide.thickness + spec.end_cap.flange_squeeze
 
 
 def cap_volume_mm3(spec) -> float:
@@ -120,16 +112,13 @@ def cap_volume_mm3(spec) -> float:
     import math
 
     from matcad.acoustics.geometry import drafted_cavity_volume_mm3
+    from matcad.spec import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
 
     flange_d, tf = cap_flange_diameter_mm(spec), cap_flange_thickness_mm(spec)
     envelope = math.pi / 4 * (flange_d**2 * tf + spec.end_cap.outer_diameter**2 * (cap_height_mm(spec) - tf))
     return envelope - float(drafted_cavity_volume_mm3(spec.cavity.diameter, spec.cavity.length,
                                                       spec.mold.draft_deg))
 
-
-def cap_height_mm(spec) -> float:
-    """End cap height from its base (on the plate) to its top: L + top thickness (mm)."""
-    return spec.cavity.length + spec.end_cap.top_thickness
 
 
 def needle_axis_mm(spec) -> tuple[tuple[float, float, float], tuple[float, float, float]]:

@@ -6,9 +6,10 @@ the bolts press it down so the flange (guide thickness + squeeze) seals against 
 
 import functools
 
-from matcad.parts.features import cap_flange_diameter_mm, laser_stack_holes, sheet_kerf_mm
+from matcad.parts.features import laser_stack_holes, sheet_kerf_mm
 from matcad.parts.flat import Flat, Hole, edge_label
 from matcad.parts.registry import Kind, Part
+from matcad.spec import cap_flange_diameter_mm
 
 BODY_CLEARANCE_MM = 0.2
 """Diametral clearance of the clamp's hole around the silicone body, so clamping does not pinch the cavity."""

@@ -20,7 +20,8 @@ import functools
 import math
 from dataclasses import dataclass
 
-from matcad.parts.features import bolt_clearance_mm, cap_flange_diameter_mm, cap_height_mm
+from matcad.parts.features import bolt_clearance_mm
+from matcad.spec import cap_flange_diameter_mm, cap_height_mm
 
 CEILING_TILT_DEG = 10.0
 """A silicone surface facing up within this angle of horizontal is a ceiling: 20 000 cps silicone does not let

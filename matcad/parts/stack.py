@@ -2,7 +2,7 @@
 
 Assembly frame: plate underside z = 0, neck axis = z. Bottom to top: the needle mount (its top face at
 z = −spacer.height, ``mount.thickness`` thick), the spacers, the neck plate (0 … l), the locator guide around the
-cap's flange, and the clamp guide resting on the flange (:func:`matcad.parts.features.cap_flange_thickness_mm`:
+cap's flange, and the clamp guide resting on the flange (:func:`matcad.spec.cap_flange_thickness_mm`:
 guide thickness + squeeze) until the bolts press it down onto the locator. The parts, the design rules, the bill
 of materials and the fabrication plan all read these heights from here.
 """
@@ -10,7 +10,7 @@ of materials and the fabrication plan all read these heights from here.
 from __future__ import annotations
 
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
-from matcad.parts.features import cap_flange_thickness_mm
+from matcad.spec import cap_flange_thickness_mm
 
 
 def clamp_seat_z_mm(spec) -> float:

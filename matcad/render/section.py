@@ -79,7 +79,8 @@ class _Drawing:
 
 
 def _dimensions(spec, draw: _Drawing) -> None:
-    from matcad.parts.features import cap_height_mm, needle_axis_mm
+    from matcad.parts.features import needle_axis_mm
+    from matcad.spec import cap_height_mm
     from matcad.parts.stack import mount_depth_mm
 
     D, L = spec.cavity.diameter, spec.cavity.length
@@ -122,7 +123,8 @@ def _dimensions(spec, draw: _Drawing) -> None:
 
 def _label_points(spec) -> dict[str, tuple[float, float]]:
     """A point inside each part of the section to start its leader from (assembly frame x, z; mm)."""
-    from matcad.parts.features import cap_height_mm, needle_tip_mm
+    from matcad.parts.features import needle_tip_mm
+    from matcad.spec import cap_height_mm
     from matcad.parts.stack import clamp_seat_z_mm
 
     w, l, g, gap = spec.plate.width, spec.neck.length, spec.guide.thickness, spec.spacer.height

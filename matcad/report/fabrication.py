@@ -51,8 +51,8 @@ def fits(spec: Spec, flats: list[Flat]) -> list[dict]:
     """The fits the kit relies on, as designed (mm): hole, what goes in it, and the clearance claimed (diametral;
     negative = interference), the locator's hole read from the laser parts ``flats``. Each names the files a check
     reads it back from."""
-    from matcad.parts.features import (SELF_TAP_PILOT_MM, bolt_nominal_mm, cap_flange_diameter_mm,
-                                       pin_hole_diameter_mm)
+    from matcad.parts.features import SELF_TAP_PILOT_MM, bolt_nominal_mm, pin_hole_diameter_mm
+    from matcad.spec import cap_flange_diameter_mm
 
     rows = []
     if spec.outputs.end_cap_mold:

@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import math
 
-from matcad.parts.features import (bolt_clearance_mm, cap_flange_diameter_mm, needle_axis_mm, needle_tip_mm,
-                                   pin_hole_diameter_mm, plate_bolt_positions_mm, plate_dowel_positions_mm)
+from matcad.parts.features import (bolt_clearance_mm, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
+                                   plate_bolt_positions_mm, plate_dowel_positions_mm)
 from matcad.parts.stack import mount_depth_mm
 from matcad.rules.finding import Finding
+from matcad.spec import cap_flange_diameter_mm
 
 JET_HALF_ANGLE_DEG = 12.0
 """Opening half-angle of the needle's free jet, to where its speed falls to ~10 % of the centre line's. A round

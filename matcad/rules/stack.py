@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from matcad.parts.features import cap_flange_thickness_mm, needle_tip_mm
+from matcad.parts.features import needle_tip_mm
 from matcad.parts.stack import mount_depth_mm, squeeze_range_mm
 from matcad.rules.finding import Finding
+from matcad.spec import cap_flange_thickness_mm
 
 PAPER_THETA_DEG = (30.0, 75.0)
 PAPER_Y_MM = (0.0, 3.47)
