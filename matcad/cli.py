@@ -239,9 +239,9 @@ def _band(args):
         return lo, hi
     if args.spec:
         from matcad.acoustics.predict import predict
-        from matcad.loop.analyze import band_from_prediction
+        from matcad.listening import PREDICTED_MARGIN, listening_band
 
-        return band_from_prediction(predict(_load_spec(args.spec, args)).band_hz)
+        return listening_band(predict(_load_spec(args.spec, args)).band_hz, PREDICTED_MARGIN)
     raise ValueError("analyze needs --spec SPEC (its predicted band) or --band LO HI (Hz)")
 
 
@@ -277,7 +277,9 @@ def _print_segments(analysis, forces=None) -> None:
 
 
 def cmd_analyze(args) -> int:
-    from matcad.loop.analyze import analyze_stream, plot, write_segments_csv, write_track_csv
+    from matcad.loop.analyze import analyze_stream
+    from matcad.loop.outputs import write_segments_csv, write_track_csv
+    from matcad.loop.plots import plot
     from matcad.output import staged_output
 
     board = _board_bands(args)
@@ -433,7 +435,9 @@ def _one_taxel(spec, name):
 def cmd_sense(args) -> int:
     import numpy as np
 
-    from matcad.loop.analyze import analyze_stream, plot, write_segments_csv
+    from matcad.loop.analyze import analyze_stream
+    from matcad.loop.outputs import write_segments_csv
+    from matcad.loop.plots import plot
     from matcad.loop.sense import SensorCalibration, force_with_interval, require_in_range, sense
     from matcad.output import staged_output
     from matcad.spec import load_calibration

@@ -4,7 +4,7 @@ force per taxel over time. Frequencies Hz, times s, forces N.
 Assignment by band. Each taxel listens in its own band: the loaded band of :func:`matcad.acoustics.bands.
 taxel_bands` (its predicted unloaded band widened by the rise of f under load up to the spec's maximum force).
 The bands of a valid array are disjoint with a guard and clear of each other's 2f and 3f (the band rules), so a
-tone belongs to the taxel whose band holds it, and one :class:`matcad.loop.analyze.BandTracker` per band — all fed
+tone belongs to the taxel whose band holds it, and one :class:`matcad.loop.tracker.BandTracker` per band — all fed
 from the same spectra in one pass (:func:`matcad.loop.analyze.run_trackers`) — tracks every taxel at once. A louder
 neighbour's tone lies in the neighbour's band: it is that taxel's tone, not a distractor of this one (the
 "stronger tone outside the band" report skips the other taxels' bands); a stronger tone outside every band is
@@ -28,7 +28,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from matcad.loop import LoopError
-from matcad.loop.analyze import Analysis, run_trackers, save_time_figure
+from matcad.loop.analysis import Analysis
+from matcad.loop.analyze import run_trackers
+from matcad.loop.plots import save_time_figure
 
 
 @dataclass(frozen=True)
