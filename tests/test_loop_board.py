@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 from matcad.loop import LoopError, synth
-from matcad.loop.board import (analyze_board, parse_calibrations, sense_board, write_forces_csv, write_segments_csv,
-                               write_track_csv)
+from matcad.loop.board import analyze_board, parse_calibrations, sense_board
+from matcad.loop.outputs import write_board_forces_csv as write_forces_csv
+from matcad.loop.outputs import write_board_segments_csv as write_segments_csv
+from matcad.loop.outputs import write_board_track_csv as write_track_csv
 from matcad.loop.calibrate import fit
 from matcad.loop.sense import SensorCalibration
 

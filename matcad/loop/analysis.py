@@ -68,6 +68,21 @@ class Analysis:
                                    "fraction": s.fraction} for s in self.sources],
                 "warnings": list(self.warnings)}
 
+    def to_text(self, source: str) -> str:
+        """What ``analyze`` prints for the recording named ``source``: the statistics, the segments, the
+        warnings."""
+        head = (f"{source}: mean {self.mean_hz:.2f} Hz, median {self.median_hz:.2f} Hz, sd {self.std_hz:.2f} Hz "
+                f"over {int(self.voiced.sum())} voiced of {len(self.track_hz)} frames (tone "
+                f"{100 * self.tone_fraction:.0f} %); line {self.snr_db:.1f} dB over the floor, prominence "
+                f"{self.prominence_db:.1f} dB (band {self.band_hz[0]:.0f}-{self.band_hz[1]:.0f} Hz)")
+        return "\n".join([head, *self.segments_text(), *(f"  warning: {w}" for w in self.warnings)])
+
+    def segments_text(self, forces=None, heading: bool = True) -> list[str]:
+        """Lines: how many steady segments (``heading``), then one per segment (:meth:`Segment.to_text`), with its
+        force when ``forces`` (per segment: force, low, high in N) is given."""
+        lines = [f"  {len(self.segments)} steady segments:"] if heading else []
+        return lines + [s.to_text(None if forces is None else forces[i]) for i, s in enumerate(self.segments)]
+
 
 @dataclass(frozen=True)
 class Frames:

@@ -38,6 +38,15 @@ class Segment:
     def to_dict(self) -> dict:
         return asdict(self)
 
+    def to_text(self, force=None) -> str:
+        """One line: start-end (s), mean and sd (Hz), with ``force`` (force, low, high in N; NaN: outside the
+        calibrated range) the force and its 95 % interval, and the flag."""
+        line = (f"  {self.start_s:8.2f}-{self.end_s:8.2f} s  {self.mean_hz:9.2f} Hz (sd {self.std_hz:5.2f})")
+        if force is not None and self.flag == "":
+            f, lo, hi = force
+            line += f"  F = {f:.3f} N (95 %: {lo:.3f} .. {hi:.3f})" if f == f else "  outside the calibrated range"
+        return line + (f"  [{self.flag}]" if self.flag else "")
+
 
 def steady_segments(times, track, state) -> list[Segment]:
     """Steady segments of voiced frames (``state`` >= 1) of ``track`` (Hz) at ``times`` (s). A segment reached by
