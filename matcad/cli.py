@@ -308,9 +308,9 @@ def _board_bands(args):
     spec = _board_spec(args)
     if spec is None:
         return None
-    from matcad.loop.board import board_bands
+    from matcad.acoustics.bands import listening_bands
 
-    return board_bands(spec)
+    return listening_bands(spec)
 
 
 def _analyze_board(args, named_bands) -> int:
@@ -431,12 +431,13 @@ def cmd_sense(args) -> int:
 def _sense_board(args, spec) -> int:
     from functools import partial
 
+    from matcad.acoustics.bands import listening_bands
     from matcad.loop import board, live, outputs
     from matcad.loop.plots import plot_board
     from matcad.loop.sense import SensorCalibration
     from matcad.output import staged_output
 
-    named_bands = board.board_bands(spec)
+    named_bands = listening_bands(spec)
     names = [n for n, _ in named_bands]
     given = board.board_calibrations(spec, args.calibration)
     cals = {n: SensorCalibration.from_spec_calibration(cal) for n, (_, cal) in given.items()}

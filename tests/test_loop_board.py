@@ -153,7 +153,7 @@ def test_cli_analyze_and_sense_an_array_spec(tmp_path):
     from scipy.io import wavfile
 
     from matcad import spec as spec_mod
-    from matcad.loop.board import board_bands
+    from matcad.acoustics.bands import listening_bands as board_bands
     from tests.conftest import ROOT, run_cli
 
     path = tmp_path / "board.toml"

@@ -198,3 +198,10 @@ def summary(spec, bands) -> dict:
                            "other_hz": list(c.other_hz), "gap_hz": c.gap_hz, "message": c.describe()}
                           for c in conflicts(bands, guard)]}
 
+
+def listening_bands(spec) -> list[tuple[str, tuple[float, float]]]:
+    """(taxel name, band Hz the recording loop listens in) per taxel of ``spec``, in taxels(spec) order: each
+    taxel's loaded band (:func:`taxel_bands`) with :data:`matcad.listening.LOADED_MARGIN`."""
+    from matcad.listening import LOADED_MARGIN, listening_band
+
+    return [(b.name, listening_band(b.loaded_hz, LOADED_MARGIN)) for b in taxel_bands(spec)]

@@ -1,8 +1,9 @@
 """A board of taxels heard by one microphone: every taxel's tone tracked at once, assigned to its taxel, and a
 force per taxel over time. Frequencies Hz, times s, forces N.
 
-Assignment by band. Each taxel listens in its own band: the loaded band of :func:`matcad.acoustics.bands.
-taxel_bands` (its predicted unloaded band widened by the rise of f under load up to the spec's maximum force).
+Assignment by band. Each taxel listens in its own band, given by the caller: the loaded band of
+:func:`matcad.acoustics.bands.listening_bands` (its predicted unloaded band widened by the rise of f under load up
+to the spec's maximum force).
 The bands of a valid array are disjoint with a guard and clear of each other's 2f and 3f (the band rules), so a
 tone belongs to the taxel whose band holds it, and one :class:`matcad.loop.tracker.BandTracker` per band — all fed
 from the same spectra in one pass (:func:`matcad.loop.analyze.run_trackers`) — tracks every taxel at once. A louder
@@ -81,13 +82,6 @@ def taxels_dict(tracks, readings=None) -> list[dict]:
     "reading" when ``readings`` ({name: Reading}) has one."""
     return [{**t.to_dict(), **({"reading": readings[t.name].to_dict()} if t.name in (readings or {}) else {})}
             for t in tracks]
-
-
-def board_bands(spec) -> list[tuple[str, tuple[float, float]]]:
-    """(taxel name, listening band Hz) per taxel of ``spec``, in taxels(spec) order: each taxel's loaded band."""
-    from matcad.acoustics.bands import taxel_bands
-
-    return [(b.name, tuple(b.loaded_hz)) for b in taxel_bands(spec)]
 
 
 def analyze_board(blocks, fs: float, named_bands, on_frame=None) -> list[TaxelTrack]:
