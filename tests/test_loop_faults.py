@@ -75,7 +75,8 @@ def calibration(tmp_path_factory):
     path.write_text(fit(forces, freqs, synth.K_MM3_HZ2, temperature_c=20.0).to_toml(), encoding="utf-8")
     from matcad.spec import load_calibration
 
-    return SensorCalibration.from_spec_calibration(load_calibration(path)), tomllib.loads(path.read_text())["calibration"]
+    table = tomllib.loads(path.read_text())["calibration"]
+    return SensorCalibration.from_spec_calibration(load_calibration(path)), table
 
 
 def test_sense_band_is_the_calibrated_range_widened(calibration):

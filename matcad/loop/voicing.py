@@ -44,9 +44,10 @@ CLUTTER_STEP_DB = 0.5
 CLUTTER_STEPS = 16
 CLUTTER_TARGET = 0.01
 """Adaptive thresholds (order-statistic CFAR, Rohling 1983): over the band's bins outside the strongest line's
-guard, pooled over ±CLUTTER_FRAMES frames, the fraction ≥ WEAK_DB + s must not exceed this (dry noise: 0.76 % on average,
-above 1 % in about one window in ten, which then asks 0.5 dB more of a new weak tone); s (a multiple of CLUTTER_STEP_DB, at most CLUTTER_STEPS of them) raises WEAK_DB
-and STRONG_DB alike where the clutter's tail is heavier — a reverberant room's response peaks, a voice."""
+guard, pooled over ±CLUTTER_FRAMES frames, the fraction ≥ WEAK_DB + s must not exceed this (dry noise: 0.76 % on
+average, above 1 % in about one window in ten, which then asks 0.5 dB more of a new weak tone); s (a multiple of
+CLUTTER_STEP_DB, at most CLUTTER_STEPS of them) raises WEAK_DB and STRONG_DB alike where the clutter's tail is
+heavier — a reverberant room's response peaks, a voice."""
 MIN_RUN_NEW = 8
 """Away from a voiced frame (a tone starting from nothing) a weak run needs this many frames over the clutter-raised
 WEAK_DB, not MIN_RUN: a reverberant room's response peaks hold 5–8 frames under broadband noise (room-noise case:
