@@ -78,7 +78,8 @@ def test_max_force_beyond_the_mechanics_curve_names_the_field(monkeypatch):
 
 
 def test_guard_follows_the_trackers_bins():
-    from matcad.loop.analyze import EDGE_BINS, EXCLUDE_BINS, Framer
+    from matcad.listening import EDGE_BINS, EXCLUDE_BINS
+    from matcad.loop.spectrum import Framer
 
     for fs in (44100.0, 48000.0, 96000.0):
         df = np.diff(Framer(fs).freqs[:2])[0]
