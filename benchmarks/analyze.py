@@ -175,7 +175,10 @@ def false_alarm_table(minutes):
     """Voiced frames in pure noise: the detector's false-alarm rate per frame, bounded at 95 % (one-sided)."""
     from scipy.stats import beta
 
-    from matcad.loop.analyze import STRONG_DB, BandTracker, Framer, _running_median_rows, FLOOR_BINS, analyze_stream
+    from matcad.loop.analyze import analyze_stream
+    from matcad.loop.spectrum import FLOOR_BINS, Framer, running_median_rows
+    from matcad.loop.tracker import BandTracker
+    from matcad.loop.voicing import STRONG_DB
 
     print(f"\nVoicing false alarms: {minutes:g} min of each noise at 44.1 kHz, band {BAND[0]:.0f}-{BAND[1]:.0f} Hz "
           "(per-bin tail: fraction of frame×bins over x dB; exponential law exp(-ln2·10^(x/10)) for a known "
@@ -205,7 +208,7 @@ def false_alarm_table(minutes):
             power = framer.feed(x)[1]
             tracker = BandTracker(framer.freqs, FS, BAND)
             slab = power[:, tracker.slab]
-            excess = (10 * np.log10(slab / _running_median_rows(slab, FLOOR_BINS)))[:, tracker.offset:
+            excess = (10 * np.log10(slab / running_median_rows(slab, FLOOR_BINS)))[:, tracker.offset:
                                                                                     tracker.offset + len(tracker.in_band)]
             over += [np.sum(excess > 12.0), np.sum(excess > 15.0)]
             bins += excess.size
@@ -274,11 +277,11 @@ def board_table(seeds, seconds):
 def _ridge_only(times, track, state, other_bin, other_excess, other_level, excess, band_freqs):
     """matcad.loop.crossing.follow_taxel doing nothing: the ridge as the tracker gives it (the code before
     crossing.py; its outputs were bit-identical to main's on every realistic case)."""
-    from matcad.loop.analyze import _segments
     from matcad.loop.crossing import Identity
+    from matcad.loop.segments import steady_segments
 
     return Identity(np.asarray(track), np.asarray(state, dtype=int).copy(), other_bin, other_excess, other_level,
-                    tuple(_segments(times, track, state, band_freqs[1] - band_freqs[0])), ())
+                    tuple(steady_segments(times, track, state)), ())
 
 
 def crossing_table(seeds, seconds):

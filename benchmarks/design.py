@@ -42,7 +42,8 @@ def inverse_design():
 
 
 def allocation():
-    from matcad.prediction.bands import conflicts, guard_hz, taxel_bands
+    from matcad.listening import guard_hz
+    from matcad.prediction.bands import conflicts, taxel_bands
     from matcad.design.allocate import allocate
 
     s = spec_mod.load(ROOT / "templates" / "mat-laser-only.toml")

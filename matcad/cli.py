@@ -237,10 +237,10 @@ def _band(args):
             raise ValueError(f"--band {lo:g} {hi:g} invalid, must be 0 <= LO < HI (Hz)")
         return lo, hi
     if args.spec:
+        from matcad.listening import PREDICTED_MARGIN, listening_band
         from matcad.prediction import predict
-        from matcad.loop.analyze import band_from_prediction
 
-        return band_from_prediction(predict(_load_spec(args.spec, args)).band_hz)
+        return listening_band(predict(_load_spec(args.spec, args)).band_hz, PREDICTED_MARGIN)
     raise ValueError("analyze needs --spec SPEC (its predicted band) or --band LO HI (Hz)")
 
 
@@ -266,17 +266,10 @@ def _loop_output(args, kind: str, source: str) -> Path:
     return output_folder(args.out, kind, source)
 
 
-def _print_segments(analysis, forces=None) -> None:
-    for i, seg in enumerate(analysis.segments):
-        line = (f"  {seg.start_s:8.2f}-{seg.end_s:8.2f} s  {seg.mean_hz:9.2f} Hz (sd {seg.std_hz:5.2f})")
-        if forces is not None and seg.flag == "":
-            f, lo, hi = forces[i]
-            line += f"  F = {f:.3f} N (95 %: {lo:.3f} .. {hi:.3f})" if f == f else "  outside the calibrated range"
-        print(line + (f"  [{seg.flag}]" if seg.flag else ""))
-
-
 def cmd_analyze(args) -> int:
-    from matcad.loop.analyze import analyze_stream, plot, write_segments_csv, write_track_csv
+    from matcad.loop import outputs
+    from matcad.loop.analyze import analyze_stream
+    from matcad.loop.plots import plot
     from matcad.output import staged_output
 
     board = _board_bands(args)
@@ -287,21 +280,14 @@ def cmd_analyze(args) -> int:
     result = analyze_stream(blocks, fs, [band])[0]
     target = _loop_output(args, "analyze", name)
     with staged_output(target) as tmp:
-        write_track_csv(result, tmp / "track.csv")
-        write_segments_csv(result, tmp / "segments.csv")
+        outputs.write_track_csv(result, tmp / "track.csv")
+        outputs.write_segments_csv(result, tmp / "segments.csv")
         plot(result, tmp / "spectrogram.png")
-        _write_json(tmp / "report.json", {"recording": name, **result.to_dict()})
+        outputs.write_json(tmp / "report.json", {"recording": name, **result.to_dict()})
     if args.json:
         _print_json({**result.to_dict(), "out_dir": str(target)})
     else:
-        print(f"{name}: mean {result.mean_hz:.2f} Hz, median {result.median_hz:.2f} Hz, sd {result.std_hz:.2f} Hz "
-              f"over {int(result.voiced.sum())} voiced of {len(result.track_hz)} frames (tone "
-              f"{100 * result.tone_fraction:.0f} %); line {result.snr_db:.1f} dB over the floor, prominence "
-              f"{result.prominence_db:.1f} dB (band {result.band_hz[0]:.0f}-{result.band_hz[1]:.0f} Hz)")
-        print(f"  {len(result.segments)} steady segments:")
-        _print_segments(result)
-        for w in result.warnings:
-            print(f"  warning: {w}")
+        print(result.to_text(name))
         print(f"  track.csv, segments.csv, spectrogram.png, report.json in {target}/")
     return EXIT_OK
 
@@ -321,55 +307,35 @@ def _board_bands(args):
     spec = _board_spec(args)
     if spec is None:
         return None
-    from matcad.loop.board import board_bands
+    from matcad.prediction.bands import listening_bands
 
-    return board_bands(spec)
-
-
-def _board_summary(tracks, readings=None) -> None:
-    for t in tracks:
-        if t.analysis is None:
-            print(f"  {t.name} ({t.band_hz[0]:.0f}-{t.band_hz[1]:.0f} Hz): {t.reason}")
-            continue
-        a = t.analysis
-        line = (f"  {t.name} ({t.band_hz[0]:.0f}-{t.band_hz[1]:.0f} Hz): mean {a.mean_hz:.2f} Hz, sd {a.std_hz:.2f} Hz, "
-                f"tone {100 * a.tone_fraction:.0f} %, {len(a.segments)} segments")
-        r = (readings or {}).get(t.name)
-        if r is not None and r.force_n == r.force_n:
-            line += f"; F = {r.force_n:.3f} N (95 %: {r.force_interval_n[0]:.3f} .. {r.force_interval_n[1]:.3f})"
-        elif r is not None:
-            line += f"; {r.reason}"
-        elif readings is not None:
-            line += "; no calibration: frequency only"
-        print(line)
-        _print_segments(a, r.segments_n if r is not None else None)
-        for w in list(a.warnings) + (list(r.warnings) if r is not None else []):
-            print(f"    warning: {w}")
+    return listening_bands(spec)
 
 
 def _analyze_board(args, named_bands) -> int:
-    from matcad.loop import board
+    from matcad.loop import board, outputs
+    from matcad.loop.plots import plot_board
     from matcad.output import staged_output
 
     blocks, fs, name = _recording_blocks(args)
     tracks = board.analyze_board(blocks, fs, named_bands)
     target = _loop_output(args, "analyze", name)
-    report = {"recording": name, "taxels": [t.to_dict() for t in tracks]}
+    report = {"recording": name, "taxels": board.taxels_dict(tracks)}
     with staged_output(target) as tmp:
-        board.write_track_csv(tracks, tmp / "track.csv")
-        board.write_segments_csv(tracks, tmp / "segments.csv")
-        board.plot(tracks, tmp / "spectrogram.png")
-        _write_json(tmp / "report.json", report)
+        outputs.write_board_track_csv(tracks, tmp / "track.csv")
+        outputs.write_board_segments_csv(tracks, tmp / "segments.csv")
+        plot_board(tracks, tmp / "spectrogram.png")
+        outputs.write_json(tmp / "report.json", report)
     if args.json:
         _print_json({**report, "out_dir": str(target)})
     else:
-        print(f"{name}: {len(tracks)} taxels, each in its own band")
-        _board_summary(tracks)
+        print(board.board_text(name, tracks))
         print(f"  track.csv, segments.csv, spectrogram.png, report.json in {target}/")
     return EXIT_OK
 
 
 def cmd_calibrate(args) -> int:
+    from matcad.loop import outputs
     from matcad.loop.calibrate import fit_from_spec, plot, read_csv
     from matcad.output import staged_output
     from matcad.spec import frequency_notes
@@ -386,27 +352,15 @@ def cmd_calibrate(args) -> int:
                         cycle_std_n=args.cycle_std_n)
     target = _loop_output(args, "calibrate", str(args.data))
     with staged_output(target) as tmp:
-        (tmp / "calibration.toml").write_text(cal.to_toml(), encoding="utf-8")
+        outputs.write_calibration_toml(cal, tmp / "calibration.toml")
         if args.taxel is not None:  # the same table to paste under that [[taxel]] entry of the board spec
-            (tmp / "taxel_calibration.toml").write_text(
-                f"# paste under the [[taxel]] entry named {args.taxel!r} of {args.spec}\n"
-                + cal.to_toml("taxel.calibration"), encoding="utf-8")
+            outputs.write_calibration_toml(cal, tmp / "taxel_calibration.toml", args.taxel, args.spec)
         plot(cal, tmp / "residuals.png")
-        _write_json(tmp / "report.json", {"data": str(args.data), "spec": spec.name, **cal.to_dict()})
+        outputs.write_json(tmp / "report.json", {"data": str(args.data), "spec": spec.name, **cal.to_dict()})
     if args.json:
         _print_json({**cal.to_dict(), "out_dir": str(target)})
     else:
-        d = cal.to_dict()
-        print(f"Eq. 5 fit to {d['points']} points, {d['force_range_n'][0]:g}-{d['force_range_n'][1]:g} N "
-              f"({'K free, V0 = as-built cavity' if cal.k_free else 'K from the as-built geometry'}):")
-        for name in ("v0", "b", "a"):
-            value = d["v0_mm3"] if name == "v0" else d[name]
-            lo, hi = d[f"{name}_ci95"]
-            print(f"  {name:<3}= {value:.6g} +- {d[name + '_se']:.3g}  (95 %: {lo:.6g} .. {hi:.6g})")
-        print(f"  residual RMS {d['residual_rms_hz']:.2f} Hz; between cycles {cal.cycle_std_n:.3g} N "
-              f"({cal.cycles} cycle(s)); at {cal.temperature_c:g} degC")
-        for note in cal.notes:
-            print(f"  note: {note}")
+        print(cal.to_text())
         extra = f"taxel_calibration.toml ([taxel.calibration] of {args.taxel}), " if args.taxel is not None else ""
         print(f"  calibration.toml, {extra}residuals.png in {target}/")
     return EXIT_OK
@@ -430,10 +384,12 @@ def _one_taxel(spec, name):
 
 
 def cmd_sense(args) -> int:
-    import numpy as np
+    from functools import partial
 
-    from matcad.loop.analyze import analyze_stream, plot, write_segments_csv
-    from matcad.loop.sense import SensorCalibration, force_with_interval, require_in_range, sense
+    from matcad.loop import live, outputs
+    from matcad.loop.analyze import analyze_stream
+    from matcad.loop.plots import plot
+    from matcad.loop.sense import SensorCalibration, listening_band_hz, require_in_range, sense
     from matcad.output import staged_output
     from matcad.spec import load_calibration
 
@@ -448,59 +404,23 @@ def cmd_sense(args) -> int:
                          "naming an array, one NAME=FILE per taxel")
     cal = SensorCalibration.from_spec_calibration(load_calibration(args.calibration[0]))
     cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
-    f_lo, f_hi = cal.frequency_range_hz()
+    band = listening_band_hz(cal)
     blocks, fs, name = _recording_blocks(args)
-    on_frame = None
-    if args.live:
-        def on_frame(_, time_s, freq, _excess):
-            if freq == freq:
-                force, half = force_with_interval(cal, [freq], temperature_c=args.temperature_c)
-                text = (f"F = {force[0]:.3f} +- {half[0]:.3f} N" if np.isfinite(force[0])
-                        else "outside the calibrated range")
-                print(f"{time_s:9.3f} s  {freq:9.2f} Hz  {text}", flush=True)
-            else:
-                print(f"{time_s:9.3f} s  no tone", flush=True)
-    result = analyze_stream(blocks, fs, [(0.8 * f_lo, 1.25 * f_hi)], on_frame)[0]
+    on_frame = live.taxel_printer(cal, args.temperature_c, partial(print, flush=True)) if args.live else None
+    result = analyze_stream(blocks, fs, [band], on_frame)[0]
     reading = sense(result, cal, args.temperature_c)
     target = _loop_output(args, "sense", name) if not (args.live and args.out is None) else None
     if target is not None:
         with staged_output(target) as tmp:
-            write_segments_csv(result, tmp / "segments.csv", reading.segments_n)
-            rows = ["time_s,frequency_hz,force_n,force_low_n,force_high_n"]
-            for t, f, force, (lo, hi), v in zip(result.times_s, result.track_hz, reading.frames_n,
-                                                reading.frames_interval_n, result.voiced):
-                cells = [f"{t:.6f}", f"{f:.4f}" if v else ""] + ["" if not np.isfinite(c) else f"{c:.4f}"
-                                                                 for c in (force, lo, hi)]
-                rows.append(",".join(cells))
-            (tmp / "forces.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+            outputs.write_segments_csv(result, tmp / "segments.csv", reading.segments_n)
+            outputs.write_forces_csv(result, reading, tmp / "forces.csv")
             plot(result, tmp / "force.png", (reading.frames_n, *reading.frames_interval_n.T))
-            _write_json(tmp / "report.json", {"recording": name, "calibration": str(args.calibration[0]),
-                                              **reading.to_dict(), "analysis": result.to_dict(),
-                                              "segment_forces_n": [[None if not np.isfinite(v) else float(v)
-                                                                    for v in row] for row in reading.segments_n]})
-    warnings = list(result.warnings) + list(reading.warnings)
+            outputs.write_json(tmp / "report.json", {"recording": name, "calibration": str(args.calibration[0]),
+                                                     **reading.report_dict(result)})
     if args.json:
-        frames = [{"time_s": float(t), "frequency_hz": float(f) if v else None,
-                   "force_n": None if np.isnan(force) else float(force),
-                   "force_interval_n": None if np.isnan(force) else [float(lo), float(hi)]}
-                  for t, f, v, force, (lo, hi) in zip(result.times_s, result.track_hz, result.voiced,
-                                                      reading.frames_n, reading.frames_interval_n)]
-        segments = [{**seg.to_dict(), "force_n": None if not np.isfinite(f) else float(f),
-                     "force_interval_n": None if not np.isfinite(f) else [float(lo), float(hi)]}
-                    for seg, (f, lo, hi) in zip(result.segments, reading.segments_n)]
-        _print_json({**reading.to_dict(), "tone_fraction": result.tone_fraction, "warnings": warnings,
-                     "segments": segments, "frames": frames,
-                     "out_dir": None if target is None else str(target)})
+        _print_json({**reading.detail_dict(result), "out_dir": None if target is None else str(target)})
     else:
-        if np.isfinite(reading.force_n):
-            lo, hi = reading.force_interval_n
-            print(f"{name}: F = {reading.force_n:.3f} N (95 %: {lo:.3f} .. {hi:.3f} N) at "
-                  f"{reading.frequency_hz:.2f} Hz; {int(np.sum(np.isfinite(reading.frames_n)))} of "
-                  f"{len(reading.frames_n)} frames with a force (tone in {100 * result.tone_fraction:.0f} %)")
-        print(f"  {len(result.segments)} steady segments:")
-        _print_segments(result, reading.segments_n)
-        for w in warnings:
-            print(f"  warning: {w}")
+        print(reading.to_text(name, result))
         if target is not None:
             print(f"  forces.csv, segments.csv, force.png, report.json in {target}/")
     require_in_range(reading)
@@ -508,35 +428,22 @@ def cmd_sense(args) -> int:
 
 
 def _sense_board(args, spec) -> int:
-    import numpy as np
+    from functools import partial
 
-    from matcad.loop import board
-    from matcad.loop.sense import SensorCalibration, force_with_interval
+    from matcad.prediction.bands import listening_bands
+    from matcad.loop import board, live, outputs
+    from matcad.loop.plots import plot_board
+    from matcad.loop.sense import SensorCalibration
     from matcad.output import staged_output
 
-    named_bands = board.board_bands(spec)
+    named_bands = listening_bands(spec)
     names = [n for n, _ in named_bands]
     given = board.board_calibrations(spec, args.calibration)
     cals = {n: SensorCalibration.from_spec_calibration(cal) for n, (_, cal) in given.items()}
     for cal in cals.values():
         cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
     blocks, fs, name = _recording_blocks(args)
-    on_frame = None
-    if args.live:
-        def taxel_text(taxel, freq):
-            if freq != freq:
-                return f"{taxel} no tone"
-            text = f"{taxel} {freq:.2f} Hz"
-            if taxel in cals:
-                force, half = force_with_interval(cals[taxel], [freq], temperature_c=args.temperature_c)
-                text += (f" F={force[0]:.3f}+-{half[0]:.3f} N" if np.isfinite(force[0])
-                         else " outside the calibrated range")
-            return text
-
-        def line(time_s, values):  # one frame, every taxel: printed once all have decided it
-            print(f"{time_s:9.3f} s  " + " | ".join(taxel_text(taxel, freq) for taxel, (freq, _) in
-                                                    zip(names, values)), flush=True)
-        on_frame = board.LiveFrames(len(names), line)
+    on_frame = live.board_printer(names, cals, args.temperature_c, partial(print, flush=True)) if args.live else None
     try:
         tracks = board.analyze_board(blocks, fs, named_bands, on_frame)
     finally:
@@ -544,20 +451,18 @@ def _sense_board(args, spec) -> int:
             on_frame.flush()
     readings = board.sense_board(tracks, cals, args.temperature_c)
     report = {"recording": name, "calibrations": {n: source for n, (source, _) in given.items()},
-              "taxels": [{**t.to_dict(), **({"reading": readings[t.name].to_dict()} if t.name in readings else {})}
-                         for t in tracks]}
+              "taxels": board.taxels_dict(tracks, readings)}
     target = _loop_output(args, "sense", name) if not (args.live and args.out is None) else None
     if target is not None:
         with staged_output(target) as tmp:
-            board.write_segments_csv(tracks, tmp / "segments.csv", readings)
-            board.write_forces_csv(tracks, readings, tmp / "forces.csv")
-            board.plot(tracks, tmp / "force.png", readings)
-            _write_json(tmp / "report.json", report)
+            outputs.write_board_segments_csv(tracks, tmp / "segments.csv", readings)
+            outputs.write_board_forces_csv(tracks, readings, tmp / "forces.csv")
+            plot_board(tracks, tmp / "force.png", readings)
+            outputs.write_json(tmp / "report.json", report)
     if args.json:
         _print_json({**report, "out_dir": None if target is None else str(target)})
     else:
-        print(f"{name}: {len(tracks)} taxels, {len(readings)} with a calibration and a tone")
-        _board_summary(tracks, readings)
+        print(board.board_text(name, tracks, readings))
         if target is not None:
             print(f"  forces.csv, segments.csv, force.png, report.json in {target}/")
     return EXIT_OK
@@ -652,12 +557,6 @@ def _format_design(result) -> str:
                      f"{b.unloaded_hz[0]:.0f}-{b.unloaded_hz[1]:.0f} Hz, loaded {b.loaded_hz[0]:.0f}-"
                      f"{b.loaded_hz[1]:.0f} Hz; {fields}")
     return "\n".join(lines)
-
-
-def _write_json(path: Path, data) -> None:
-    import json
-
-    path.write_text(json.dumps(data, indent=2, allow_nan=False) + "\n", encoding="utf-8")
 
 
 def cmd_schema(args) -> int:

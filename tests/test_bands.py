@@ -10,7 +10,8 @@ import pytest
 from matcad import spec as spec_mod
 from matcad.prediction import bands
 from matcad.prediction import taxel as taxel_prediction
-from matcad.prediction.bands import TaxelBand, conflicts, guard_hz, taxel_band
+from matcad.listening import guard_hz
+from matcad.prediction.bands import TaxelBand, conflicts, taxel_band
 from matcad.acoustics.design import calibration
 from matcad.prediction import predict
 from matcad.spec import SpecError
@@ -79,7 +80,8 @@ def test_max_force_beyond_the_mechanics_curve_names_the_field(monkeypatch):
 
 
 def test_guard_follows_the_trackers_bins():
-    from matcad.loop.analyze import EDGE_BINS, EXCLUDE_BINS, Framer
+    from matcad.listening import EDGE_BINS, EXCLUDE_BINS
+    from matcad.loop.spectrum import Framer
 
     for fs in (44100.0, 48000.0, 96000.0):
         df = np.diff(Framer(fs).freqs[:2])[0]

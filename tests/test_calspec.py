@@ -12,7 +12,8 @@ import pytest
 
 from matcad import spec as spec_mod
 from matcad.loop import synth
-from matcad.loop.board import LiveFrames, board_bands
+from matcad.prediction.bands import listening_bands as board_bands
+from matcad.loop.board import LiveFrames
 from matcad.spec import taxels
 from tests.conftest import ROOT, run_cli
 

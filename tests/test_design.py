@@ -125,7 +125,8 @@ def _array_base(write_spec, max_force="5.0"):
 
 
 def test_taxels_bands_are_disjoint_inside_the_band_and_check_accepts(tmp_path, write_spec):
-    from matcad.prediction.bands import conflicts, guard_hz, taxel_bands
+    from matcad.listening import guard_hz
+    from matcad.prediction.bands import conflicts, taxel_bands
     from matcad.spec import taxels
 
     out = tmp_path / "arr"

@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 from matcad.loop import LoopError, synth
-from matcad.loop.board import (analyze_board, parse_calibrations, sense_board, write_forces_csv, write_segments_csv,
-                               write_track_csv)
+from matcad.loop.board import analyze_board, parse_calibrations, sense_board
+from matcad.loop.outputs import write_board_forces_csv as write_forces_csv
+from matcad.loop.outputs import write_board_segments_csv as write_segments_csv
+from matcad.loop.outputs import write_board_track_csv as write_track_csv
 from matcad.loop.calibrate import fit
 from matcad.loop.sense import SensorCalibration
 
@@ -151,7 +153,7 @@ def test_cli_analyze_and_sense_an_array_spec(tmp_path):
     from scipy.io import wavfile
 
     from matcad import spec as spec_mod
-    from matcad.loop.board import board_bands
+    from matcad.prediction.bands import listening_bands as board_bands
     from tests.conftest import ROOT, run_cli
 
     path = tmp_path / "board.toml"

@@ -3,7 +3,7 @@
 import numpy as np
 
 from matcad.loop import harmonic, synth
-from matcad.loop.analyze import Framer
+from matcad.loop.spectrum import Framer
 
 FS = 44100
 

@@ -132,7 +132,8 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     """Allocate ``n`` disjoint bands in [``lo_hz``, ``hi_hz``] and solve one taxel for each (see the module
     docstring); ``vary`` as for :func:`matcad.design.solve.solve`, continuous per-taxel fields only. Raises
     :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
-    from matcad.prediction.bands import guard_hz, taxel_band
+    from matcad.listening import guard_hz
+    from matcad.prediction.bands import taxel_band
     from matcad.rules import check, errors
     from matcad.spec import MAX_TAXELS, taxel_spec, taxels
 

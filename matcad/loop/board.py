@@ -1,10 +1,11 @@
 """A board of taxels heard by one microphone: every taxel's tone tracked at once, assigned to its taxel, and a
 force per taxel over time. Frequencies Hz, times s, forces N.
 
-Assignment by band. Each taxel listens in its own band: the loaded band of :func:`matcad.prediction.bands.
-taxel_bands` (its predicted unloaded band widened by the rise of f under load up to the spec's maximum force).
+Assignment by band. Each taxel listens in its own band, given by the caller: the loaded band of
+:func:`matcad.prediction.bands.listening_bands` (its predicted unloaded band widened by the rise of f under load up
+to the spec's maximum force).
 The bands of a valid array are disjoint with a guard and clear of each other's 2f and 3f (the band rules), so a
-tone belongs to the taxel whose band holds it, and one :class:`matcad.loop.analyze.BandTracker` per band — all fed
+tone belongs to the taxel whose band holds it, and one :class:`matcad.loop.tracker.BandTracker` per band — all fed
 from the same spectra in one pass (:func:`matcad.loop.analyze.run_trackers`) — tracks every taxel at once. A louder
 neighbour's tone lies in the neighbour's band: it is that taxel's tone, not a distractor of this one (the
 "stronger tone outside the band" report skips the other taxels' bands); a stronger tone outside every band is
@@ -28,7 +29,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from matcad.loop import LoopError
-from matcad.loop.analyze import Analysis, run_trackers, save_time_figure
+from matcad.loop.analysis import Analysis
+from matcad.loop.analyze import run_trackers
+from matcad.loop.sense import sense
 
 
 @dataclass(frozen=True)
@@ -45,12 +48,40 @@ class TaxelTrack:
         body = self.analysis.to_dict() if self.analysis is not None else {"reason": self.reason}
         return {"taxel": self.name, "listening_band_hz": list(self.band_hz), **body}
 
+    def to_text(self, reading=None, sensed: bool = False) -> str:
+        """This taxel's lines of a board's summary: band, frequency statistics and, with ``reading``
+        (:class:`matcad.loop.sense.Reading`), its force (``sensed`` without one: the board was sensed but this
+        taxel has no calibration); its segments and warnings."""
+        band = f"  {self.name} ({self.band_hz[0]:.0f}-{self.band_hz[1]:.0f} Hz): "
+        if self.analysis is None:
+            return band + self.reason
+        a, r = self.analysis, reading
+        line = (f"{band}mean {a.mean_hz:.2f} Hz, sd {a.std_hz:.2f} Hz, tone {100 * a.tone_fraction:.0f} %, "
+                f"{len(a.segments)} segments")
+        if r is not None and r.force_n == r.force_n:
+            line += f"; F = {r.force_n:.3f} N (95 %: {r.force_interval_n[0]:.3f} .. {r.force_interval_n[1]:.3f})"
+        elif r is not None:
+            line += f"; {r.reason}"
+        elif sensed:
+            line += "; no calibration: frequency only"
+        warnings = list(a.warnings) + (list(r.warnings) if r is not None else [])
+        return "\n".join([line, *a.segments_text(r.segments_n if r is not None else None, heading=False),
+                          *(f"    warning: {w}" for w in warnings)])
 
-def board_bands(spec) -> list[tuple[str, tuple[float, float]]]:
-    """(taxel name, listening band Hz) per taxel of ``spec``, in taxels(spec) order: each taxel's loaded band."""
-    from matcad.prediction.bands import taxel_bands
 
-    return [(b.name, tuple(b.loaded_hz)) for b in taxel_bands(spec)]
+def board_text(source: str, tracks, readings=None) -> str:
+    """What ``analyze`` (``readings`` None) or ``sense`` ({name: Reading}) prints for a board heard in the
+    recording named ``source``: one block per taxel (:meth:`TaxelTrack.to_text`)."""
+    head = (f"{source}: {len(tracks)} taxels, each in its own band" if readings is None else
+            f"{source}: {len(tracks)} taxels, {len(readings)} with a calibration and a tone")
+    return "\n".join([head, *(t.to_text((readings or {}).get(t.name), readings is not None) for t in tracks)])
+
+
+def taxels_dict(tracks, readings=None) -> list[dict]:
+    """report.json's "taxels" of a board: each :meth:`TaxelTrack.to_dict`, with its reading's ``to_dict`` under
+    "reading" when ``readings`` ({name: Reading}) has one."""
+    return [{**t.to_dict(), **({"reading": readings[t.name].to_dict()} if t.name in (readings or {}) else {})}
+            for t in tracks]
 
 
 def analyze_board(blocks, fs: float, named_bands, on_frame=None) -> list[TaxelTrack]:
@@ -135,121 +166,10 @@ class LiveFrames:
         self.next = max(self.reported, default=0)
 
 
-def frame_times(tracks) -> np.ndarray:
-    """The frame times (s) the trackers share."""
-    return next(t.analysis.times_s for t in tracks if t.analysis is not None)
-
-
-def _cell(v, fmt="{:.4f}") -> str:
-    return fmt.format(v) if v is not None and np.isfinite(v) else ""
-
-
-def write_track_csv(tracks, path) -> None:
-    """Per frame: time (s) and per taxel its frequency (Hz, empty where unvoiced), ridge excess (dB) and voicing
-    (columns NAME_frequency_hz, NAME_snr_db, NAME_voiced)."""
-    times = frame_times(tracks)
-    head = ["time_s"] + [f"{t.name}_{c}" for t in tracks for c in ("frequency_hz", "snr_db", "voiced")]
-    rows = [",".join(head)]
-    for i, time_s in enumerate(times):
-        cells = [f"{time_s:.6f}"]
-        for t in tracks:
-            a = t.analysis
-            if a is None:
-                cells += ["", "", "0"]
-            else:
-                cells += [_cell(a.track_hz[i]) if a.voiced[i] else "", _cell(a.frame_snr_db[i], "{:.2f}"),
-                          str(int(a.voiced[i]))]
-        rows.append(",".join(cells))
-    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
-
-
-def write_segments_csv(tracks, path, readings=None) -> None:
-    """Per taxel and segment: taxel, start, end (s), frames, mean/median/sd frequency (Hz), with ``readings``
-    ({name: Reading}) force and its 95 % interval (N; empty for a taxel without calibration), flag."""
-    head = "taxel,start_s,end_s,frames,mean_hz,median_hz,std_hz"
-    head += ",force_n,force_low_n,force_high_n" if readings is not None else ""
-    rows = [head + ",flag"]
-    for t in tracks:
-        if t.analysis is None:
-            continue
-        reading = (readings or {}).get(t.name)
-        for i, s in enumerate(t.analysis.segments):
-            row = f"{t.name},{s.start_s:.3f},{s.end_s:.3f},{s.frames},{s.mean_hz:.3f},{s.median_hz:.3f},{s.std_hz:.3f}"
-            if readings is not None:
-                row += "," + ",".join(_cell(v) for v in (reading.segments_n[i] if reading else (None,) * 3))
-            rows.append(row + "," + s.flag.replace(",", ";"))
-    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
-
-
-def write_forces_csv(tracks, readings, path) -> None:
-    """Per frame: time (s) and per taxel its frequency (Hz), force and 95 % interval (N); empty where unvoiced,
-    outside the calibrated range or without a calibration (columns NAME_frequency_hz, NAME_force_n, ...)."""
-    times = frame_times(tracks)
-    head = ["time_s"] + [f"{t.name}_{c}" for t in tracks
-                         for c in ("frequency_hz", "force_n", "force_low_n", "force_high_n")]
-    rows = [",".join(head)]
-    for i, time_s in enumerate(times):
-        cells = [f"{time_s:.6f}"]
-        for t in tracks:
-            a, r = t.analysis, readings.get(t.name)
-            cells.append(_cell(a.track_hz[i]) if a is not None and a.voiced[i] else "")
-            cells += [_cell(v) for v in ((r.frames_n[i], *r.frames_interval_n[i]) if r else (None,) * 3)]
-        rows.append(",".join(cells))
-    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
-
-
-def plot(tracks, path, readings=None) -> None:
-    """One figure: every taxel's band as spectrogram (dB) with its voiced track, a colour and a label per taxel;
-    with ``readings`` ({name: Reading}) a second panel of force against time, one line and 95 % band per taxel.
-    PNG."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    rows = 2 if readings else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(9, 3.6 * rows + 0.8), sharex=True, squeeze=False)
-    ax = axes[0, 0]
-    present = [t for t in tracks if t.analysis is not None]
-    levels = np.concatenate([t.analysis.plot_db.ravel() for t in present])
-    vmin, vmax = np.percentile(levels, 5), levels.max()
-    colours = plt.get_cmap("tab10")
-    for k, t in enumerate(tracks):
-        colour = colours(k % 10)
-        ax.axhspan(*t.band_hz, color=colour, alpha=0.08, lw=0)
-        if t.analysis is None:
-            ax.text(0.01, np.mean(t.band_hz), f"{t.name}: no tone", color=colour, fontsize=8,
-                    transform=ax.get_yaxis_transform())
-            continue
-        a = t.analysis
-        ax.pcolormesh(a.plot_times_s, a.plot_freqs_hz, a.plot_db, shading="nearest", cmap="gray_r", vmin=vmin,
-                      vmax=vmax)
-        ax.plot(a.times_s, np.where(a.voiced, a.track_hz, np.nan), color=colour, lw=1.2,
-                label=f"{t.name}: {a.mean_hz:.0f} Hz, tone {100 * a.tone_fraction:.0f} %")
-    ax.set(ylabel="frequency [Hz]", title=f"{len(tracks)} taxels, one band each")
-    ax.legend(loc="upper right", fontsize=7)
-    if readings:
-        bx = axes[1, 0]
-        for k, t in enumerate(tracks):
-            r = readings.get(t.name)
-            if r is None or t.analysis is None:
-                continue
-            colour = colours(k % 10)
-            times = t.analysis.times_s
-            bx.fill_between(times, r.frames_interval_n[:, 0], r.frames_interval_n[:, 1], color=colour, alpha=0.25,
-                            lw=0)
-            bx.plot(times, r.frames_n, color=colour, lw=1, label=t.name)
-        bx.set(ylabel="force [N]")
-        bx.legend(loc="upper right", fontsize=7)
-    save_time_figure(fig, axes, path)
-
-
 def sense_board(tracks, calibrations, temperature_c=None) -> dict:
     """{taxel name: :class:`matcad.loop.sense.Reading`} for every taxel that has a tone and a calibration
     (``calibrations``: {name: SensorCalibration}); raises LoopError when none of them has a force in its
     calibrated range."""
-    from matcad.loop.sense import sense
-
     readings = {t.name: sense(t.analysis, calibrations[t.name], temperature_c)
                 for t in tracks if t.analysis is not None and t.name in calibrations}
     if not any(np.isfinite(r.force_n) for r in readings.values()):

@@ -70,6 +70,21 @@ class CalibrationFit:
                 "outliers": [{"point": i + 1, "studentized_residual": r} for i, r in self.outliers],
                 "notes": list(self.notes)}
 
+    def to_text(self) -> str:
+        """What ``calibrate`` prints: the range fitted, each parameter with its standard error and 95 % interval,
+        the residual RMS (Hz), the between-cycle scatter (N), the temperature (°C) and the notes."""
+        d = self.to_dict()
+        lines = [f"Eq. 5 fit to {d['points']} points, {d['force_range_n'][0]:g}-{d['force_range_n'][1]:g} N "
+                 f"({'K free, V0 = as-built cavity' if self.k_free else 'K from the as-built geometry'}):"]
+        for name in ("v0", "b", "a"):
+            value = d["v0_mm3"] if name == "v0" else d[name]
+            lo, hi = d[f"{name}_ci95"]
+            lines.append(f"  {name:<3}= {value:.6g} +- {d[name + '_se']:.3g}  (95 %: {lo:.6g} .. {hi:.6g})")
+        lines.append(f"  residual RMS {d['residual_rms_hz']:.2f} Hz; between cycles {self.cycle_std_n:.3g} N "
+                     f"({self.cycles} cycle(s)); at {self.temperature_c:g} degC")
+        lines += [f"  note: {note}" for note in self.notes]
+        return "\n".join(lines)
+
     def to_toml(self, table: str = "calibration") -> str:
         """A [calibration] table that a spec accepts as it is (``table`` "taxel.calibration": the same fields as
         one [[taxel]] entry's sub-table)."""

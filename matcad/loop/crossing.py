@@ -2,7 +2,7 @@
 
 With one analysis band (a single-taxel spec, a neighbour the spec does not know, ``--band`` by hand) a second taxel
 of similar level can sit in the band, and pressing one of them can carry its pitch through the other's. The ridge
-of :class:`matcad.loop.analyze.BandTracker` follows the stronger line and pays to move, so it may leave the taxel
+of :class:`matcad.loop.tracker.BandTracker` follows the stronger line and pays to move, so it may leave the taxel
 for the other tone — at a crossing, or by a jump when the other tone starts — and report the other's frequency.
 Per frame the tracker keeps the ridge and the strongest other line (its bin, excess and level); from them:
 
@@ -37,7 +37,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from matcad.loop.analyze import MIN_RUN, WEAK_DB, Segment, _segments
+from matcad.loop.segments import Segment, steady_segments
+from matcad.loop.voicing import MIN_RUN, WEAK_DB
 
 COMPARABLE_DB = 10.0
 """A second line counts as a tone that can take the taxel's place when it is at most this far below the ridge."""
@@ -136,7 +137,7 @@ def follow_taxel(times, track, state, other_bin, other_excess, other_level, exce
                             f"{track[i]:.0f} Hz while the taxel's line went on: the taxel is kept on its line")
     if not np.any(role) and not np.any(left_out):
         return Identity(np.asarray(track), state, other_bin, other_excess, other_level,
-                        tuple(_segments(times, track, state, df)), ())
+                        tuple(steady_segments(times, track, state)), ())
     swapped = role & (state >= 1)
     new_track = np.where(swapped, other_hz, track)
     last = np.nan
@@ -150,12 +151,12 @@ def follow_taxel(times, track, state, other_bin, other_excess, other_level, exce
     out_excess = np.where(swapped, excess, other_excess)
     out_level = np.where(swapped, -other_level, other_level)
     kept = np.where(left_out, 0, state)
-    segments = _segments(times, new_track, kept, df) if np.any(kept >= 1) else []
+    segments = steady_segments(times, new_track, kept) if np.any(kept >= 1) else []
     for first, stop, flag in reasons:
         part = np.zeros_like(state)
         part[first:stop + 1] = state[first:stop + 1]
         if np.any(part >= 1):
-            segments += [replace(s, flag=flag) for s in _segments(times, new_track, part, df)]
+            segments += [replace(s, flag=flag) for s in steady_segments(times, new_track, part)]
     state[left_out & (state >= 1)] = 2
     return Identity(new_track, state, out_bin, out_excess, out_level,
                     tuple(sorted(segments, key=lambda s: s.start_s)), tuple(warnings))

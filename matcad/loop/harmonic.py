@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from matcad.loop.spectrum import running_median_rows
+
 LOW_HZ = 150.0
 HIGH_HZ = 2500.0
 """The detector's band: above mains fundamentals, below every taxel (4–6 kHz) with room to spare."""
@@ -45,13 +47,11 @@ def detector_band(analysis_low_hz: float) -> tuple[float, float] | None:
 def periodicity(power: np.ndarray, freqs: np.ndarray, band_hz: tuple[float, float]) -> np.ndarray:
     """Per frame (rows of ``power``, one-sided PSD at ``freqs`` Hz): the largest normalised autocorrelation of the
     excess spectrum inside ``band_hz`` at lags SPACING_HZ (0 for a frame without any excess)."""
-    from matcad.loop.analyze import _running_median_rows
-
     df = float(freqs[1] - freqs[0])
     sel = np.flatnonzero((freqs >= band_hz[0]) & (freqs <= band_hz[1]))
     tiny = np.finfo(float).tiny
     level = 10 * np.log10(power[:, sel] + tiny)
-    excess = np.clip(level - 10 * np.log10(_running_median_rows(power[:, sel], FLOOR_BINS) + tiny), 0.0, CLIP_DB)
+    excess = np.clip(level - 10 * np.log10(running_median_rows(power[:, sel], FLOOR_BINS) + tiny), 0.0, CLIP_DB)
     excess -= excess.mean(axis=1, keepdims=True)
     n = excess.shape[1]
     spectrum = np.fft.rfft(excess, n=2 * n, axis=1)

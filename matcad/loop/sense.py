@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from matcad.acoustics.load import LoadCalibration, force_at_frequency_n
+from matcad.listening import CALIBRATED_MARGIN, listening_band
 from matcad.loop import LoopError
 from matcad.loop.calibrate import t_quantile
 
@@ -113,6 +114,41 @@ class Reading:
                 "frames": int(len(self.frames_n)), "frames_with_force": int(np.sum(np.isfinite(self.frames_n))),
                 "warnings": list(self.warnings)}
 
+    def report_dict(self, analysis) -> dict:
+        """report.json of ``sense`` (beside the recording and calibration names): :meth:`to_dict`, the
+        :class:`matcad.loop.analysis.Analysis` this reading came from and the force per segment (N, null where
+        none)."""
+        return {**self.to_dict(), "analysis": analysis.to_dict(),
+                "segment_forces_n": [[None if not np.isfinite(v) else float(v) for v in row]
+                                     for row in self.segments_n]}
+
+    def detail_dict(self, analysis) -> dict:
+        """``sense --json``: :meth:`to_dict` with the analysis' tone fraction and warnings, and per segment and per
+        frame the frequency (Hz) and force with its 95 % interval (N; null where none)."""
+        frames = [{"time_s": float(t), "frequency_hz": float(f) if v else None,
+                   "force_n": None if np.isnan(force) else float(force),
+                   "force_interval_n": None if np.isnan(force) else [float(lo), float(hi)]}
+                  for t, f, v, force, (lo, hi) in zip(analysis.times_s, analysis.track_hz, analysis.voiced,
+                                                      self.frames_n, self.frames_interval_n)]
+        segments = [{**seg.to_dict(), "force_n": None if not np.isfinite(f) else float(f),
+                     "force_interval_n": None if not np.isfinite(f) else [float(lo), float(hi)]}
+                    for seg, (f, lo, hi) in zip(analysis.segments, self.segments_n)]
+        return {**self.to_dict(), "tone_fraction": analysis.tone_fraction,
+                "warnings": list(analysis.warnings) + list(self.warnings), "segments": segments, "frames": frames}
+
+    def to_text(self, source: str, analysis) -> str:
+        """What ``sense`` prints for the recording named ``source``: the overall force (when in range), the segments
+        with their forces, the warnings of the analysis and of the reading."""
+        lines = []
+        if np.isfinite(self.force_n):
+            lo, hi = self.force_interval_n
+            lines.append(f"{source}: F = {self.force_n:.3f} N (95 %: {lo:.3f} .. {hi:.3f} N) at "
+                         f"{self.frequency_hz:.2f} Hz; {int(np.sum(np.isfinite(self.frames_n)))} of "
+                         f"{len(self.frames_n)} frames with a force (tone in {100 * analysis.tone_fraction:.0f} %)")
+        lines += analysis.segments_text(self.segments_n)
+        lines += [f"  warning: {w}" for w in list(analysis.warnings) + list(self.warnings)]
+        return "\n".join(lines)
+
 
 def sense(analysis, cal: SensorCalibration, temperature_c: float | None = None) -> Reading:
     """Forces of an :class:`matcad.loop.analyze.Analysis`: per voiced frame, per segment and overall."""
@@ -137,6 +173,12 @@ def sense(analysis, cal: SensorCalibration, temperature_c: float | None = None) 
                         "force is a time average; read the segments")
     return Reading(force, (force - width, force + width), mean_f, frames,
                    np.column_stack([frames - half, frames + half]), segments, reason, tuple(warnings))
+
+
+def listening_band_hz(cal: SensorCalibration) -> tuple[float, float]:
+    """The band (Hz) ``sense`` listens in: the calibration's frequency range widened by
+    :data:`matcad.listening.CALIBRATED_MARGIN`."""
+    return listening_band(cal.frequency_range_hz(), CALIBRATED_MARGIN)
 
 
 def require_in_range(reading: Reading) -> Reading:

@@ -5,7 +5,7 @@
 - :mod:`matcad.prediction.bands` — each taxel's unloaded and loaded band, a board's conflicts and its summary.
 """
 
-from matcad.prediction.bands import TaxelBand, conflicts, guard_hz, summary, taxel_band, taxel_bands
+from matcad.prediction.bands import TaxelBand, conflicts, listening_bands, summary, taxel_band, taxel_bands
 from matcad.prediction.taxel import predict
 
-__all__ = ["TaxelBand", "conflicts", "guard_hz", "predict", "summary", "taxel_band", "taxel_bands"]
+__all__ = ["TaxelBand", "conflicts", "listening_bands", "predict", "summary", "taxel_band", "taxel_bands"]

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from matcad.listening import guard_hz
+
 HARMONICS = (2, 3)
 """Overtones of a taxel's tone that another taxel's band must avoid: an edge tone is rich in harmonics, and
 overblowing jumps to them (paper Sec. VI-B); the 2nd and 3rd are the strong ones."""
@@ -74,16 +76,6 @@ class Conflict:
         how = f"overlap by {-self.gap_hz:.0f} Hz" if self.gap_hz < 0 else f"are only {self.gap_hz:.0f} Hz apart"
         return (f"{what}, {self.band_hz[0]:.0f}-{self.band_hz[1]:.0f} Hz, and {self.other}'s loaded band, "
                 f"{self.other_hz[0]:.0f}-{self.other_hz[1]:.0f} Hz, {how} (guard {self.guard_hz:.0f} Hz)")
-
-
-def guard_hz(sample_rate_hz: float) -> float:
-    """Least gap between two taxels' bands (Hz) for the loop (:mod:`matcad.loop.analyze`) to keep them apart: a
-    tone at one band's edge spreads its Hann main lobe over ±EXCLUDE_BINS bins, and a ridge within EDGE_BINS bins
-    of a band's edge is refused as hugging it; so the gap is (EXCLUDE_BINS + EDGE_BINS) bins of the tracker's
-    zero-padded spectrum, fs / (ZERO_PAD · window). 43 Hz at 44.1 kHz (window 4096, 5.4 Hz bins)."""
-    from matcad.loop.analyze import EDGE_BINS, EXCLUDE_BINS, ZERO_PAD, window_samples
-
-    return (EXCLUDE_BINS + EDGE_BINS) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
 
 
 def conflicts(bands, guard: float, harmonics=HARMONICS) -> list[Conflict]:
@@ -188,3 +180,11 @@ def summary(spec, bands) -> dict:
             "conflicts": [{"taxel": c.taxel, "harmonic": c.harmonic, "other": c.other, "band_hz": list(c.band_hz),
                            "other_hz": list(c.other_hz), "gap_hz": c.gap_hz, "message": c.describe()}
                           for c in conflicts(bands, guard)]}
+
+
+def listening_bands(spec) -> list[tuple[str, tuple[float, float]]]:
+    """(taxel name, band Hz the recording loop listens in) per taxel of ``spec``, in taxels(spec) order: each
+    taxel's loaded band (:func:`taxel_bands`) with :data:`matcad.listening.LOADED_MARGIN`."""
+    from matcad.listening import LOADED_MARGIN, listening_band
+
+    return [(b.name, listening_band(b.loaded_hz, LOADED_MARGIN)) for b in taxel_bands(spec)]

@@ -18,7 +18,8 @@ FIX = ("move the taxels apart in frequency (`matcad design --taxels N --band LO 
 def band_separation(spec) -> list[Finding]:
     """Errors for every pair of loaded bands closer than the guard, and every 2f/3f of one taxel's loaded band
     within the guard of another's band; an info line with each taxel's bands (Hz)."""
-    from matcad.prediction.bands import conflicts, guard_hz, taxel_bands
+    from matcad.listening import guard_hz
+    from matcad.prediction.bands import conflicts, taxel_bands
     from matcad.spec import is_array
 
     if not is_array(spec):

@@ -1,0 +1,67 @@
+"""Where the recording loop listens: its analysis window, the guard that window implies between two taxels' bands,
+and the band it listens in for a taxel. Frequencies Hz, times s.
+
+The analysis window (:data:`WINDOW_S`, :data:`ZERO_PAD`) and the bins a line and a band edge take
+(:data:`EXCLUDE_BINS`, :data:`EDGE_BINS`) set how far apart two taxels' bands must be (:func:`guard_hz`); the
+design rules and the band planner read that guard here, the tracker (:mod:`matcad.loop.analyze`) reads the same
+numbers. :func:`listening_band` is the one formula for the band the loop listens in, from whichever band is known:
+an unloaded prediction (single-taxel ``analyze --spec``), a calibration's frequency range (``sense``) or a board
+taxel's loaded band (``analyze``/``sense`` of an array spec), each widened by its own :class:`Margin`.
+
+Base floor: the standard library only at module level (numpy inside :func:`window_samples`, for the same
+arithmetic as the tracker's frames).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+WINDOW_S = 0.093
+"""~4096 samples at 44.1 kHz: ~11 Hz resolution (5.4 Hz bins with 2× padding), 46 ms between frames."""
+ZERO_PAD = 2
+"""The FFT is this many window lengths long (bins of fs / (ZERO_PAD · window))."""
+EXCLUDE_BINS = 6
+"""Bins either side of a line that belong to it (Hann main lobe is ±4 bins at 2× padding)."""
+EDGE_BINS = 2
+"""A ridge within this many bins of a band's edge is refused as hugging it (the tone probably lies outside)."""
+
+
+def window_samples(fs: float) -> int:
+    """Window length (samples) at sample rate ``fs`` (Hz): the power of two nearest WINDOW_S."""
+    import numpy as np
+
+    return max(64, int(2 ** round(np.log2(WINDOW_S * fs))))
+
+
+def guard_hz(sample_rate_hz: float) -> float:
+    """Least gap between two taxels' bands (Hz) for the loop (:mod:`matcad.loop.analyze`) to keep them apart: a
+    tone at one band's edge spreads its Hann main lobe over ±EXCLUDE_BINS bins, and a ridge within EDGE_BINS bins
+    of a band's edge is refused as hugging it; so the gap is (EXCLUDE_BINS + EDGE_BINS) bins of the tracker's
+    zero-padded spectrum, fs / (ZERO_PAD · window). 43 Hz at 44.1 kHz (window 4096, 5.4 Hz bins)."""
+    return (EXCLUDE_BINS + EDGE_BINS) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
+
+
+class Margin(NamedTuple):
+    """Factors on a known band's low and high edge that give the band the loop listens in."""
+
+    low: float
+    high: float
+
+
+PREDICTED_MARGIN = Margin(0.9, 1.25)
+"""A single taxel's predicted *unloaded* band (``analyze --spec``): −10 % below for the model's error, +25 % above
+because a press raises f (+11 % at 25 N on the paper's Eq. 5 fit) on top of the model's error."""
+CALIBRATED_MARGIN = Margin(0.8, 1.25)
+"""A calibration's frequency range over its force range (``sense``): wide on both sides so that a tone just
+outside the calibrated range (a force beyond it, air warmer or colder than at calibration) is still tracked and
+reported as outside the calibrated range rather than lost as "no tone"."""
+LOADED_MARGIN = Margin(1.0, 1.0)
+"""A board taxel's *loaded* band (:func:`matcad.prediction.bands.listening_bands`): used as it is — it already
+holds the model's uncertainty and the rise under load up to the maximum force, and the bands of a valid board are
+only a guard apart, so widening one would take in a neighbour's tone."""
+
+
+def listening_band(band_hz: tuple[float, float], margin: Margin) -> tuple[float, float]:
+    """The band (low, high) Hz the loop listens in for a taxel whose known band is ``band_hz`` (Hz), widened by
+    ``margin`` (:data:`PREDICTED_MARGIN`, :data:`CALIBRATED_MARGIN` or :data:`LOADED_MARGIN`)."""
+    return band_hz[0] * margin.low, band_hz[1] * margin.high
