@@ -37,7 +37,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from matcad.loop import LoopError, synth  # noqa: E402
+from matcad.errors import LoopError  # noqa: E402
+from matcad.loop import synth  # noqa: E402
 from matcad.loop.analyze import analyze  # noqa: E402
 from matcad.loop.wav import read_mono  # noqa: E402
 

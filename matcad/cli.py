@@ -352,9 +352,9 @@ def cmd_calibrate(args) -> int:
                         cycle_std_n=args.cycle_std_n)
     target = _loop_output(args, "calibrate", str(args.data))
     with staged_output(target) as tmp:
-        outputs.write_calibration_toml(cal, tmp / "calibration.toml")
+        outputs.write_calibration_toml(cal.law, tmp / "calibration.toml")
         if args.taxel is not None:  # the same table to paste under that [[taxel]] entry of the board spec
-            outputs.write_calibration_toml(cal, tmp / "taxel_calibration.toml", args.taxel, args.spec)
+            outputs.write_calibration_toml(cal.law, tmp / "taxel_calibration.toml", args.taxel, args.spec)
         plot(cal, tmp / "residuals.png")
         outputs.write_json(tmp / "report.json", {"data": str(args.data), "spec": spec.name, **cal.to_dict()})
     if args.json:
@@ -389,7 +389,7 @@ def cmd_sense(args) -> int:
     from matcad.loop import live, outputs
     from matcad.loop.analyze import analyze_stream
     from matcad.loop.plots import plot
-    from matcad.loop.sense import SensorCalibration, listening_band_hz, require_in_range, sense
+    from matcad.loop.sense import listening_band_hz, require_in_range, sense, sensing_law
     from matcad.output import staged_output
     from matcad.spec import load_calibration
 
@@ -402,7 +402,7 @@ def cmd_sense(args) -> int:
     if len(args.calibration) != 1:
         raise ValueError(f"--calibration given {len(args.calibration)} times: several calibrations need --spec "
                          "naming an array, one NAME=FILE per taxel")
-    cal = SensorCalibration.from_spec_calibration(load_calibration(args.calibration[0]))
+    cal = sensing_law(load_calibration(args.calibration[0]))
     cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
     band = listening_band_hz(cal)
     blocks, fs, name = _recording_blocks(args)
@@ -433,13 +433,13 @@ def _sense_board(args, spec) -> int:
     from matcad.prediction.bands import listening_bands
     from matcad.loop import board, live, outputs
     from matcad.loop.plots import plot_board
-    from matcad.loop.sense import SensorCalibration
+    from matcad.loop.sense import sensing_law
     from matcad.output import staged_output
 
     named_bands = listening_bands(spec)
     names = [n for n, _ in named_bands]
     given = board.board_calibrations(spec, args.calibration)
-    cals = {n: SensorCalibration.from_spec_calibration(cal) for n, (_, cal) in given.items()}
+    cals = {n: sensing_law(cal) for n, (_, cal) in given.items()}
     for cal in cals.values():
         cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
     blocks, fs, name = _recording_blocks(args)
@@ -885,7 +885,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _dispatch(args) -> int:
     from matcad.errors import OutputError
-    from matcad.loop import LoopError
+    from matcad.errors import LoopError
     from matcad.spec import SpecError
 
     try:

@@ -18,3 +18,8 @@ class OutputError(Exception):
 
 class InputError(ValueError):
     """An input file is unusable before it is parsed (not a regular file, larger than its limit): exit code 2."""
+
+
+class LoopError(Exception):
+    """Measured data cannot give a trustworthy answer (no tone, a tone at a band edge, degenerate calibration data,
+    a force outside the calibrated range): exit code 1 with the reason."""

@@ -42,7 +42,7 @@ def board(tmp_path_factory):
     plain.write_text(_board_text())
     bands = board_bands(spec_mod.load(plain))
     f0 = [0.5 * (lo + hi) / 1.04 for _, (lo, hi) in bands]  # the middle of each band's unloaded part
-    k_hz2 = [synth.EQ5[0] * f**2 for f in f0]
+    k_hz2 = [synth.EQ5.v0_mm3 * f**2 for f in f0]
     n = int(FS * SECONDS)
     force = [synth.press_profile(SECONDS, FS, [(0.8, 2.0, 10.0), (2.6, 3.4, 10.0)]), np.full(n, 4.0)]
     x = sum(synth.taxel(synth.frequency_of_force(F, k), FS, 5 + i) for i, (F, k) in enumerate(zip(force, k_hz2)))

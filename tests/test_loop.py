@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import wave
 
@@ -9,10 +10,10 @@ import numpy as np
 import pytest
 from scipy.io import wavfile
 
-from matcad.loop import LoopError
+from matcad.acoustics.eq5fit import fit
+from matcad.errors import LoopError
 from matcad.loop.analyze import analyze
-from matcad.loop.calibrate import fit
-from matcad.loop.sense import SensorCalibration, force_with_interval
+from matcad.loop.sense import sensing_law
 from matcad.loop.wav import read_mono
 from tests.conftest import PAPER, run_cli
 
@@ -141,11 +142,10 @@ def test_force_interval_coverage():
     hits, trials = 0, 400
     for seed in range(trials):
         cal = fit(*_synthetic_calibration(seed), K)
-        sensor = SensorCalibration(cal.v0_mm3, cal.b, cal.a, cal.k_mm3_hz2, cal.covariance, cal.residual_std_mm3,
-                                   cal.dof, cal.force_range_n)
+        sensor = dataclasses.replace(cal.law, cycle_std_mm3=0.0)  # the fit's own scatter, no cycle term
         rng = np.random.default_rng(10_000 + seed)
         true_force = rng.uniform(0.5, 19.5)
-        force, half = force_with_interval(sensor, [f_of(true_force) + rng.normal(0.0, 2.0)])
+        force, half = sensor.force_with_interval([f_of(true_force) + rng.normal(0.0, 2.0)])
         hits += abs(force[0] - true_force) <= half[0]
     assert hits / trials >= 0.90, hits / trials
 
@@ -176,7 +176,7 @@ def test_calibrate_and_sense_cli(tmp_path):
     code, _, err = run_cli("predict", tmp_path / "spec.toml", "--force", "5")
     assert code == 0, err
 
-    sensor = SensorCalibration.from_spec_calibration(__import__("matcad.spec", fromlist=["x"]).load_calibration(cal_toml))
+    sensor = sensing_law(__import__("matcad.spec", fromlist=["x"]).load_calibration(cal_toml))
     true_force = 12.0
     rec = tmp_path / "press.wav"
     wavfile.write(rec, FS, (wobbling_tone(float(f_of(true_force)), wobble=3.0, snr_db=20.0) * 30000).astype(np.int16))
@@ -199,9 +199,9 @@ def test_paper_seven_load_protocol_to_28_n():
     forces = 28.0 / 2.87 * np.array([0.05, 0.17, 0.87, 1.37, 1.87, 2.37, 2.87])
     freqs = f_of(np.where(forces > 25.0, 22.0, forces)) + np.random.default_rng(1).normal(0, 1.0, 7)
     cal = fit(forces, freqs, K)
-    assert cal.force_range_n == (forces[0], forces[-2]) and cal.excluded_n == (forces[-1],)
+    assert cal.law.force_range_n == (forces[0], forces[-2]) and cal.excluded_n == (forces[-1],)
     assert any(f"holds up to {forces[-2]:g} N" in note for note in cal.notes)
-    assert np.allclose([cal.v0_mm3, cal.b, cal.a], TRUE, rtol=0.2, atol=0.01)
+    assert np.allclose([cal.law.v0_mm3, cal.law.b, cal.law.a], TRUE, rtol=0.2, atol=0.01)
 
 
 def test_outlier_named():
@@ -225,11 +225,11 @@ def force_coverage(cycles, tau_n, cycle_std_n=None, trials=300):
     hits = 0
     for seed in range(trials):
         forces, freqs, labels = _cycles(seed, cycles, tau_n)
-        sensor = SensorCalibration.from_fit(fit(forces, freqs, K, cycles=labels, cycle_std_n=cycle_std_n))
+        sensor = fit(forces, freqs, K, cycles=labels, cycle_std_n=cycle_std_n).law
         rng = np.random.default_rng(50_000 + seed)
         true_force = rng.uniform(0.5, 19.5)
         heard = f_of(true_force + rng.normal(0.0, tau_n)) + rng.normal(0.0, 2.0)
-        force, half = force_with_interval(sensor, [heard])
+        force, half = sensor.force_with_interval([heard])
         hits += abs(force[0] - true_force) <= half[0]
     return hits / trials
 

@@ -7,13 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from matcad.loop import LoopError, synth
+from matcad.errors import LoopError
+from matcad.loop import synth
 from matcad.loop.board import analyze_board, parse_calibrations, sense_board
 from matcad.loop.outputs import write_board_forces_csv as write_forces_csv
 from matcad.loop.outputs import write_board_segments_csv as write_segments_csv
 from matcad.loop.outputs import write_board_track_csv as write_track_csv
-from matcad.loop.calibrate import fit
-from matcad.loop.sense import SensorCalibration
+from matcad.acoustics.eq5fit import fit
 
 HOP_S = 0.0464
 
@@ -51,7 +51,7 @@ def test_presses_show_on_the_pressed_taxels_only(board):
     rec, tracks = board
     for k, t in enumerate(tracks):
         f0 = synth.BOARD_F0_HZ[k]
-        k_hz2 = synth.EQ5[0] * f0**2
+        k_hz2 = synth.EQ5.v0_mm3 * f0**2
         high = [s for s in t.analysis.segments
                 if abs(s.mean_hz - synth.frequency_of_force(12.0, k_hz2)) < 10 and s.frames >= 5]
         if k in (1, 3):
@@ -62,8 +62,8 @@ def test_presses_show_on_the_pressed_taxels_only(board):
 
 def _cal(k):
     forces = np.linspace(0.0, 15.0, 11)
-    k_hz2 = synth.EQ5[0] * synth.BOARD_F0_HZ[k] ** 2
-    return SensorCalibration.from_fit(fit(forces, synth.frequency_of_force(forces, k_hz2), k_hz2))
+    k_hz2 = synth.EQ5.v0_mm3 * synth.BOARD_F0_HZ[k] ** 2
+    return fit(forces, synth.frequency_of_force(forces, k_hz2), k_hz2).law
 
 
 def test_force_per_taxel_over_time_and_csv_columns(board, tmp_path):
@@ -84,7 +84,7 @@ def test_force_per_taxel_over_time_and_csv_columns(board, tmp_path):
     assert len(rows) == len(tracks[0].analysis.times_s) and len(head.split(",")) == 13
     col = head.split(",").index("t3_frequency_hz")
     heard = np.array([float(r.split(",")[col]) for r in rows if r.split(",")[col]])
-    assert abs(np.mean(heard) - synth.frequency_of_force(4.0, synth.EQ5[0] * synth.BOARD_F0_HZ[2] ** 2)) < 1.0
+    assert abs(np.mean(heard) - synth.frequency_of_force(4.0, synth.EQ5.v0_mm3 * synth.BOARD_F0_HZ[2] ** 2)) < 1.0
     head, *rows = (tmp_path / "forces.csv").read_text().splitlines()
     names = head.split(",")
     assert names[:5] == ["time_s", "t1_frequency_hz", "t1_force_n", "t1_force_low_n", "t1_force_high_n"]
@@ -164,7 +164,7 @@ def test_cli_analyze_and_sense_an_array_spec(tmp_path):
     n = int(fs * seconds)
     # each taxel sings at the middle of its band's unloaded part, the low one pressed 2 -> 10 N
     f0 = [0.5 * (lo + hi) / 1.04 for _, (lo, hi) in bands]
-    k_hz2 = [synth.EQ5[0] * f**2 for f in f0]
+    k_hz2 = [synth.EQ5.v0_mm3 * f**2 for f in f0]
     force = [synth.press_profile(seconds, fs, [(1.0, 2.5, 10.0), (3.2, 4.2, 10.0)]), np.full(n, 4.0)]
     x = sum(synth.taxel(synth.frequency_of_force(F, k), fs, 5 + i) for i, (F, k) in enumerate(zip(force, k_hz2)))
     x = synth._room(x, fs, 3)
@@ -182,7 +182,7 @@ def test_cli_analyze_and_sense_an_array_spec(tmp_path):
     # sense: the low taxel calibrated, the high one not (frequencies only)
     forces = np.linspace(0.0, 15.0, 11)
     cal = tmp_path / "low.toml"
-    cal.write_text(fit(forces, synth.frequency_of_force(forces, k_hz2[0]), k_hz2[0]).to_toml())
+    cal.write_text(fit(forces, synth.frequency_of_force(forces, k_hz2[0]), k_hz2[0]).law.to_toml())
     code, out, err = run_cli("sense", tmp_path / "rec.wav", "--spec", path, "--calibration", f"low={cal}",
                              "--json", "--out", tmp_path / "s")
     assert code == 0, err

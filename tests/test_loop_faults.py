@@ -16,8 +16,8 @@ import pytest
 from matcad.listening import CALIBRATED_MARGIN, LOADED_MARGIN, PREDICTED_MARGIN, listening_band
 from matcad.loop import synth
 from matcad.loop.analyze import analyze
-from matcad.loop.calibrate import fit
-from matcad.loop.sense import SensorCalibration, force_with_interval, listening_band_hz, sense
+from matcad.acoustics.eq5fit import fit
+from matcad.loop.sense import listening_band_hz, sense, sensing_law
 from matcad.loop.voicing import Voicing
 from tests.conftest import PAPER, run_cli
 
@@ -44,7 +44,7 @@ def test_analyze_spec_listens_in_the_predicted_band_widened_and_finds_the_tone(t
     """`analyze REC --spec` of a single taxel: the band the report states is the predicted unloaded band −10 %
     / +25 %, and a tone inside it is found."""
     from matcad import spec as spec_mod
-    from matcad.acoustics.predict import predict
+    from matcad.prediction import predict
 
     lo, hi = predict(spec_mod.load(PAPER)).band_hz
     freq = 0.5 * (lo + hi)
@@ -67,16 +67,16 @@ def test_analyze_spec_listens_in_the_predicted_band_widened_and_finds_the_tone(t
 
 @pytest.fixture(scope="module")
 def calibration(tmp_path_factory):
-    """(SensorCalibration read back from a calibration.toml, the TOML's table): Eq. 5 fitted to the paper's b and a
+    """(the Eq. 5 law read back from a calibration.toml, the TOML's table): Eq. 5 fitted to the paper's b and a
     (synth.EQ5) over 0-20 N, 1 Hz scatter, calibrated at 20 °C."""
     forces = np.tile(np.linspace(0.0, 20.0, 11), 2)
     freqs = synth.frequency_of_force(forces) + np.random.default_rng(5).normal(0.0, 1.0, len(forces))
     path = tmp_path_factory.mktemp("cal") / "calibration.toml"
-    path.write_text(fit(forces, freqs, synth.K_MM3_HZ2, temperature_c=20.0).to_toml(), encoding="utf-8")
+    path.write_text(fit(forces, freqs, synth.K_MM3_HZ2, temperature_c=20.0).law.to_toml(), encoding="utf-8")
     from matcad.spec import load_calibration
 
     table = tomllib.loads(path.read_text())["calibration"]
-    return SensorCalibration.from_spec_calibration(load_calibration(path)), table
+    return sensing_law(load_calibration(path)), table
 
 
 def test_sense_band_is_the_calibrated_range_widened(calibration):
@@ -99,7 +99,7 @@ def test_sense_force_of_a_tone(calibration):
     reading = sense(analysis, cal)
     assert reading.force_n == pytest.approx(8.0, abs=0.3)
     assert reading.force_interval_n[0] < 8.0 < reading.force_interval_n[1]
-    force, _ = force_with_interval(cal, synth.frequency_of_force([2.0, 15.0]))
+    force, _ = cal.force_with_interval(synth.frequency_of_force([2.0, 15.0]))
     assert force == pytest.approx([2.0, 15.0], abs=0.3)
 
 
@@ -110,8 +110,8 @@ def test_temperature_correction_direction(calibration):
     assert cal.temperature_factor(30.0) == pytest.approx(math.sqrt(293.15 / 303.15), rel=1e-12)
     assert cal.temperature_factor(None) == 1.0
     heard = float(synth.frequency_of_force(8.0)) * math.sqrt(303.15 / 293.15)
-    same, _ = force_with_interval(cal, [float(synth.frequency_of_force(8.0))])
-    fixed, _ = force_with_interval(cal, [heard], temperature_c=30.0)
+    same, _ = cal.force_with_interval([float(synth.frequency_of_force(8.0))])
+    fixed, _ = cal.force_with_interval([heard], temperature_c=30.0)
     assert fixed[0] == pytest.approx(same[0], abs=1e-9)
     reading = sense(analyze(_tone(heard, 2.0), FS, listening_band_hz(cal)), cal, 30.0)
     assert reading.force_n == pytest.approx(8.0, abs=0.3)

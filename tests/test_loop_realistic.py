@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 from scipy.io import wavfile
 
-from matcad.loop import LoopError, synth
+from matcad.errors import LoopError
+from matcad.loop import synth
 from matcad.loop.analyze import analyze, analyze_stream
 from tests.conftest import ROOT, run_cli
 
@@ -213,15 +214,13 @@ def test_sense_per_segment_csv_plot_and_live_stdin(tmp_path):
 
 def test_temperature_compensation(tmp_path):
     """3 °C warmer air raises f by sqrt(T/T_cal) (~0.5 %, ~23 Hz ≈ 0.8 N); --temperature-c removes it."""
-    from matcad.loop.calibrate import fit
-    from matcad.loop.sense import SensorCalibration, force_with_interval
+    from matcad.acoustics.eq5fit import fit
 
     forces = np.linspace(0.0, 20.0, 11)
-    cal = SensorCalibration.from_fit(fit(forces, synth.frequency_of_force(forces), synth.K_MM3_HZ2,
-                                         temperature_c=20.0))
+    cal = fit(forces, synth.frequency_of_force(forces), synth.K_MM3_HZ2, temperature_c=20.0).law
     heard = synth.frequency_of_force(10.0) * np.sqrt((23.0 + 273.15) / (20.0 + 273.15))
-    raw, _ = force_with_interval(cal, [heard])
-    fixed, _ = force_with_interval(cal, [heard], temperature_c=23.0)
+    raw, _ = cal.force_with_interval([heard])
+    fixed, _ = cal.force_with_interval([heard], temperature_c=23.0)
     assert raw[0] - 10.0 > 0.5 and fixed[0] == pytest.approx(10.0, abs=1e-6)
     with pytest.raises(ValueError, match="temperature"):
-        force_with_interval(cal, [heard], temperature_c=500.0)
+        cal.force_with_interval([heard], temperature_c=500.0)

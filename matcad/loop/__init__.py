@@ -5,9 +5,6 @@ Recordings in (``wav``) → spectra and the floor (``spectrum``) → combs remov
 (``ridge``) → voicing (``voicing``) → segments (``segments``) → the result (``analysis``, via ``crossing``), wired
 by ``tracker`` and driven by ``analyze``; a board of taxels (``board``); Eq. 5 fitted (``calibrate``) and read
 back as force (``sense``); what it writes (``outputs``, ``plots``) and prints live (``live``). Where it listens:
-:mod:`matcad.listening`."""
+:mod:`matcad.listening`. When the data cannot give a trustworthy answer it raises :class:`matcad.errors.LoopError`
+(exit code 1)."""
 
-
-class LoopError(Exception):
-    """The data cannot give a trustworthy answer (no tone, tone at a band edge, degenerate calibration):
-    exit code 1 with the reason."""

@@ -1,7 +1,7 @@
 """The result of analysing one band of a recording, and how it is concluded from the frames the tracker decided.
 
 :func:`conclude` takes every frame of the band (:class:`Frames`) and gives the :class:`Analysis`, or the reason there
-is none (:class:`matcad.loop.LoopError`): it keeps the taxel on its own line through hops and crossings of a second
+is none (:class:`matcad.errors.LoopError`): it keeps the taxel on its own line through hops and crossings of a second
 tone (:mod:`matcad.loop.crossing`), leaves out flagged segments (mode jumps, blends), refuses a ridge that hugs the
 band edge, and reports other sources — a second stable line in the band (a neighbouring taxel) with its frequency
 and level; a stronger tone outside the band (hum, a harmonic), never taken. Frequencies Hz, times s, levels dB.
@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from matcad.listening import EDGE_BINS, WINDOW_S, window_samples
-from matcad.loop import LoopError, crossing
+from matcad.errors import LoopError
+from matcad.loop import crossing
 from matcad.loop.segments import Segment
 from matcad.loop.spectrum import BandBins
 from matcad.loop.voicing import MIN_RUN, MIN_RUN_HARMONIC, STABLE_BINS, STRONG_DB, WEAK_DB, longest_run

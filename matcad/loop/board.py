@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.loop import LoopError
+from matcad.errors import LoopError
 from matcad.loop.analysis import Analysis
 from matcad.loop.analyze import run_trackers
 from matcad.loop.sense import sense
@@ -168,7 +168,7 @@ class LiveFrames:
 
 def sense_board(tracks, calibrations, temperature_c=None) -> dict:
     """{taxel name: :class:`matcad.loop.sense.Reading`} for every taxel that has a tone and a calibration
-    (``calibrations``: {name: SensorCalibration}); raises LoopError when none of them has a force in its
+    (``calibrations``: {name: :class:`matcad.acoustics.eq5.Eq5`}); raises LoopError when none of them has a force in its
     calibrated range."""
     readings = {t.name: sense(t.analysis, calibrations[t.name], temperature_c)
                 for t in tracks if t.analysis is not None and t.name in calibrations}

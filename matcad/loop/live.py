@@ -11,15 +11,14 @@ from __future__ import annotations
 import numpy as np
 
 from matcad.loop.board import LiveFrames
-from matcad.loop.sense import force_with_interval
 
 
 def taxel_line(cal, temperature_c, time_s: float, freq: float) -> str:
     """One frame of one taxel heard at ``freq`` (Hz, NaN: no tone) through calibration ``cal``
-    (:class:`matcad.loop.sense.SensorCalibration`) at ``temperature_c`` (°C)."""
+    (:class:`matcad.acoustics.eq5.Eq5`) at ``temperature_c`` (°C)."""
     if freq != freq:
         return f"{time_s:9.3f} s  no tone"
-    force, half = force_with_interval(cal, [freq], temperature_c=temperature_c)
+    force, half = cal.force_with_interval([freq], temperature_c=temperature_c)
     text = f"F = {force[0]:.3f} +- {half[0]:.3f} N" if np.isfinite(force[0]) else "outside the calibrated range"
     return f"{time_s:9.3f} s  {freq:9.2f} Hz  {text}"
 
@@ -34,14 +33,14 @@ def taxel_printer(cal, temperature_c, emit):
 
 def board_line(names, cals, temperature_c, time_s: float, values) -> str:
     """One frame of a board: per taxel of ``names`` its frequency (Hz) and, with a calibration in ``cals``
-    ({name: SensorCalibration}), its force at ``temperature_c`` (°C); ``values``: (frequency Hz or NaN, excess dB)
+    ({name: Eq5}), its force at ``temperature_c`` (°C); ``values``: (frequency Hz or NaN, excess dB)
     per taxel."""
     def taxel_text(taxel, freq):
         if freq != freq:
             return f"{taxel} no tone"
         text = f"{taxel} {freq:.2f} Hz"
         if taxel in cals:
-            force, half = force_with_interval(cals[taxel], [freq], temperature_c=temperature_c)
+            force, half = cals[taxel].force_with_interval([freq], temperature_c=temperature_c)
             text += (f" F={force[0]:.3f}+-{half[0]:.3f} N" if np.isfinite(force[0])
                      else " outside the calibrated range")
         return text

@@ -155,7 +155,7 @@ def write_board_forces_csv(tracks, readings, path: Path) -> None:
 
 
 def write_calibration_toml(cal, path: Path, taxel: str | None = None, spec_path=None) -> None:
-    """calibration.toml: the [calibration] table of a :class:`matcad.loop.calibrate.CalibrationFit`; with ``taxel``
+    """calibration.toml: the [calibration] table of a fitted :class:`matcad.acoustics.eq5.Eq5`; with ``taxel``
     the [taxel.calibration] table to paste under that [[taxel]] entry of the board spec ``spec_path``."""
     if taxel is None:
         path.write_text(cal.to_toml(), encoding="utf-8")

@@ -18,79 +18,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from matcad.acoustics.load import LoadCalibration, force_at_frequency_n
+from matcad.acoustics.eq5 import Eq5
+from matcad.errors import LoopError
 from matcad.listening import CALIBRATED_MARGIN, listening_band
-from matcad.loop import LoopError
-from matcad.loop.calibrate import t_quantile
-
-RANGE_TOLERANCE = 0.02
-"""Forces within 2 % of the calibrated span beyond its ends still count as inside it."""
-KELVIN = 273.15
 
 
-@dataclass(frozen=True)
-class SensorCalibration:
-    """What sensing needs from a calibration (spec [calibration] with the fit's fields)."""
+def sensing_law(cal) -> Eq5:
+    """The :class:`~matcad.acoustics.eq5.Eq5` that sensing reads forces through, from a spec's or a calibration
+    file's [calibration] table; ValueError (exit 2) when the table lacks what only `matcad calibrate` writes."""
+    from matcad.acoustics.design import eq5
 
-    v0_mm3: float
-    b: float
-    a: float
-    k_mm3_hz2: float
-    covariance: np.ndarray
-    residual_std_mm3: float
-    dof: int
-    force_range_n: tuple[float, float]
-    cycle_std_mm3: float = 0.0
-    temperature_c: float | None = None
-
-    @classmethod
-    def from_spec_calibration(cls, cal) -> "SensorCalibration":
-        missing = [k for k in ("k_mm3_hz2", "covariance", "residual_std_mm3", "dof", "force_range_n")
-                   if getattr(cal, k) is None]
-        if missing:
-            raise ValueError(f"calibration lacks {', '.join(missing)}: sensing needs a calibration written by "
-                             "`matcad calibrate`")
-        return cls(cal.v0_mm3, cal.b, cal.a, cal.k_mm3_hz2, np.array(cal.covariance).reshape(3, 3),
-                   cal.residual_std_mm3, cal.dof, tuple(cal.force_range_n), cal.cycle_std_mm3 or 0.0,
-                   cal.temperature_c)
-
-    @classmethod
-    def from_fit(cls, fit) -> "SensorCalibration":
-        """From a :class:`matcad.loop.calibrate.CalibrationFit`."""
-        return cls(fit.v0_mm3, fit.b, fit.a, fit.k_mm3_hz2, fit.covariance, fit.residual_std_mm3, fit.dof,
-                   fit.force_range_n, fit.cycle_std_mm3, fit.temperature_c)
-
-    def frequency_range_hz(self) -> tuple[float, float]:
-        ends = [float(np.sqrt(self.k_mm3_hz2 / (self.v0_mm3 - self.b * f - self.a * f * f)))
-                for f in self.force_range_n]
-        return min(ends), max(ends)
-
-    def temperature_factor(self, temperature_c: float | None) -> float:
-        """sqrt(T_cal/T) that maps a frequency heard at ``temperature_c`` to calibration conditions (1 when either
-        temperature is unknown). Raises ValueError when only the recording's is known."""
-        if temperature_c is None:
-            return 1.0
-        if not -60.0 <= temperature_c <= 100.0:
-            raise ValueError(f"--temperature-c {temperature_c:g} invalid, must be -60 to 100 degC")
-        if self.temperature_c is None:
-            raise ValueError("--temperature-c needs a calibration that records its temperature_c (calibrate with "
-                             "--temperature-c)")
-        return float(np.sqrt((self.temperature_c + KELVIN) / (temperature_c + KELVIN)))
-
-
-def force_with_interval(cal: SensorCalibration, frequency_hz, level: float = 0.95, temperature_c=None):
-    """(force, half-width of its ``level`` interval) (N) at each frequency (Hz) heard at ``temperature_c`` (°C);
-    NaN outside the calibrated range."""
-    f = np.asarray(frequency_hz, dtype=float) * cal.temperature_factor(temperature_c)
-    force = force_at_frequency_n(LoadCalibration(cal.v0_mm3, cal.a, cal.b, k_mm3_hz2=cal.k_mm3_hz2), f, 0.0, 1.0, 1.0)
-    lo, hi = cal.force_range_n
-    slack = RANGE_TOLERANCE * (hi - lo)
-    force = np.where((force >= lo - slack) & (force <= hi + slack), force, np.nan)
-    slope = cal.b + 2 * cal.a * force  # −∂y/∂F
-    grad = np.stack([np.ones_like(force), -force, -force * force]) / slope
-    scatter = cal.residual_std_mm3 ** 2 + cal.cycle_std_mm3 ** 2
-    var = np.einsum("i...,ij,j...->...", grad, cal.covariance, grad) + scatter / slope ** 2
-    return force, t_quantile(0.5 + level / 2, cal.dof) * np.sqrt(var)
+    missing = [k for k in ("k_mm3_hz2", "covariance", "residual_std_mm3", "dof", "force_range_n")
+               if getattr(cal, k) is None]
+    if missing:
+        raise ValueError(f"calibration lacks {', '.join(missing)}: sensing needs a calibration written by "
+                         "`matcad calibrate`")
+    return eq5(cal)
 
 
 @dataclass(frozen=True)
@@ -150,15 +93,16 @@ class Reading:
         return "\n".join(lines)
 
 
-def sense(analysis, cal: SensorCalibration, temperature_c: float | None = None) -> Reading:
-    """Forces of an :class:`matcad.loop.analyze.Analysis`: per voiced frame, per segment and overall."""
+def sense(analysis, cal: Eq5, temperature_c: float | None = None) -> Reading:
+    """Forces of an :class:`matcad.loop.analysis.Analysis` through a calibration (:meth:`Eq5.force_with_interval`):
+    per voiced frame, per segment and overall."""
     track = np.where(analysis.voiced, analysis.track_hz, np.nan)
-    frames, half = force_with_interval(cal, track, temperature_c=temperature_c)
+    frames, half = cal.force_with_interval(track, temperature_c=temperature_c)
     seg_f = np.array([s.mean_hz if not s.flag else np.nan for s in analysis.segments])
-    seg_force, seg_half = force_with_interval(cal, seg_f, temperature_c=temperature_c)
+    seg_force, seg_half = cal.force_with_interval(seg_f, temperature_c=temperature_c)
     segments = np.column_stack([seg_force, seg_force - seg_half, seg_force + seg_half]).reshape(-1, 3)
     mean_f = analysis.mean_hz
-    force, width = force_with_interval(cal, np.array([mean_f]), temperature_c=temperature_c)
+    force, width = cal.force_with_interval(np.array([mean_f]), temperature_c=temperature_c)
     force, width = float(force[0]), float(width[0])
     reason = ""
     if not np.isfinite(force):
@@ -175,7 +119,7 @@ def sense(analysis, cal: SensorCalibration, temperature_c: float | None = None) 
                    np.column_stack([frames - half, frames + half]), segments, reason, tuple(warnings))
 
 
-def listening_band_hz(cal: SensorCalibration) -> tuple[float, float]:
+def listening_band_hz(cal: Eq5) -> tuple[float, float]:
     """The band (Hz) ``sense`` listens in: the calibration's frequency range widened by
     :data:`matcad.listening.CALIBRATED_MARGIN`."""
     return listening_band(cal.frequency_range_hz(), CALIBRATED_MARGIN)

@@ -14,23 +14,24 @@ Every generator is a pure function of its arguments and seed. Frequencies Hz, ti
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from matcad.acoustics.eq5 import Eq5
+
 FS = 44100.0
-EQ5 = (37.8, 0.4626, -0.0086)
-"""(V0 mm³, b mm³/N, a mm³/N²) with the paper's b and a (paper Eq. 5, Fig. 9)."""
-K_MM3_HZ2 = EQ5[0] * 4400.0**2
+EQ5 = Eq5(v0_mm3=37.8, a=-0.0086, b=0.4626, name="synthetic")
+"""Eq. 5 with the paper's b and a (paper Eq. 5, Fig. 9) and V0 = 37.8 mm³ (mm³, mm³/N², mm³/N)."""
+K_MM3_HZ2 = EQ5.v0_mm3 * 4400.0**2
 """K = c²A/(4π² l) (mm³·Hz²) chosen so that the taxel sings 4.40 kHz unloaded, 4.67 kHz at 12 N, as the
 paper's did (Fig. 6, Fig. 7)."""
 
 
 def frequency_of_force(force_n, k_mm3_hz2: float = K_MM3_HZ2, eq5=EQ5):
-    """Paper Eq. 5: f = sqrt(K / (V0 − bF − aF²)) (Hz)."""
-    v0, b, a = eq5
-    f = np.asarray(force_n, dtype=float)
-    return np.sqrt(k_mm3_hz2 / (v0 - b * f - a * f * f))
+    """Paper Eq. 5: f = sqrt(K / (V0 − aF² − bF)) (Hz) with ``eq5``'s constants and this K (mm³·Hz²)."""
+    return dataclasses.replace(eq5, k_mm3_hz2=k_mm3_hz2).frequency_hz(force_n)
 
 
 @dataclass(frozen=True)
@@ -314,7 +315,7 @@ def board_scenario(seconds: float = 10.0, seed: int = 0, fs: float = FS, f0_hz=B
         else:
             force = np.full(n, 4.0)
         forces.append(force)
-        freqs.append(frequency_of_force(force, EQ5[0] * f0**2))
+        freqs.append(frequency_of_force(force, EQ5.v0_mm3 * f0**2))
     x = sum(taxel(f, fs, seed + 11 * k, amplitude=a) for k, (f, a) in enumerate(zip(freqs, amplitudes)))
     x = _room(x, fs, seed, rt60=0.4)
     return BoardRecording(x, fs, tuple(f"t{k + 1}" for k in range(len(f0_hz))), np.array(freqs), np.array(forces),

@@ -74,7 +74,8 @@ def deformed_resonator(res: Resonator, volume_mm3: float, length_mm: float, neck
 def force_curve(d: Design, curve: CapCurve, f0_hz: float | None = None, fem_level: int | None = None) -> ForceCurve:
     """f(F) of design ``d`` along ``curve``; ``f0_hz`` the unloaded ladder's chosen f0 (default: the transmission
     line's); ``fem_level`` runs the FEM on every deformed outline and makes it the route of the shift."""
-    from matcad.loop.calibrate import LoopError, fit
+    from matcad.acoustics.eq5fit import fit
+    from matcad.errors import LoopError
 
     res = resonator(d)
     line = registry.model("transmission_line")
@@ -106,7 +107,7 @@ def force_curve(d: Design, curve: CapCurve, f0_hz: float | None = None, fem_leve
     eq5 = eq5_paper = None
     note = ""
     try:
-        cal = fit(forces, f, k)
+        cal = fit(forces, f, k).law
         eq5 = Eq5(cal.v0_mm3, cal.a, cal.b, area_convention="pi_d2/4", name="mechanics")
         # A = d²/4 is A(πd²/4)/π: every volume of the fit scales by 1/π
         eq5_paper = Eq5(cal.v0_mm3 / np.pi, cal.a / np.pi, cal.b / np.pi, area_convention="d2/4", name="mechanics")
