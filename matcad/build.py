@@ -16,7 +16,7 @@ from matcad.output import MANIFEST, staged_output
 from matcad.export.dxf_svg import write_dxf, write_svg
 from matcad.parts.catalogue import laser_parts, needs_cad_kernel, printed_parts
 from matcad.parts.flat import cut_plan
-from matcad.rules import Finding, check, errors
+from matcad.rules import Finding, check, errors, findings_text
 
 
 UNFORCEABLE = ("laser.drawn_size", "needle.bore")
@@ -30,14 +30,50 @@ class DesignRuleFailure(Exception):
         self.findings = findings
         super().__init__("; ".join(f"{f.id}: {f.message}" for f in errors(findings)))
 
+    def to_dict(self) -> dict:
+        """`matcad build --json` of a refused build: nothing written, every finding."""
+        return {"verdict": "fail", "written": [], "findings": [f.to_dict() for f in self.findings]}
+
+    def to_text(self) -> str:
+        """The errors that refused the build."""
+        return findings_text(errors(self.findings))
+
 
 @dataclass(frozen=True)
 class BuildResult:
+    """A built kit: its folder, the files in it, the rule findings, the (first taxel's) prediction and the report
+    data."""
+
     out_dir: Path
     files: tuple[str, ...]
     findings: tuple[Finding, ...]
     prediction: Prediction
     report: dict
+
+    @property
+    def board(self) -> list[dict] | None:
+        """Each taxel's bands (report data) when the kit is a board's, else None: a board has no single f0."""
+        return self.report["bands"]["taxels"] if "taxels" in self.report else None
+
+    def to_dict(self) -> dict:
+        """`matcad build --json`: verdict, folder, files, f0 and band (Hz; a board: its taxels' bands), findings."""
+        board, p = self.board, self.prediction
+        return ({"verdict": self.report["verdict"], "out_dir": str(self.out_dir), "written": list(self.files),
+                 "f0_hz": None if board else p.f0_hz, "band_hz": None if board else list(p.band_hz)}
+                | ({"taxels": board} if board else {}) | {"findings": [f.to_dict() for f in self.findings]})
+
+    def to_text(self, name: str) -> str:
+        """What `matcad build` prints for the spec ``name``: the files, each taxel's f0 and bands (Hz), the verdict
+        and the findings worth reading (no info)."""
+        board, p = self.board, self.prediction
+        lines = [f"{name}: {len(self.files)} files in {self.out_dir}/"] + [f"  {file}" for file in self.files]
+        lines += [f"{t['name']} at ({t['x_mm']:g}, {t['y_mm']:g}) mm: f0 = {t['f0_hz']:.0f} Hz ({t['model']}), band "
+                  f"{t['unloaded_hz'][0]:.0f}-{t['unloaded_hz'][1]:.0f} Hz, loaded to {t['max_force_n']:g} N "
+                  f"{t['loaded_hz'][0]:.0f}-{t['loaded_hz'][1]:.0f} Hz" for t in board or ()]
+        lines.append((f"{len(board)} taxels" if board else f"f0 = {p.f0_hz:.0f} Hz ({p.model}), band "
+                      f"{p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz") + f"; verdict {self.report['verdict']}")
+        lines.append(findings_text([f for f in self.findings if f.level != "info"]))
+        return "\n".join(lines)
 
 
 def default_out_dir(spec, suffix: str = "", root: Path = Path("out")) -> Path:

@@ -1,4 +1,22 @@
-"""Exceptions the CLI maps to exit codes (kept import-light: the CLI loads this on every command)."""
+"""The exit-code table and the exceptions the CLI maps to it (kept import-light: the CLI loads this on every
+command).
+
+  0   ok
+  1   design-rule failure, or for analyze/calibrate/sense no trustworthy result (no tone, a tone at the band
+      edge, degenerate or flat data, a force outside the calibrated range): :class:`LoopError`
+  2   bad input or unusable file (spec, data, recording, output folder, the file system refusing a write):
+      ``SpecError``, :class:`InputError`, :class:`OutputError`, a ValueError raised by matcad's own code
+  70  internal error (a bug): one line "internal error, please report" with the path of a log holding the
+      traceback (in the temporary folder, never under $HOME) — never 1, which is reserved for the rules
+  130 interrupted (Ctrl-C, SIGINT), anywhere, including while the CAD kernel loads; no traceback
+  143 terminated (SIGTERM), handled exactly like an interrupt
+"""
+
+EXIT_OK, EXIT_RULES, EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPT, EXIT_TERMINATED = 0, 1, 2, 70, 130, 143
+EXIT_CODES = {EXIT_OK: "ok", EXIT_RULES: "design-rule failure or no trustworthy result",
+              EXIT_INPUT: "bad input or unusable file", EXIT_INTERNAL: "internal error (please report)",
+              EXIT_INTERRUPT: "interrupted (SIGINT)", EXIT_TERMINATED: "terminated (SIGTERM)"}
+"""One row per exit code, enforced by :func:`matcad.cli.main`."""
 
 ECHO_MAX_CHARS = 80
 """Longest echo of a user's value in a message: a 100 MB field must not come back as a 100 MB error."""

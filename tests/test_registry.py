@@ -190,9 +190,9 @@ def test_every_registered_part_of_the_paper_template_renders_and_reads_back(pape
 def test_model_registry_is_the_one_list():
     from matcad.acoustics import registry as models
     from matcad.acoustics.registry import cheap_models, model_errors
-    from matcad.cli import _parser
+    from matcad.commands import parser as build_parser
 
-    parser = _parser()
+    parser = build_parser()
     predict = next(a for a in parser._subparsers._group_actions[0].choices["predict"]._actions
                    if "--model" in a.option_strings)
     assert list(predict.choices) == models.model_choices()

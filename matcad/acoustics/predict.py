@@ -72,6 +72,60 @@ class Prediction:
         d["band_hz"] = list(self.band_hz)
         return d
 
+    def to_text(self, name: str, d: Design) -> str:
+        """What `matcad predict` prints for the taxel ``name`` of design ``d``: its geometry and air, every model's
+        f0 with its failed checks (the chosen one starred), the band and its budget, the load curve and the
+        warnings (mm, Hz)."""
+        lines = [
+            f"{name}: cavity D {d.cavity_diameter:g} x L {d.cavity_length:g} mm, neck d {d.neck_diameter:g} x "
+            f"l {d.neck_length:g} mm, mouth {d.mouth}, wall {d.wall.model}",
+            f"  cavity volume   {self.cavity_volume_mm3:10.4f} mm^3    neck area {self.neck_area_mm2:.4f} mm^2",
+            f"  A*l/V           {self.neck_air_ratio:10.4f}         xi = d/D  {self.diameter_ratio:.4f}",
+            f"  speed of sound  {self.speed_of_sound_m_s:10.2f} m/s     end corrections: outer "
+            f"{self.outer_end_correction_mm:.3f} mm, inner {self.inner_end_correction_mm:.3f} mm",
+            "",
+            f"  {'model':<18} {'f0 [Hz]':>9}  {'valid':<5}  failed checks",
+        ]
+        for model, r in self.models.items():
+            failed = ", ".join(k for k, ok in r.checks.items() if not ok) or "-"
+            mark = "*" if model == self.model else " "
+            lines.append(f"{mark} {model:<18} {r.f0_hz:9.1f}  {'yes' if r.valid else 'no':<5}  {failed}")
+        lines += ["", f"  f0 = {self.f0_hz:.0f} Hz ({self.model}), band {self.band_hz[0]:.0f}-{self.band_hz[1]:.0f} "
+                      "Hz (root-sum-square in ln f of):"]
+        lines += [f"    {b.source:<28} {b.tolerance:<52} {b.low_hz:+8.1f} {b.high_hz:+8.1f} Hz" for b in self.budget]
+        if self.load_curve:
+            lines += self.load_curve_text()
+        if self.warnings:
+            lines += ["", "  warnings:"] + [f"  - {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+    def load_curve_text(self) -> list[str]:
+        """The load curve by source (Eq. 5 calibration, cap mechanics) and the mechanics' summary, as lines (N, Hz,
+        mm, mm³)."""
+        lines = []
+        for source in dict.fromkeys(pt.source for pt in self.load_curve):
+            lines += ["", f"  load curve from {source}:", f"  {'F [N]':>9} {'f [Hz]':>9} {'x [mm]':>8} {'V [mm^3]':>9}"]
+            for pt in (q for q in self.load_curve if q.source == source):
+                if pt.f_hz is None:
+                    lines.append(f"  {pt.force_n:9.3f} {'n/a':>9}  {pt.reason}")
+                    continue
+                x, v = (f"{q:8.3f}" if q is not None else f"{'-':>8}" for q in (pt.displacement_mm,
+                                                                             pt.cavity_volume_mm3))
+                lines.append(f"  {pt.force_n:9.3f} {pt.f_hz:9.1f} {x} {v:>9}")
+        m = self.load_model
+        if m:
+            turn = f"stops rising at {m['turn_force_n']:.3g} N" if m["turn_force_n"] is not None else \
+                f"still rising at the curve's end, {m['max_force_n']:.3g} N"
+            lines += [f"  cap mechanics: df/dF = {m['sensitivity_hz_per_n_at_0']:.1f} Hz/N at 0 N; f {turn}; "
+                      f"f shift by {m['route']}; {m['nodes']} nodes, {m['seconds']:.1f} s"]
+            for key in ("eq5", "eq5_paper_convention"):
+                if m[key]:
+                    e = m[key]
+                    lines.append(f"  Eq. 5 fit to it ({e['area_convention']}): V0 = {e['v0_mm3']:.4g} mm^3, "
+                                 f"a = {e['a']:.4g} mm^3/N^2, b = {e['b']:.4g} mm^3/N")
+            lines += [f"  {m[k]}" for k in ("fit_note", "fem_note") if m[k]]
+        return lines
+
 
 def _relative(ev: Evaluation, reference: Reference, model: str, this: ModelResult) -> ModelResult:
     """This design as the reference taxel's measured f0 times ``model``'s ratio (this design / reference); it

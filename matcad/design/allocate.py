@@ -47,6 +47,18 @@ class Allocation:
                                           "fields": {k: v[1] for k, v in s.fields.items()}}
                            for b, s in zip(self.bands, self.solutions)]}
 
+    def to_text(self) -> str:
+        """What `matcad design --taxels` prints: the band shared (Hz), the guard, and each taxel's position (mm),
+        f0, unloaded and loaded band (Hz) and solved fields (mm)."""
+        lines = [f"{self.spec.name}: {len(self.bands)} taxels in {self.band_hz[0]:g}-{self.band_hz[1]:g} Hz, "
+                 f"guard {self.guard_hz:.0f} Hz, {self.seconds:.1f} s"]
+        for b, s in zip(self.bands, self.solutions):
+            fields = ", ".join(f"{k} {v[1]:.4g} mm" for k, v in s.fields.items())
+            lines.append(f"  {b.name} at ({b.x_mm:g}, {b.y_mm:g}) mm: f0 {b.f0_hz:.0f} Hz, unloaded "
+                         f"{b.unloaded_hz[0]:.0f}-{b.unloaded_hz[1]:.0f} Hz, loaded {b.loaded_hz[0]:.0f}-"
+                         f"{b.loaded_hz[1]:.0f} Hz; {fields}")
+        return "\n".join(lines)
+
 
 def _harmonic_top(placed, band, guard: float) -> float | None:
     """The top (Hz) of the highest harmonic of an earlier band that ``band`` meets within the guard, or None."""

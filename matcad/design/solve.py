@@ -59,6 +59,15 @@ class Solution:
                 "seconds": self.seconds, "evaluations": self.evaluations, "notes": list(self.notes),
                 "findings": [f.to_dict() for f in self.findings]}
 
+    def to_text(self) -> str:
+        """What `matcad design --target-hz` prints: f0 by predict against the target (Hz), the error, each varied
+        field's start and solution (mm), the run time and the notes."""
+        fields = ", ".join(f"{k} {a:g} -> {b:.4g} mm" for k, (a, b) in self.fields.items())
+        lines = [f"{self.spec.name}: f0 = {self.f0_hz:.1f} Hz by predict ({self.model}) for target "
+                 f"{self.target_hz:g} Hz, error {100 * self.error:+.3f} %; {fields}; {self.seconds:.2f} s, "
+                 f"{self.evaluations} model evaluations"]
+        return "\n".join(lines + [f"  note: {n}" for n in self.notes])
+
 
 def get_field(spec, path: str) -> float:
     section, name = path.split(".")

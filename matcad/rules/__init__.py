@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from matcad.rules.finding import LEVELS, Finding
+from matcad.rules.finding import LEVELS, Finding, findings_text, verdict_dict
 from matcad.rules.registry import PREDICTION_MODULES, SPEC_MODULES
 
-__all__ = ["Finding", "check", "errors"]
+__all__ = ["Finding", "check", "errors", "findings_text", "verdict_dict"]
 
 
 def check(spec, prediction=None) -> list[Finding]:

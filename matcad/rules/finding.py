@@ -25,3 +25,19 @@ class Finding:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+
+def findings_text(findings) -> str:
+    """The findings as `matcad check` prints them: one line each (level, rule, message) and its fix below unless
+    it is only information."""
+    if not findings:
+        return "  no findings"
+    return "\n".join(f"  {f.level:<7} {f.id:<24} {f.message}" + (f"\n  {'':<7} {'':<24} fix: {f.fix}" if f.fix
+                                                                  and f.level != "info" else "")
+                     for f in findings)
+
+
+def verdict_dict(findings) -> dict:
+    """`matcad check --json`: every finding and the verdict ('fail' with any error, else 'pass')."""
+    return {"findings": [f.to_dict() for f in findings],
+            "verdict": "fail" if any(f.level == "error" for f in findings) else "pass"}

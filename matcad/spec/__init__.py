@@ -29,7 +29,7 @@ from matcad.spec.fields import Section, SpecError
 from matcad.spec.io import apply_sets, load, load_calibration, load_spec, read_spec_data
 from matcad.spec.model import SECTIONS, Spec, from_dict, to_dict
 from matcad.spec.notes import frequency_notes, spec_notes
-from matcad.spec.schema import schema
+from matcad.spec.schema import schema, schema_text
 from matcad.spec.sections import (MAX_TAXELS, Air, Array, Cavity, EndCap, Fasteners, Guide, Machine, Mechanics,
                                   Microphone, Mold, Mount, Neck, Needle, Outputs, Plate, Reference, Silicone,
                                   Spacer, TaxelEntry, Wall)
@@ -40,4 +40,4 @@ __all__ = [
     "Silicone", "Spacer", "Spec", "SpecError", "Taxel", "TaxelEntry", "Wall", "apply_sets", "cap_flange_diameter_mm",
     "cap_flange_thickness_mm", "cap_height_mm", "field_path",
     "frequency_notes", "from_dict", "is_array", "load", "load_calibration", "load_spec", "read_spec_data",
-    "reference_spec", "schema", "spec_notes", "taxel_spec", "taxels", "to_dict", "variant"]
+    "reference_spec", "schema", "schema_text", "spec_notes", "taxel_spec", "taxels", "to_dict", "variant"]

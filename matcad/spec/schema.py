@@ -35,3 +35,13 @@ def schema() -> list[dict]:
                          "choices": list(meta["choices"]), "lo": meta["lo"], "hi": meta["hi"],
                          "lo_open": meta["lo_open"], "required_in_table": f.default is dataclasses.MISSING})
     return rows
+
+
+def schema_text(rows) -> str:
+    """``matcad schema``'s text: per field its key, unit, default (or required), meaning and allowed values."""
+    lines = []
+    for row in rows:
+        default = "(required)" if row["required"] else f"default {row['default']!r}"
+        unit = f" [{row['unit']}]" if row["unit"] else ""
+        lines.append(f"{row['key']}{unit}  {default}\n    {row['doc']}\n    allowed: {row['allowed']}")
+    return "\n".join(lines)

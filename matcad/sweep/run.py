@@ -68,6 +68,24 @@ class SweepResult:
         extra = sorted({k for r in self.rows for k in r if k.startswith("cad_")})
         return names + extra
 
+    def counts(self) -> dict:
+        """Variants by status (ok, invalid, failed) and how many break a design rule."""
+        out = {s: sum(r["status"] == s for r in self.rows) for s in ("ok", "invalid", "failed")}
+        out["rule_errors"] = sum(bool(r.get("rule_errors")) for r in self.rows)
+        return out
+
+    def summary_dict(self, folder, files) -> dict:
+        """`matcad sweep --json`: where the table went, the model, the counts and the run time (s)."""
+        return {"out_dir": str(folder), "written": files, "model": self.model, "variants": len(self.rows),
+                **self.counts(), "seconds": round(self.seconds, 3)}
+
+    def summary_text(self, folder, files) -> str:
+        """What `matcad sweep` prints: the counts, the model and executor, the run time and the files."""
+        c = self.counts()
+        return (f"{self.name}: {len(self.rows)} variants ({c['ok']} ok, {c['invalid']} invalid, {c['failed']} failed; "
+                f"{c['rule_errors']} with design-rule errors) by {self.model} on {self.executor} in "
+                f"{self.seconds:.1f} s\n  {', '.join(files)} in {folder}/")
+
     def column(self, name: str) -> np.ndarray:
         """A numeric column as a float array in grid shape (NaN where a variant has no value)."""
         values = [r.get(name) for r in self.rows]

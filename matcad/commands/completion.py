@@ -1,14 +1,29 @@
-"""Shell completion generated from the argparse parser itself, so it never lists a command or option that
-does not exist (``matcad completion bash >> ~/.bashrc``; ``zsh`` through bashcompinit)."""
+"""`matcad completion SHELL`: shell completion generated from the argparse parser itself, so it never lists a
+command or option that does not exist (``matcad completion bash >> ~/.bashrc``; ``zsh`` through bashcompinit)."""
 
 from __future__ import annotations
 
 import argparse
 
+from matcad.errors import EXIT_OK
+
+HELP = "print a shell completion script (bash; zsh via bashcompinit)"
+JSON = False
 SHELLS = ("bash", "zsh")
 
 
-def _commands(parser: argparse.ArgumentParser) -> dict[str, list[str]]:
+def arguments(cmd) -> None:
+    cmd.add_argument("shell", choices=SHELLS)
+
+
+def run(args) -> int:
+    from matcad.commands import parser
+
+    print(script(parser(), args.shell), end="")
+    return EXIT_OK
+
+
+def options(parser: argparse.ArgumentParser) -> dict[str, list[str]]:
     """Subcommand → its option strings (the top level under '')."""
     out = {"": [s for a in parser._actions for s in a.option_strings]}
     for action in parser._actions:
@@ -24,7 +39,7 @@ def script(parser: argparse.ArgumentParser, shell: str) -> str:
     other words complete as file names."""
     if shell not in SHELLS:
         raise ValueError(f"shell {shell!r} invalid, must be one of {', '.join(SHELLS)}")
-    table = _commands(parser)
+    table = options(parser)
     cases = "\n".join(f'        {name}) opts="{" ".join(opts)}" ;;' for name, opts in table.items() if name)
     commands = " ".join(name for name in table if name)
     prog = parser.prog

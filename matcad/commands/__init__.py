@@ -1,0 +1,52 @@
+"""The `matcad` commands: one module each, registered in :data:`COMMANDS` (their order in `matcad --help`).
+
+A command module declares ``HELP`` (one line for `matcad --help`), ``OUT`` (its default output folder, or None when
+it writes none), ``JSON`` (False for the two commands that print no result: completion, serve), ``arguments(parser)``
+adding its own arguments (``--json`` and ``--out`` are added for it from ``JSON`` and ``OUT``) and ``run(args)``
+returning an exit code of :data:`matcad.errors.EXIT_CODES`. A command imports what it needs inside ``run``, so
+building the parser loads no heavy library. Adding a command is one module and one entry here;
+:func:`parser` builds the command line from the registry and :mod:`matcad.cli` dispatches to ``run``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+from pathlib import Path
+
+COMMANDS = ("predict", "check", "build", "coupon", "analyze", "calibrate", "sense", "sweep", "design", "schema",
+            "init", "completion", "serve")
+"""Every command, in the order of `matcad --help`; each is the module ``matcad.commands.<name>``."""
+
+
+def command(name: str):
+    """The module of command ``name``."""
+    return importlib.import_module(f"{__name__}.{name}")
+
+
+def out_path(text: str) -> Path:
+    """``--out``: made absolute at once, so that `--out .` stays meaningful after the folder is replaced."""
+    import os
+
+    return Path(os.path.abspath(text))
+
+
+def parser() -> argparse.ArgumentParser:
+    """The whole command line: every registered command with its arguments, ``run`` as its ``func``."""
+    import matcad
+    from matcad.errors import EXIT_CODES
+
+    top = argparse.ArgumentParser(prog="matcad", description=matcad.__doc__,
+                                  epilog="exit codes: " + "; ".join(f"{k} {v}" for k, v in EXIT_CODES.items()))
+    top.add_argument("--version", action="version", version=f"matcad {matcad.__version__}")
+    sub = top.add_subparsers(dest="command", required=True)
+    for name in COMMANDS:
+        module = command(name)
+        cmd = sub.add_parser(name, help=module.HELP)
+        cmd.set_defaults(func=module.run)
+        if getattr(module, "JSON", True):
+            cmd.add_argument("--json", action="store_true", help="print JSON instead of text")
+        if getattr(module, "OUT", None):
+            cmd.add_argument("--out", type=out_path, help=f"output folder (default {module.OUT})")
+        module.arguments(cmd)
+    return top

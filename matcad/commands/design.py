@@ -1,0 +1,77 @@
+"""`matcad design SPEC`: one taxel solved onto a target f0, or N taxels onto disjoint bands; writes a spec."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from matcad.commands.common import load_spec, print_json, spec_argument
+from matcad.errors import EXIT_OK, EXIT_RULES
+
+HELP = "solve a taxel for a target f0, or N taxels for disjoint bands; writes a spec"
+OUT = "out/<name>-design"
+
+
+def arguments(cmd) -> None:
+    spec_argument(cmd)
+    cmd.add_argument("--target-hz", type=float, metavar="F", help="target unloaded f0 (Hz) of one taxel")
+    cmd.add_argument("--vary", nargs="+", metavar="FIELD[=LO:HI]",
+                     help="fields the solver may change: neck.diameter, cavity.diameter, cavity.length (optional "
+                          "range in mm) and neck.length (a stock sheet); with --taxels default neck.diameter")
+    cmd.add_argument("--taxels", type=int, metavar="N", help="design an array of N taxels with disjoint bands")
+    cmd.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"),
+                     help="with --taxels: the band (Hz) they share")
+    cmd.add_argument("--name", help="name of the written spec (default <name>-<F>hz or <name>-<N>taxels)")
+
+
+def solve(spec, args):
+    """The design the arguments ask for: a :class:`matcad.design.solve.Solution` (one taxel onto --target-hz) or
+    an :class:`matcad.design.allocate.Allocation` (--taxels N in --band LO HI)."""
+    import dataclasses
+
+    from matcad.design.solve import CONTINUOUS, parse_vary
+
+    if (args.target_hz is None) == (args.taxels is None):
+        raise ValueError("design needs either --target-hz F (one taxel) or --taxels N --band LO HI (an array)")
+    if args.target_hz is not None:
+        from matcad.design.solve import solve as solve_one
+
+        if args.band:
+            raise ValueError("--band goes with --taxels, not with --target-hz")
+        if not args.vary:
+            raise ValueError("--target-hz needs --vary FIELD [FIELD ...] (the fields the solver may change)")
+        result = solve_one(spec, args.target_hz, parse_vary(spec, args.vary))
+        return dataclasses.replace(result, spec=dataclasses.replace(
+            result.spec, name=args.name or f"{spec.name}-{args.target_hz:.0f}hz"))
+    from matcad.design.allocate import allocate
+
+    if not args.band:
+        raise ValueError("--taxels needs --band LO HI (Hz)")
+    return allocate(spec, args.taxels, *args.band, parse_vary(spec, args.vary or ["neck.diameter"], CONTINUOUS),
+                    args.name)
+
+
+def run(args) -> int:
+    from matcad.design import RulesFailed
+    from matcad.design.spec_toml import write_design
+    from matcad.rules import errors, findings_text
+
+    spec = load_spec(args.spec, args)
+    try:
+        result = solve(spec, args)
+    except RulesFailed as exc:
+        if args.json:
+            print_json({"verdict": "fail", "error": str(exc), "findings": [f.to_dict() for f in exc.findings]})
+        else:
+            print(findings_text(errors(exc.findings)))
+        print(f"matcad: {exc}; nothing written", file=sys.stderr)
+        return EXIT_RULES
+    target = args.out or Path("out") / f"{result.spec.name}-design"
+    report = {"source": str(args.spec), **result.to_dict()}
+    write_design(target, result.spec, report, f"written by `matcad design` from {args.spec}")
+    if args.json:
+        print_json({**report, "out_dir": str(target), "spec_file": str(target / f"{result.spec.name}.toml")})
+    else:
+        print(result.to_text())
+        print(f"  {result.spec.name}.toml and design.json in {target}/")
+    return EXIT_OK
