@@ -71,7 +71,11 @@ class Design:
     """One taxel as built, for the acoustics (mm): the cavity (diameter D at the plate, length L, core-pin draft in
     degrees), the neck (diameter d, length l = the plate's sheet) and its outer end (``mouth``: 'baffled',
     'unflanged' or 'mount', with the mount's gap height and vent radius), the silicone cap around the cavity (outer
-    diameter, top thickness, height clamped by the guide), the air, the wall material and how it is made."""
+    diameter, top thickness, height clamped by the guide), the air, the wall material and how it is made.
+
+    As-built deviations the drawing does not show (docs/inference.md): ``neck_taper_mm``, the neck's diameter at
+    the mouth minus at the cavity (a laser's taper; ``neck_diameter`` is their mean), and ``side_volume_mm3``, air
+    joined to the cavity at the plate (gaps in the stack, a counterbore) that the cavity's walls do not hold."""
 
     cavity_diameter: float
     cavity_length: float
@@ -87,6 +91,8 @@ class Design:
     air: Air
     wall: WallMaterial
     making: Making
+    neck_taper_mm: float = 0.0
+    side_volume_mm3: float = 0.0
 
     def replace(self, **values) -> Design:
         """A copy with fields set (``air_temperature_c`` sets the air's temperature): a model variant, unvalidated,

@@ -6,19 +6,23 @@ draft) and the exterior below the plate (z < 0):
   spherical radiation condition ∂p/∂n = −(ik + 1/R) p on the arc (exact for the monopole near field);
 - ``mount``: the spacer gap of height h between plate and mount out to the gap radius R_g, with the
   cylindrical condition ∂p/∂n = −(ik + 1/(2R_g)) p on r = R_g.
+As built, the neck may taper (its mouth radius differs from its radius at the cavity, linearly along it) and air may
+be joined to the cavity at the plate (gaps in the stack): a groove in the plate from halfway between the neck and the
+cavity wall outwards, open to the cavity's floor, at most half the plate deep and reaching under the cap's base as far
+as the side volume needs (it leaves the neck's length untouched).
 All other walls are rigid here; :mod:`matcad.acoustics.fsi` couples the elastic silicone cap to this air mesh.
 
 The radiation term depends on k, so the eigenproblem K + (ik + κ)C = k²M is solved by fixed-point iteration
 on k in the boundary term, each step a shift-invert Arnoldi solve near the current k. Of the modes found, the
 Helmholtz mode is the one with the largest share of its energy in the cavity (spurious exterior "box" modes
-have almost none), with Q = Re k / (2 |Im k|) above ``MIN_Q``.
+have almost none), with Q = Re k / (2 |Im k|) above ``MIN_Q`` and within ``GUESS_WINDOW`` of the guess.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -44,6 +48,18 @@ class FemGeometry:
     mouth: str
     gap: float = 0.0
     gap_radius: float = 0.0
+    mouth_radius: float | None = None
+    side_volume: float = 0.0
+
+    @property
+    def mouth_r(self) -> float:
+        """The neck's radius at the mouth (mm): ``mouth_radius``, else the neck's own."""
+        return self.neck_radius if self.mouth_radius is None else self.mouth_radius
+
+    def neck_radius_at(self, z):
+        """The neck's radius at height z (mm; 0 at the mouth, the neck length at the cavity), linear between."""
+        return self.mouth_r + (self.neck_radius - self.mouth_r) * np.asarray(z) / self.neck_length
+
 
 
 @dataclass(frozen=True)
@@ -59,13 +75,17 @@ class FemResult:
 
 
 def geometry(d) -> FemGeometry:
-    """The FEM geometry of a :class:`~matcad.acoustics.design.Design`'s air (drafted cavity, neck, mouth, gap), mm."""
+    """The FEM geometry of a :class:`~matcad.acoustics.design.Design`'s air (drafted cavity, neck with its taper,
+    mouth, gap, air joined to the cavity as a groove in its floor), mm. ``neck_radius`` is the neck's radius at the cavity."""
     from matcad.acoustics.geometry import drafted_tip_diameter_mm
 
     tip = float(drafted_tip_diameter_mm(d.cavity_diameter, d.cavity_length, d.draft_deg))
-    return FemGeometry(neck_radius=d.neck_diameter / 2, neck_length=d.neck_length,
+    taper = d.neck_taper_mm
+    return FemGeometry(neck_radius=(d.neck_diameter - taper / 2) / 2, neck_length=d.neck_length,
                        cavity_radius=d.cavity_diameter / 2, cavity_tip_radius=tip / 2,
-                       cavity_length=d.cavity_length, mouth=d.mouth, gap=d.gap_mm, gap_radius=d.gap_radius_mm)
+                       cavity_length=d.cavity_length, mouth=d.mouth, gap=d.gap_mm, gap_radius=d.gap_radius_mm,
+                       mouth_radius=(d.neck_diameter + taper / 2) / 2 if taper else None,
+                       side_volume=d.side_volume_mm3)
 
 
 # ---------------------------------------------------------------- mesh
@@ -145,6 +165,8 @@ class Layout:
     z_neck: np.ndarray
     z_cavity: np.ndarray
     s_annulus: np.ndarray
+    groove_r: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    groove_depth: float = 0.0
 
 
 def cavity_wall_radius(g: FemGeometry, z):
@@ -166,22 +188,53 @@ def layout(g: FemGeometry, level: int = DEFAULT_LEVEL, cavity_breaks: tuple[floa
     width = max(float(np.max(cavity_wall_radius(g, z_cav))) - a, 0.0)
     s = (_graded_span(0.0, width, min(h, width), max(min(h, width), h_max), fine_end=False) / width
          if width > 1e-9 * a else np.zeros(0))
-    return Layout(h, h_max, np.linspace(0.0, a, level + 1), _graded_span(0.0, l, h, h_max), z_cav, s)
+    groove_r, groove_depth = np.zeros(0), 0.0
+    if g.side_volume and len(s):  # the groove's inner wall, halfway from neck to wall, is a node line at any level
+        s = np.unique(np.append(s, 0.5 * (float(cavity_wall_radius(g, l)) - a) / width))
+        groove_r, groove_depth = _floor_groove(g, s, h, h_max)
+    return Layout(h, h_max, np.linspace(0.0, a, level + 1), _graded_span(0.0, l, h, h_max), z_cav, s,
+                  groove_r, groove_depth)
+
+
+GROOVE_DEPTH_PER_PLATE = 0.5
+"""The side volume's groove is at most this fraction of the plate (neck length) deep."""
+
+
+def _floor_groove(g: FemGeometry, s_annulus: np.ndarray, h: float, h_max: float) -> tuple[np.ndarray, float]:
+    """Radial node lines (mm) and depth (mm) of the groove holding ``side_volume`` (mm³): from halfway between neck
+    and wall (a node line of the floor, :func:`layout`) out to the wall on the floor's own nodes, then under the cap's
+    base as far as a groove ``GROOVE_DEPTH_PER_PLATE`` of the plate deep needs."""
+    a, l, big_r = g.neck_radius, g.neck_length, g.cavity_radius
+    floor = a + s_annulus * (float(cavity_wall_radius(g, l)) - a)
+    floor = floor[floor >= 0.5 * (a + big_r) * (1 - 1e-12)]
+    depth_max = GROOVE_DEPTH_PER_PLATE * l
+    inside = math.pi * (big_r ** 2 - floor[0] ** 2)
+    if g.side_volume <= inside * depth_max:
+        return floor, g.side_volume / inside
+    outer = math.sqrt(floor[0] ** 2 + g.side_volume / (math.pi * depth_max))
+    return np.concatenate([floor, _graded_span(big_r, outer, min(h, outer - big_r), h_max, fine_end=False)[1:]]), \
+        depth_max
 
 
 def air_blocks(g: FemGeometry, lay: Layout) -> list:
     """The air's structured blocks (neck, cavity core, cavity annulus, exterior) as (points, triangles)."""
     a = g.neck_radius
     r_neck, z_cav = lay.r_neck, lay.z_cavity
-    blocks = [_block(lambda s, z: s, lay.z_neck, r_neck), _block(lambda s, z: s, z_cav, r_neck)]
+    neck_r = (lambda s, z: s) if g.mouth_radius is None else (lambda s, z: s / a * g.neck_radius_at(z))
+    blocks = [_block(neck_r, lay.z_neck, r_neck), _block(lambda s, z: s, z_cav, r_neck)]
     if len(lay.s_annulus):
         blocks.append(_block(lambda s_, z: a + s_ * (cavity_wall_radius(g, z) - a), z_cav, lay.s_annulus))
+    if lay.groove_depth:
+        z = _uniform(g.neck_length - lay.groove_depth, g.neck_length, min(lay.h_max, max(lay.h, lay.groove_depth / 4)))
+        blocks.append(_block(lambda r, z_: r, z, lay.groove_r))
+    a_m = g.mouth_r
+    r_mouth = r_neck * (a_m / a)
     if g.mouth == "mount":
-        radii = np.concatenate([r_neck, _graded(a, g.gap_radius, lay.h)[1:]])
+        radii = np.concatenate([r_mouth, _graded(a_m, g.gap_radius, lay.h)[1:]])
         z_gap = _uniform(-g.gap, 0.0, max(lay.h, g.gap / 16))
         blocks.append(_block(lambda s, z: s, z_gap, radii))
     elif g.mouth == "baffled":
-        radii = np.concatenate([r_neck, _graded(a, EXTERIOR_RADIUS_PER_A * a, lay.h)[1:]])
+        radii = np.concatenate([r_mouth, _graded(a_m, EXTERIOR_RADIUS_PER_A * a_m, lay.h)[1:]])
         blocks.append(_quarter_disc(radii))
     else:
         raise ValueError(f"mouth {g.mouth!r} invalid for the FEM, must be one of 'baffled', 'mount'")
@@ -284,7 +337,7 @@ def _boundary_facets(m, g: FemGeometry):
     boundary = np.zeros(m.facets.shape[1], dtype=bool)
     boundary[m.boundary_facets()] = True
     r, z = mid
-    a = g.neck_radius
+    a = g.mouth_r
     tol = 1e-6 * a
     if g.mouth == "baffled":
         big_r = EXTERIOR_RADIUS_PER_A * a
@@ -294,6 +347,19 @@ def _boundary_facets(m, g: FemGeometry):
         radiation = boundary & (r > g.gap_radius - tol)
         kappa = 1.0 / (2.0 * g.gap_radius)
     return np.flatnonzero(radiation), kappa
+
+
+GUESS_WINDOW = 2.0
+"""The resonance is sought within this factor of the guess: a side volume's groove has its own modes, well above,
+in which the cavity's share of the energy can exceed the Helmholtz mode's."""
+
+
+def in_cavity(g: FemGeometry, lay: Layout, r, z):
+    """Whether points (r, z in mm) are in the cavity's air: above the neck, or in the side volume's groove."""
+    above = np.asarray(z) > g.neck_length
+    if not lay.groove_depth:
+        return above
+    return above | ((np.asarray(z) > g.neck_length - lay.groove_depth) & (np.asarray(r) > lay.groove_r[0] * (1 - 1e-9)))
 
 
 def _eigs_near(a_mat, m_mat, sigma, count):
@@ -312,7 +378,8 @@ def solve(g: FemGeometry, k_guess_per_mm: float, level: int = DEFAULT_LEVEL, spe
     from skfem import Basis, ElementTriP2, FacetBasis, asm
 
     t0 = time.perf_counter()
-    m = mesh(g, level)
+    lay = layout(g, level)
+    m = merge_blocks(air_blocks(g, lay), lay.h)[0]
     if cavity_outline is not None:
         m = deform_cavity(m, g, *cavity_outline)
     element = ElementTriP2()
@@ -322,7 +389,7 @@ def solve(g: FemGeometry, k_guess_per_mm: float, level: int = DEFAULT_LEVEL, spe
     m_mat = asm(mass, basis)
     radiation, kappa = _boundary_facets(m, g)
     c_mat = asm(mass, FacetBasis(m, element, facets=radiation))
-    cavity = (np.asarray(basis.global_coordinates()[1]) > g.neck_length).astype(float)
+    cavity = in_cavity(g, lay, *np.asarray(basis.global_coordinates())).astype(float)
     m_cav = asm(weighted_mass, basis, weight=cavity)
 
     k = complex(k_guess_per_mm)
@@ -335,7 +402,8 @@ def solve(g: FemGeometry, k_guess_per_mm: float, level: int = DEFAULT_LEVEL, spe
         energy = np.real(np.einsum("ij,ij->j", vecs.conj(), m_mat @ vecs))
         fraction = np.real(np.einsum("ij,ij->j", vecs.conj(), m_cav @ vecs)) / energy
         q = ks.real / (2 * np.abs(ks.imag) + 1e-300)
-        fraction = np.where((ks.real > 0) & (q > MIN_Q), fraction, -np.inf)
+        near = (ks.real > k_guess_per_mm / GUESS_WINDOW) & (ks.real < k_guess_per_mm * GUESS_WINDOW)
+        fraction = np.where(near & (q > MIN_Q), fraction, -np.inf)
         i = int(np.argmax(fraction))
         converged = abs(ks[i] - k) <= 1e-10 * abs(k)
         k, best = ks[i], (ks[i], float(fraction[i]), float(q[i]))

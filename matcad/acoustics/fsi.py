@@ -95,6 +95,22 @@ def _solid_count(span: float, h: float) -> int:
     return max(2, math.ceil(span / h - 1e-9))
 
 
+def _cap_wall_nodes(g: fem.FemGeometry, lay: fem.Layout, b: float, h_solid: float) -> np.ndarray:
+    """Fractions 0…1 of the way from the cavity wall to the cap's outer radius b (mm) at which the cap's side wall
+    has node lines; where a side-volume groove reaches under the cap's base, its node lines come first, so that the
+    base over the groove is shared with the air (and loaded by it)."""
+    wall = min(g.cavity_radius, g.cavity_tip_radius)
+    under = lay.groove_r[lay.groove_r > g.cavity_radius * (1 + 1e-9)]
+    if not len(under):
+        return np.linspace(0.0, 1.0, _solid_count(b - wall, h_solid) + 1)
+    if under[-1] >= b:
+        raise ValueError(f"the side volume's groove reaches r = {under[-1]:.3g} mm, beyond the cap's outer radius "
+                         f"{b:.3g} mm; the coupled FEM holds at most the volume under the cap")
+    inner = (under - g.cavity_radius) / (b - g.cavity_radius)
+    rest = np.linspace(inner[-1], 1.0, _solid_count(b - under[-1], h_solid) + 1)
+    return np.concatenate([[0.0], inner, rest[1:]])
+
+
 def coupled_mesh(g: fem.FemGeometry, cap: Cap, level: int = fem.DEFAULT_LEVEL) -> CoupledMesh:
     """Air and cap on one conforming mesh; element index arrays of each subdomain."""
     l, L = g.neck_length, g.cavity_length
@@ -103,7 +119,7 @@ def coupled_mesh(g: fem.FemGeometry, cap: Cap, level: int = fem.DEFAULT_LEVEL) -
     n_air = len(blocks)
     b = cap.outer_radius
     h_solid = lay.h_max * fem.DEFAULT_LEVEL / level  # refines with the level like the air away from corners
-    s = np.linspace(0.0, 1.0, _solid_count(b - min(g.cavity_radius, g.cavity_tip_radius), h_solid) + 1)
+    s = _cap_wall_nodes(g, lay, b, h_solid)
     blocks.append(fem._block(lambda s_, z: fem.cavity_wall_radius(g, z) + s_ * (b - fem.cavity_wall_radius(g, z)),
                              lay.z_cavity, s))
     tip = g.cavity_tip_radius
@@ -129,7 +145,7 @@ def _facets(cm: CoupledMesh, g: fem.FemGeometry, cap: Cap):
     boundary = f2t[1] < 0
     tol = 1e-6 * g.neck_radius
     l = g.neck_length
-    a = g.neck_radius
+    a = g.mouth_r
     ring = np.flatnonzero(boundary & (np.abs(z) < tol) & (r > SOURCE_RING[0] * a) & (r < SOURCE_RING[1] * a))
     solid_b = boundary & side0
     fixed = np.flatnonzero(solid_b & ((np.abs(z - l) < tol)

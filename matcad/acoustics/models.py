@@ -98,30 +98,49 @@ def end_corrected_hz(speed_of_sound_m_s, neck_area_mm2, cavity_volume_mm3, effec
     return lumped_hz(speed_of_sound_m_s, neck_area_mm2, cavity_volume_mm3, effective_neck_length_mm)
 
 
-def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, rtol=1e-13, max_iter=100):
-    """Fundamental root k (1/mm) of tan(k·l)·tan(k·L) = r, with r = A/S (Selamet et al. 1997).
+def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, side_length_mm=0.0,
+                                 cone_per_mm=0.0, rtol=1e-13, max_iter=100):
+    """Fundamental root k (1/mm) of tan(k·l)·(tan(k·L) + k·s) = r·(1 − q·tan(k·l)/k), with r = A/S (Selamet et
+    al. 1997), s = V_side/S the length of cavity that a volume V_side of air joined to the cavity at the neck would
+    add (a lumped compliance at the neck-cavity junction) and q = σ/R the cone of a tapered neck (σ = dR/dx, its
+    radius growing towards the cavity, R its radius there, A = πR²). s = q = 0: tan(k·l)·tan(k·L) = r.
 
     The fundamental is the only root with both tangents on their first branch, k in (0, π/(2M)), M = max(l, L).
-    In u = ln k, Φ(u) = ln tan(kl) + ln tan(kL) − ln r is increasing and convex there (d ln tan x / d ln x =
-    2x/sin 2x grows with x). The start is right of the root and left of the pole: the smaller of the lumped
-    guess sqrt(r/(lL)) (tan x ≥ x) and π·sqrt(r/(8mM + 4rM²)), m = min(l, L) (tan x ≥ 8x/(π² − 4x²) on
-    the longer segment). Newton in u therefore descends monotonically onto the fundamental in ~5 steps and
-    never jumps to an overtone; a bisection safeguard inside the bracket guards against rounding.
-    Broadcasts over array inputs.
+    In u = ln k, Φ(u) = ln tan(kl) + ln(tan(kL) + ks) − ln r − ln(1 − q·tan(kl)/k) increases (each factor does for
+    q ≥ 0; a cone narrowing to the cavity, q < 0, is checked against the bracket); for s = q = 0 it is also convex
+    (d ln tan x / d ln x = 2x/sin 2x grows with x). The start is right of the root and left of the pole: the
+    smaller of the lumped guess sqrt(r(1 − ql)/(l(L + s))) (tan x ≥ x) and, for s = q = 0,
+    π·sqrt(r/(8mM + 4rM²)), m = min(l, L) (tan x ≥ 8x/(π² − 4x²) on the longer segment), else 0.99 of the pole.
+    Newton in u then descends onto the fundamental in ~5 steps and never jumps to an overtone; a bisection
+    safeguard inside the bracket (Φ = +∞ where 1 − q·tan(kl)/k ≤ 0) guards against rounding. Broadcasts over
+    array inputs.
     """
-    r, ln, lc = np.broadcast_arrays(*(np.asarray(x, dtype=float)
-                                      for x in (area_ratio, neck_length_mm, cavity_length_mm)))
+    r, ln, lc, side, q = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
+        area_ratio, neck_length_mm, cavity_length_mm, side_length_mm, cone_per_mm)))
     long, short = np.maximum(ln, lc), np.minimum(ln, lc)
     lo = np.zeros_like(r)
     hi = np.pi / (2.0 * long)
-    k = np.minimum(np.sqrt(r / (ln * lc)), np.pi * np.sqrt(r / (8.0 * short * long + 4.0 * r * long * long)))
+    plain = not (np.any(side) or np.any(q))
+    if plain:
+        k = np.minimum(np.sqrt(r / (ln * lc)), np.pi * np.sqrt(r / (8.0 * short * long + 4.0 * r * long * long)))
+    else:
+        k = np.minimum(np.sqrt(r * (1.0 - q * ln) / (ln * (lc + side))), 0.99 * hi)
     for _ in range(max_iter):
         t1, t2 = np.tan(k * ln), np.tan(k * lc)
-        phi = np.log(t1 * t2 / r)
-        dphi_du = k * (ln * (t1 + 1.0 / t1) + lc * (t2 + 1.0 / t2))
+        if plain:
+            phi = np.log(t1 * t2 / r)
+            dphi_du = k * (ln * (t1 + 1.0 / t1) + lc * (t2 + 1.0 / t2))
+        else:
+            t2s = t2 + k * side
+            cone = 1.0 - q * t1 / k
+            with np.errstate(divide="ignore", invalid="ignore"):
+                phi = np.where(cone > 0.0, np.log(t1 * t2s / (r * cone)), np.inf)
+                dphi_du = (k * (ln * (t1 + 1.0 / t1) + (lc * (1.0 + t2 * t2) + side) / t2s)
+                           + q * (ln * (1.0 + t1 * t1) - t1 / k) / cone)
         lo = np.where(phi < 0.0, k, lo)
         hi = np.where(phi > 0.0, k, hi)
-        newton = k * np.exp(-phi / dphi_du)
+        with np.errstate(over="ignore", invalid="ignore"):
+            newton = k * np.exp(-phi / dphi_du)
         k_new = np.where((newton >= lo) & (newton <= hi), newton, 0.5 * (lo + hi))
         done = np.all(np.abs(k_new - k) <= rtol * k_new)
         k = k_new
@@ -131,7 +150,8 @@ def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, r
 
 
 def transmission_line_hz(speed_of_sound_m_s, neck_area_mm2, cavity_area_mm2, effective_neck_length_mm,
-                         cavity_length_mm, wall_length_factor=1.0, wall_extra_length_mm=0.0):
+                         cavity_length_mm, wall_length_factor=1.0, wall_extra_length_mm=0.0, side_volume_mm3=0.0,
+                         neck_cone_mm=None):
     """Fundamental of the neck + closed-cavity transmission line (Hz), Selamet et al., JASA 101(1), 1997.
 
     Plane waves in a neck (area A, effective length l + end corrections, open end) and a cavity (area S,
@@ -141,11 +161,25 @@ def transmission_line_hz(speed_of_sound_m_s, neck_area_mm2, cavity_area_mm2, eff
     A compliant cavity wall (see :func:`soft_wall_length_scale`) slows waves in the cavity by
     n = ``wall_length_factor`` and adds ``wall_extra_length_mm`` of closed-end compliance; the equation
     becomes tan(k·l_eff)·tan(k·n·L') = A/(n·S) with L' = L + extra, the same form, solved the same way.
+    ``side_volume_mm3`` of air joined to the cavity at the neck (gaps in the stack) is a compliance V/(ρc²) in
+    parallel with the cavity at the junction: tan(k·l_eff)·(tan(k·n·L') + k·V/(n·S)) = A/(n·S); in the lumped
+    limit it adds V to the cavity volume.
+    ``neck_cone_mm`` = (R_m, R_c), the radii at the mouth and cavity ends of a tapered neck of length l_eff (a
+    cone, its end corrections included): spherical waves p = sin(k·x)/(x − x_apex) in the neck, whose admittance
+    at the cavity is (A_c/ρc)·(cot(k·l_eff) − σ/(k·R_c)), σ = (R_c − R_m)/l_eff, A_c = πR_c²; the right side
+    becomes A_c/(n·S)·(1 − σ·tan(k·l_eff)/(k·R_c)). Its lumped limit is the cone's inertance ρ·l_eff/(πR_m·R_c),
+    and ``neck_area_mm2`` is then unused.
     """
     n = np.asarray(wall_length_factor, dtype=float)
-    r = np.asarray(neck_area_mm2, dtype=float) / (cavity_area_mm2 * n)
-    k = transmission_line_wavenumber(r, effective_neck_length_mm,
-                                     n * (np.asarray(cavity_length_mm, dtype=float) + wall_extra_length_mm))
+    cavity_area = np.asarray(cavity_area_mm2, dtype=float)
+    neck_area, cone = np.asarray(neck_area_mm2, dtype=float), 0.0
+    if neck_cone_mm is not None:
+        r_mouth, r_cavity = (np.asarray(x, dtype=float) for x in neck_cone_mm)
+        neck_area = np.pi * r_cavity**2
+        cone = (r_cavity - r_mouth) / np.asarray(effective_neck_length_mm, dtype=float) / r_cavity
+    k = transmission_line_wavenumber(neck_area / (cavity_area * n), effective_neck_length_mm,
+                                     n * (np.asarray(cavity_length_mm, dtype=float) + wall_extra_length_mm),
+                                     np.asarray(side_volume_mm3, dtype=float) / (cavity_area * n), cone)
     return _c_mm_s(speed_of_sound_m_s) * k / (2.0 * np.pi)
 
 

@@ -64,13 +64,22 @@ class Prediction:
     calibration: str | None = None
     load_curve: tuple[LoadPoint, ...] = ()
     load_model: dict | None = None
+    physics_model: str = ""
+    physics_f0_hz: float = float("nan")
+    physics_band_hz: tuple[float, float] = (float("nan"), float("nan"))
 
     def to_dict(self) -> dict:
         d = asdict(self)
         for name, result in self.models.items():
             d["models"][name]["valid"] = result.valid
         d["band_hz"] = list(self.band_hz)
+        d["physics_band_hz"] = list(self.physics_band_hz)
         return d
+
+    @property
+    def anchored(self) -> bool:
+        """Whether the headline f0 and band rest on a measurement rather than on physics alone."""
+        return self.model != self.physics_model
 
     def to_text(self, name: str, d: Design) -> str:
         """What `matcad predict` prints for the taxel ``name`` of design ``d``: its geometry and air, every model's
@@ -93,6 +102,9 @@ class Prediction:
         lines += ["", f"  f0 = {self.f0_hz:.0f} Hz ({self.model}), band {self.band_hz[0]:.0f}-{self.band_hz[1]:.0f} "
                       "Hz (root-sum-square in ln f of):"]
         lines += [f"    {b.source:<28} {b.tolerance:<52} {b.low_hz:+8.1f} {b.high_hz:+8.1f} Hz" for b in self.budget]
+        if self.anchored:
+            lines.append(f"  physics only: f0 = {self.physics_f0_hz:.0f} Hz ({self.physics_model}), band "
+                         f"{self.physics_band_hz[0]:.0f}-{self.physics_band_hz[1]:.0f} Hz")
         if self.load_curve:
             lines += self.load_curve_text()
         if self.warnings:
@@ -155,7 +167,7 @@ def _paper_anchor(d: Design, chosen: str, f0_hz: float, band_low_hz: float) -> l
 
 def _requested(d: Design, model: str, reference: Reference | None) -> None:
     """Refuse a ``--model`` that does not apply to this design, saying why (ValueError)."""
-    if model in registry.DERIVED:
+    if model == "relative":
         if reference is None:
             raise ValueError(f"model {model!r} needs a [reference] taxel (its measured f0) in the spec")
         return
@@ -191,6 +203,13 @@ def predict(d: Design, reference: Reference | None = None, model: str | None = N
         chosen = model
     lines = budget(d, res, chosen, results[chosen].f0_hz, results[chosen].valid, reference)
     low, high = total(lines, results[chosen].f0_hz)
+    physics = chosen if chosen not in registry.DERIVED else registry.CHOSEN[d.wall.model]
+    if physics == chosen:
+        physics_band = (results[chosen].f0_hz + low, results[chosen].f0_hz + high)
+    else:
+        f_physics = results[physics].f0_hz
+        p_low, p_high = total(budget(d, res, physics, f_physics, results[physics].valid), f_physics)
+        physics_band = (f_physics + p_low, f_physics + p_high)
 
     warnings = checks.warnings(chosen, results[chosen].checks, ev)
     eps = float(boundary_layer_shift(results[chosen].f0_hz, d.neck_diameter / 2))
@@ -208,4 +227,5 @@ def predict(d: Design, reference: Reference | None = None, model: str | None = N
         cavity_volume_mm3=res.volume, neck_area_mm2=res.neck_area, cavity_area_mm2=res.cavity_area,
         neck_air_ratio=res.neck_air_ratio, diameter_ratio=res.diameter_ratio, speed_of_sound_m_s=res.c_m_s,
         outer_end_correction_mm=res.outer_correction, inner_end_correction_mm=res.inner_step, models=results,
-        model=chosen, f0_hz=f0, band_hz=(f0 + low, f0 + high), budget=tuple(lines), warnings=tuple(warnings))
+        model=chosen, f0_hz=f0, band_hz=(f0 + low, f0 + high), budget=tuple(lines), warnings=tuple(warnings),
+        physics_model=physics, physics_f0_hz=results[physics].f0_hz, physics_band_hz=physics_band)

@@ -124,8 +124,11 @@ MODELS: tuple[AcousticModel, ...] = (
 CHOSEN = {"rigid": "transmission_line", "silicone": "elastic_wall"}
 """The model `predict` chooses for each ``wall.model`` (the cheapest whose measured error is small for that wall)."""
 DERIVED = {"relative": "the [reference] taxel's measured f0 times the chosen model's ratio (this design / "
-                       "reference)"}
-"""Choices of ``predict --model`` that are not models of their own."""
+                       "reference)",
+           "calibration": "the taxel's own [calibration]: Eq. 5 f(0) at the air's temperature",
+           "as_built": "the lab state inferred from the [[measured]] taxels (`matcad infer`), this design built in it"}
+"""Choices of ``predict --model`` that are not models of their own: anchors to measurements (the last two are made
+in :mod:`matcad.prediction.anchor`)."""
 
 
 def model(name: str) -> AcousticModel:

@@ -137,8 +137,10 @@ def dynamic_compliance_mm3_pa(f_hz, wall: Modes, loss_factor: float):
     return (comps / (g - (f / freqs) ** 2)).sum(axis=-1)
 
 
-def _cavity_end_response(f_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall_compliance):
-    """|p| at the cavity's closed end per unit pressure at the mouth source (transfer matrices, mm, Pa, s)."""
+def _cavity_end_response(f_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall_compliance,
+                         side_volume=0.0):
+    """|p| at the cavity's closed end per unit pressure at the mouth source (transfer matrices, mm, Pa, s); air of
+    ``side_volume`` (mm³) joined to the cavity at the neck is a compliance V/(ρc²) at that junction."""
     c = c_m_s * 1e3
     omega = 2 * np.pi * f_hz
     k = omega / c
@@ -148,6 +150,8 @@ def _cavity_end_response(f_hz, c_m_s, neck_area, cavity_area, neck_length_eff, c
     u = 1j * omega * wall_compliance * p  # volume velocity into the wall at the closed end
     kl = k * cavity_length
     p, u = np.cos(kl) * p + 1j * z_cav * np.sin(kl) * u, 1j * np.sin(kl) / z_cav * p + np.cos(kl) * u
+    if side_volume:
+        u = u + 1j * omega * side_volume / BULK_MODULUS_PA * p
     kl = k * neck_length_eff
     p, u = np.cos(kl) * p + 1j * z_neck * np.sin(kl) * u, 1j * np.sin(kl) / z_neck * p + np.cos(kl) * u
     return 1.0 / np.abs(p + rho * c * k * k / (2 * np.pi) * u)
@@ -164,13 +168,39 @@ def _peak_hz(f_grid, response) -> float:
 
 
 def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
-               loss_factor: float) -> float:
-    """Peak of the cavity pressure with the elastic wall over the peak with a rigid wall (same network)."""
+               loss_factor: float, side_volume: float = 0.0) -> float:
+    """Peak of the cavity pressure with the elastic wall over the peak with a rigid wall (same network, air of
+    ``side_volume`` mm³ joined at the neck in both)."""
     f = f_tl_hz * np.geomspace(*SWEEP[:2], SWEEP[2])
     geometry = (c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length)
-    soft = _peak_hz(f, _cavity_end_response(f, *geometry, dynamic_compliance_mm3_pa(f, wall, loss_factor)))
-    rigid = _peak_hz(f, _cavity_end_response(f, *geometry, 0.0))
+    soft = _peak_hz(f, _cavity_end_response(f, *geometry, dynamic_compliance_mm3_pa(f, wall, loss_factor),
+                                            side_volume))
+    rigid = _peak_hz(f, _cavity_end_response(f, *geometry, 0.0, side_volume))
     return soft / rigid
+
+
+DOUBLET_LEVEL = 0.5
+"""A second peak of the cavity pressure at least this fraction of the highest (−6 dB) makes a doublet: the taxel
+may sing at either, and which one wins depends on what no model here resolves (the jet, losses, the cap as cast)."""
+
+
+def doublet_hz(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
+               loss_factor: float, side_volume: float = 0.0) -> float | None:
+    """The other peak of a doublet (Hz, on the same scale as :func:`peak_ratio`'s f_TL × ratio), or None: the
+    highest local maximum of the driven response with the wall, besides the highest, if it reaches
+    :data:`DOUBLET_LEVEL` of it."""
+    f = f_tl_hz * np.geomspace(*SWEEP[:2], SWEEP[2])
+    geometry = (c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length)
+    soft = _cavity_end_response(f, *geometry, dynamic_compliance_mm3_pa(f, wall, loss_factor), side_volume)
+    rigid = _peak_hz(f, _cavity_end_response(f, *geometry, 0.0, side_volume))
+    inner = np.flatnonzero((soft[1:-1] > soft[:-2]) & (soft[1:-1] >= soft[2:])) + 1
+    if len(inner) < 2:
+        return None
+    order = inner[np.argsort(soft[inner])[::-1]]
+    top, second = order[0], order[1]
+    if soft[second] < DOUBLET_LEVEL * soft[top]:
+        return None
+    return f_tl_hz * _peak_hz(f[second - 1:second + 2], soft[second - 1:second + 2]) / rigid
 
 
 def quasi_static_valid(wall: Modes, f_hz: float) -> bool:

@@ -14,7 +14,7 @@ import argparse
 import importlib
 from pathlib import Path
 
-COMMANDS = ("predict", "check", "build", "coupon", "analyze", "calibrate", "sense", "sweep", "design", "schema",
+COMMANDS = ("predict", "check", "build", "coupon", "analyze", "calibrate", "infer", "sense", "sweep", "design", "schema",
             "init", "completion", "serve")
 """Every command, in the order of `matcad --help`; each is the module ``matcad.commands.<name>``."""
 

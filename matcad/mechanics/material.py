@@ -8,6 +8,7 @@ u–p–J formulation.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from matcad.materials import grade as grade_record
@@ -32,6 +33,13 @@ class Hyperelastic:
     @property
     def bulk_modulus_mpa(self) -> float:
         return self.bulk_per_shear * self.shear_modulus_mpa
+
+    def scaled(self, factor: float) -> Hyperelastic:
+        """The same law ``factor`` times as stiff: every modulus constant (not Ogden's exponent) times ``factor``."""
+        constants = (self.constants[0] * factor, self.constants[1]) if self.model == "ogden" else \
+            tuple(c * factor for c in self.constants)
+        return dataclasses.replace(self, constants=constants, shear_modulus_mpa=self.shear_modulus_mpa * factor,
+                                   note=f"{self.note}; x {factor:.4g}")
 
     def umat(self):
         """The isochoric FElupe material (imports FElupe)."""

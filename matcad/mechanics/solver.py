@@ -16,6 +16,7 @@ converged step and :attr:`CapCurve.message` says where and why.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -75,6 +76,15 @@ class CapCurve:
     def split(self, outline: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """A cavity outline as (wall from its foot to the corner, closed end from the corner to the axis)."""
         return outline[:self.corner + 1], outline[self.corner:]
+
+    def scaled(self, factor: float) -> CapCurve:
+        """This curve for the same silicone ``factor`` times as stiff: every force times ``factor``, the rest the
+        same. Exact for these laws: each has one modulus scale (K/G fixed, the contact penalty ∝ G), so
+        equilibrium at travel x holds with every stress, hence the plate's force, scaled by it."""
+        if factor == 1.0:
+            return self
+        return dataclasses.replace(self, material=self.material.scaled(factor),
+                                   steps=tuple(dataclasses.replace(s, force_n=s.force_n * factor) for s in self.steps))
 
     def column(self, name: str) -> np.ndarray:
         """One per-step quantity as an array, the unloaded state (0, 0, V0) first: displacement_mm, force_n,

@@ -107,18 +107,17 @@ def eq5_rise(cal, max_force_n: float) -> tuple[float, float]:
                         f"must stay where the calibration's Eq. 5 holds: {exc}") from None
 
 
-def mechanics_rise(spec, f0_hz: float, max_force_n: float) -> tuple[float, float, str]:
+def mechanics_rise(spec, f0_hz: float, max_force_n: float, model: str = "") -> tuple[float, float, str]:
     """(min, max) of f(F)/f(0) over 0 <= F <= ``max_force_n`` (N) from the cap mechanics of the single-taxel
-    ``spec`` (its curve computed once per distinct cap: :func:`matcad.prediction.taxel.cap_curve`), and its source
-    text; SpecError naming ``mechanics.max_force_n`` when the computed curve stops below that force."""
-    from matcad.acoustics.design import design
-    from matcad.mechanics.case import cap_case
+    ``spec`` (its curve computed once per distinct cap: :func:`matcad.prediction.taxel.cap_curve`; as built when its
+    prediction's ``model`` is 'as_built'), and its source text; SpecError naming ``mechanics.max_force_n`` when the
+    computed curve stops below that force."""
     from matcad.mechanics.frequency import at_forces, force_curve
-    from matcad.prediction.taxel import cap_curve
+    from matcad.prediction.taxel import load_model_of
     from matcad.spec import SpecError
 
-    curve = cap_curve(cap_case(spec))
-    fc = force_curve(design(spec), curve, f0_hz)
+    built, curve = load_model_of(spec, model)
+    fc = force_curve(built, curve, f0_hz)
     forces = np.array([s.force_n for s in fc.states])
     f = np.array([s.f_hz for s in fc.states])
     top = at_forces(fc, [max_force_n])[0][1]
@@ -149,7 +148,7 @@ def taxel_band(spec, name: str = "t1", x_mm: float = 0.0, y_mm: float = 0.0, mec
             low, high = eq5_rise(cal, force)
             source = f"calibration {cal.name} (paper Eq. 5)"
         elif mechanics:
-            low, high, source = mechanics_rise(spec, p.f0_hz, force)
+            low, high, source = mechanics_rise(spec, p.f0_hz, force, p.model)
         else:
             low, high = 1.0, 1.0
             source = ("not computed (no [calibration]; the cap mechanics run was skipped: `matcad predict --load` "

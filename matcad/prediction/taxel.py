@@ -17,6 +17,8 @@ from matcad.acoustics import design as adapt
 from matcad.acoustics.eq5 import MAT_PAPER_2024
 from matcad.acoustics.predict import LoadPoint, Prediction
 from matcad.acoustics.predict import predict as predict_unloaded
+from matcad.acoustics.registry import ModelResult
+from matcad.prediction.anchor import ANCHORS, anchor
 
 _CAP_CURVES: dict = {}
 """Cap mechanics curves by :class:`matcad.mechanics.case.CapCase`: one FElupe run per distinct cap per process."""
@@ -29,6 +31,35 @@ def cap_curve(case):
 
         _CAP_CURVES[case] = solver.cap_curve(case)
     return _CAP_CURVES[case]
+
+
+def load_model_of(spec, model: str):
+    """(design, cap curve) that f(F) of the single-taxel ``spec`` is computed on: the drawn design and the grade's
+    curve, or, when its prediction is ``as_built``, the design built in the inferred lab state and the curve of its
+    silicone (:mod:`matcad.prediction.asbuilt`)."""
+    from matcad.mechanics.case import cap_case
+
+    d = adapt.design(spec)
+    curve = cap_curve(cap_case(spec))
+    if model != "as_built":
+        return d, curve
+    from matcad.prediction import asbuilt
+    from matcad.prediction.inference import infer
+
+    state = infer(spec).state
+    return asbuilt.built(d, state), asbuilt.built_curve(curve, state)
+
+
+def _anchored(spec, p: Prediction, name: str | None) -> Prediction:
+    """``p`` with its headline f0 and band anchored to the spec's measurements (:mod:`matcad.prediction.anchor`):
+    the anchor's result joins the models, the physics-only numbers stay in ``physics_*``."""
+    a = anchor(spec, name)
+    if a is None:
+        return p
+    result = a.anchored(spec)
+    models = dict(p.models) | {a.name: ModelResult(result.f0_hz, {}, result.note)}
+    return dataclasses.replace(p, models=models, model=a.name, f0_hz=result.f0_hz, band_hz=result.band_hz,
+                               budget=result.lines)
 
 
 def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None = None,
@@ -48,7 +79,12 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
             raise SpecError("taxel", f"{len(board)} taxels", "predict answers for one taxel so far")
         spec = taxel_spec(spec, board[0])
     d = adapt.design(spec)
-    p = predict_unloaded(d, adapt.reference(spec), model, fem_level)
+    anchored = model in ANCHORS
+    if anchored:
+        anchor(spec, model)  # refuses, naming what the spec lacks
+    p = predict_unloaded(d, adapt.reference(spec), None if anchored else model, fem_level)
+    if model is None or anchored:
+        p = _anchored(spec, p, model)
     cal = adapt.calibration(spec, d)
     warnings = list(p.warnings)
     curve: tuple[LoadPoint, ...] = ()
@@ -66,8 +102,9 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
         from matcad.mechanics.case import cap_case
         from matcad.mechanics.frequency import load_points
 
-        # the FEM route on the deformed outlines when the FEM is the chosen model
-        rows, load_model = load_points(d, cap_curve(cap_case(spec)), forces_n, p.f0_hz,
+        # the FEM route on the deformed outlines when the FEM is the chosen model; as built, when inferred
+        built, curve = load_model_of(spec, p.model)
+        rows, load_model = load_points(built, curve, forces_n, p.f0_hz,
                                        (fem_level or DEFAULT_LEVEL) if p.model == "fem" else None)
         curve += tuple(LoadPoint(**row) for row in rows)
         if load_model["message"]:

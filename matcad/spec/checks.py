@@ -11,6 +11,7 @@ import math
 from matcad.spec.board import field_path, taxels
 from matcad.spec.derive import reference_spec
 from matcad.spec.fields import SpecError
+from matcad.spec.measured import measured_spec
 
 
 def cross_checks(spec) -> None:
@@ -27,10 +28,16 @@ def cross_checks(spec) -> None:
             raise SpecError(f"reference ({err.field})", err.value, err.allowed) from None
     if spec.array is not None and spec.taxel:
         raise SpecError("array", "[array] and [[taxel]]", "give either an [array] grid or [[taxel]] entries, not both")
-    names = [entry.name for entry in spec.taxel]
-    for i, name in enumerate(names, 1):
-        if name is not None and name in names[:i - 1]:
-            raise SpecError(f"taxel[{i}].name", name, "must be unique among the [[taxel]] entries")
+    for key in ("taxel", "measured"):
+        names = [entry.name for entry in getattr(spec, key)]
+        for i, name in enumerate(names, 1):
+            if name is not None and name in names[:i - 1]:
+                raise SpecError(f"{key}[{i}].name", name, f"must be unique among the [[{key}]] entries")
+    for i, entry in enumerate(spec.measured, 1):
+        try:
+            measured_spec(spec, entry)
+        except SpecError as err:
+            raise SpecError(f"measured[{i}] ({err.field})", err.value, err.allowed) from None
     for index, t in enumerate(taxels(spec)):
         _geometry_checks(t, lambda key, i=index: field_path(spec, i, key), spec.mold.draft_deg)
 

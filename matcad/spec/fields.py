@@ -20,6 +20,8 @@ from matcad.errors import shorten
 
 LENGTH_MIN_MM = 1e-3
 LENGTH_MAX_MM = 1e5
+VECTOR_MAX = 10_000
+"""Most values a list field (a measured series) may hold."""
 
 
 class SpecError(ValueError):
@@ -35,8 +37,8 @@ class SpecError(ValueError):
 def param(doc: str, unit: str = "", default: Any = dataclasses.MISSING, *, kind: str = "number",
           lo: float | None = None, hi: float | None = None, lo_open: bool = True,
           choices: tuple[str, ...] = (), section: type | None = None) -> Any:
-    """Declare one spec field. ``kind`` is number | integer | bool | text | range | choice | name | section (a
-    sub-table validated as the Section class ``section``)."""
+    """Declare one spec field. ``kind`` is number | integer | bool | text | range | vector (a list of numbers) |
+    vector9 | choice | name | section (a sub-table validated as the Section class ``section``)."""
     meta = {"doc": doc, "unit": unit, "kind": kind, "lo": lo, "hi": hi, "lo_open": lo_open,
             "choices": choices, "section": section}
     return field(default=default, metadata=meta)
@@ -81,6 +83,8 @@ def allowed_text(meta: dict) -> str:
         return "at most 40 printable ASCII characters"
     if kind == "vector9":
         return "9 finite numbers"
+    if kind == "vector":
+        return "[x1, x2, ...], 1 to 10000 values, each " + _range_text(meta)
     if kind == "name":
         return "A-Z a-z 0-9 . _ - (1-64)"
     return _range_text(meta)
@@ -114,6 +118,10 @@ def convert(path: str, value: Any, meta: dict) -> Any:
     if kind == "vector9":
         if not isinstance(value, (list, tuple)) or len(value) != 9:
             raise SpecError(path, value, "must be a list of 9 finite numbers (a 3 x 3 matrix, row by row)")
+        return tuple(_number(path, v, meta) for v in value)
+    if kind == "vector":
+        if not isinstance(value, (list, tuple)) or not 1 <= len(value) <= VECTOR_MAX:
+            raise SpecError(path, value, f"must be a list of 1 to {VECTOR_MAX} values, each {_range_text(meta)}")
         return tuple(_number(path, v, meta) for v in value)
     if kind == "bool":
         if not isinstance(value, bool):

@@ -17,6 +17,7 @@ from matcad.errors import InputError
 from matcad.inputs import CALIBRATION_MAX_BYTES, SPEC_MAX_BYTES, read_text
 from matcad.spec.calibration import Calibration
 from matcad.spec.fields import SpecError, read_section
+from matcad.spec.measured import resolve_files
 from matcad.spec.model import Spec, from_dict
 
 MAX_NESTING = 32
@@ -26,8 +27,16 @@ REPORT_MAX_BYTES = 16 << 20
 
 
 def load(path: str | Path) -> Spec:
-    """Read and validate a spec TOML file. Raises SpecError naming the field on bad input."""
-    return from_dict(read_toml(path, "spec file", SPEC_MAX_BYTES))
+    """Read and validate a spec TOML file (the files its [[measured]] tables name read too, relative to its folder).
+    Raises SpecError naming the field on bad input."""
+    return from_dict(with_measured_files(read_toml(path, "spec file", SPEC_MAX_BYTES), Path(path).parent))
+
+
+def with_measured_files(data: dict, base_dir: Path) -> dict:
+    """``data`` with the files its [[measured]] tables name (relative to ``base_dir``) turned into their numbers."""
+    if "measured" not in data:
+        return data
+    return data | {"measured": resolve_files(data["measured"], base_dir)}
 
 
 def load_calibration(path: str | Path) -> Calibration:
@@ -77,7 +86,7 @@ def read_spec_data(path: str | Path) -> dict:
 
     p = Path(path)
     if p.suffix.lower() != ".json":
-        return read_toml(p, "spec file", SPEC_MAX_BYTES)
+        return with_measured_files(read_toml(p, "spec file", SPEC_MAX_BYTES), p.parent)
     try:
         report = json.loads(read_text(p, "report file", REPORT_MAX_BYTES))
     except InputError as exc:

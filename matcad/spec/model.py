@@ -15,6 +15,7 @@ from matcad.materials import GRADES
 from matcad.spec.calibration import Calibration
 from matcad.spec.checks import cross_checks
 from matcad.spec.fields import SpecError, convert, did_you_mean, param, read_section
+from matcad.spec.measured import Measured
 from matcad.spec.sections import (CAP_OUTER_PER_D, CAP_TOP_PER_D, MAX_TAXELS, Air, Array, Cavity, EndCap,
                                   Fasteners, Guide, Machine, Mechanics, Microphone, Mold, Mount, Neck, Needle,
                                   Outputs, Plate, Reference, Silicone, Spacer, TaxelEntry, Wall)
@@ -46,6 +47,7 @@ class Spec:
     reference: Reference | None = None
     array: Array | None = None
     taxel: tuple[TaxelEntry, ...] = ()
+    measured: tuple[Measured, ...] = ()
 
     def __post_init__(self) -> None:
         name_meta = dict(dataclasses.fields(Spec)[0].metadata)
@@ -56,9 +58,10 @@ class Spec:
                 raise SpecError(section, None, f"is required: add a [{section}] table")
             if value is not None and not isinstance(value, cls):
                 raise SpecError(section, value, f"must be a {cls.__name__} section")
-        object.__setattr__(self, "taxel", tuple(self.taxel))
-        if not all(isinstance(entry, TaxelEntry) for entry in self.taxel):
-            raise SpecError("taxel", self.taxel, "must be [[taxel]] entries")
+        for key, cls in ARRAY_TABLES.items():
+            object.__setattr__(self, key, tuple(getattr(self, key)))
+            if not all(isinstance(entry, cls) for entry in getattr(self, key)):
+                raise SpecError(key, getattr(self, key), f"must be [[{key}]] entries")
         cross_checks(self)
 
 
@@ -68,11 +71,13 @@ SECTIONS: dict[str, type] = {
     "outputs": Outputs, "air": Air, "wall": Wall, "microphone": Microphone, "silicone": Silicone,
     "calibration": Calibration, "mechanics": Mechanics, "reference": Reference, "array": Array}
 REQUIRED_SECTIONS = ("cavity", "neck")
+ARRAY_TABLES: dict[str, type] = {"taxel": TaxelEntry, "measured": Measured}
+"""Arrays of tables ([[taxel]], [[measured]]): key → the Section class of one entry."""
 
 
 def from_dict(data: dict) -> Spec:
     """Validate a parsed TOML document into a :class:`Spec` (lengths in mm). Raises SpecError."""
-    known = ["name", *SECTIONS, "taxel"]
+    known = ["name", *SECTIONS, *ARRAY_TABLES]
     for key in data:
         if key not in known:
             raise SpecError(key, data[key], did_you_mean(key, known))
@@ -87,17 +92,19 @@ def from_dict(data: dict) -> Spec:
             values[section] = read_section(cls, section, data[section])
         elif section in REQUIRED_SECTIONS:
             raise SpecError(section, None, f"is required: add a [{section}] table")
-    if "taxel" in data:
-        values["taxel"] = _taxel_entries(data["taxel"])
+    for key, cls in ARRAY_TABLES.items():
+        if key in data:
+            values[key] = _entries(key, cls, data[key])
     return _resolve_defaults(Spec(**values))  # Spec.__post_init__ runs the cross-field checks
 
 
-def _taxel_entries(data: Any) -> tuple[TaxelEntry, ...]:
+def _entries(key: str, cls: type, data: Any) -> tuple:
+    """The [[key]] tables of ``data`` as ``cls`` sections, 1 to :data:`MAX_TAXELS` of them."""
     if not isinstance(data, (list, tuple)) or not all(isinstance(item, dict) for item in data):
-        raise SpecError("taxel", data, "must be [[taxel]] tables, one per taxel")
+        raise SpecError(key, data, f"must be [[{key}]] tables, one per taxel")
     if not 1 <= len(data) <= MAX_TAXELS:
-        raise SpecError("taxel", f"{len(data)} entries", f"must be 1 to {MAX_TAXELS} [[taxel]] entries")
-    return tuple(read_section(TaxelEntry, f"taxel[{i}]", item) for i, item in enumerate(data, 1))
+        raise SpecError(key, f"{len(data)} entries", f"must be 1 to {MAX_TAXELS} [[{key}]] entries")
+    return tuple(read_section(cls, f"{key}[{i}]", item) for i, item in enumerate(data, 1))
 
 
 KEY_CLEARANCE_MM = {"fdm": 0.2, "sla": 0.1}
@@ -131,7 +138,23 @@ def _resolve_defaults(spec: Spec) -> Spec:
         wall = dataclasses.replace(wall, loss_factor=grade.loss_factor)
     if wall.khz_modulus_factor is None:
         wall = dataclasses.replace(wall, khz_modulus_factor=grade.khz_modulus_factor)
-    return dataclasses.replace(spec, end_cap=cap, machine=machine, silicone=silicone, wall=wall, taxel=entries)
+    spec = dataclasses.replace(spec, end_cap=cap, machine=machine, silicone=silicone, wall=wall, taxel=entries)
+    return dataclasses.replace(spec, reference=spec.reference and _drawn(spec.reference, spec),
+                               measured=tuple(_drawn(e, spec) for e in spec.measured))
+
+
+DRAWN = {"cavity_diameter": ("cavity", "diameter"), "cavity_length": ("cavity", "length"),
+         "neck_diameter": ("neck", "diameter"), "neck_length": ("neck", "length"),
+         "cap_outer_diameter": ("end_cap", "outer_diameter"), "cap_top_thickness": ("end_cap", "top_thickness")}
+"""The drawn geometry a [reference] or [[measured]] taxel may give → the table and field of this spec it defaults
+to."""
+
+
+def _drawn(entry, spec):
+    """A [reference] or [[measured]] entry with the geometry it leaves out filled from ``spec`` as loaded, so that
+    it stays the taxel that was built when a design, sweep or budget varies this spec."""
+    return dataclasses.replace(entry, **{key: getattr(getattr(spec, table), name) for key, (table, name)
+                                         in DRAWN.items() if getattr(entry, key) is None})
 
 
 def _proportional(own: float | None, shared: float | None, per_d: float, cavity_diameter: float) -> float:
@@ -142,7 +165,11 @@ def _proportional(own: float | None, shared: float | None, per_d: float, cavity_
 
 
 def to_dict(spec: Spec) -> dict:
-    """The resolved spec (defaults filled in) as plain TOML-like data; ``taxel`` only when it has entries."""
+    """The resolved spec (defaults filled in) as plain TOML-like data; an array of tables only when it has
+    entries."""
     data = dataclasses.asdict(spec)
-    entries = data.pop("taxel")
-    return data | ({"taxel": list(entries)} if entries else {})
+    for key in ARRAY_TABLES:
+        entries = data.pop(key)
+        if entries:
+            data[key] = list(entries)
+    return data

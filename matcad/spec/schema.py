@@ -7,8 +7,8 @@ from __future__ import annotations
 import dataclasses
 
 from matcad.spec.fields import allowed_text
-from matcad.spec.model import REQUIRED_SECTIONS, SECTIONS, Spec
-from matcad.spec.sections import TaxelEntry
+from matcad.spec.measured import FILE_FIELDS
+from matcad.spec.model import ARRAY_TABLES, REQUIRED_SECTIONS, SECTIONS, Spec
 
 
 def schema() -> list[dict]:
@@ -18,7 +18,7 @@ def schema() -> list[dict]:
     rows.append({"key": "name", "unit": "", "default": None, "allowed": "A-Z a-z 0-9 . _ - (1-64)",
                  "required": True, "doc": name_meta["doc"], "kind": "name", "choices": [], "lo": None,
                  "hi": None, "lo_open": True, "required_in_table": True})
-    tables = [*SECTIONS.items(), ("taxel[]", TaxelEntry)]
+    tables = [*SECTIONS.items(), *((f"{key}[]", cls) for key, cls in ARRAY_TABLES.items())]
     tables += [(f"{name}.{f.name}", f.metadata["section"]) for name, cls in tables for f in dataclasses.fields(cls)
                if f.metadata["kind"] == "section"]  # sub-tables, e.g. taxel[].calibration
     for section, cls in tables:
@@ -34,6 +34,11 @@ def schema() -> list[dict]:
                          "allowed": allowed, "required": required, "doc": meta["doc"], "kind": meta["kind"],
                          "choices": list(meta["choices"]), "lo": meta["lo"], "hi": meta["hi"],
                          "lo_open": meta["lo_open"], "required_in_table": f.default is dataclasses.MISSING})
+    for key, (filled, doc) in FILE_FIELDS.items():  # read at load into the fields they fill
+        rows.append({"key": f"measured[].{key}", "unit": "", "default": None,
+                     "allowed": "a file path, relative to the spec's folder", "required": False,
+                     "doc": f"instead of {' and '.join(filled)}: {doc}", "kind": "path", "choices": [], "lo": None,
+                     "hi": None, "lo_open": True, "required_in_table": False})
     return rows
 
 
