@@ -80,7 +80,7 @@ def truth_f0(spec, state, level: int) -> tuple[float, bool]:
     from matcad.acoustics import fem, fsi
     from matcad.acoustics.design import design, speed_of_sound
     from matcad.prediction.asbuilt import built
-    from matcad.prediction.inference import f0_hz
+    from matcad.prediction.measurements import f0_hz
 
     b = built(design(spec), state)
     shear, loss = b.wall.dynamic_moduli_pa()[1], b.wall.loss_factors()[1]
@@ -109,7 +109,6 @@ def lab(seed: int, level: int, load: bool) -> dict:
     """One lab: its hidden state, the measured taxel, and each design's truth and predictions."""
     from matcad import spec as spec_mod
     from matcad.prediction import predict
-    from matcad.prediction.inference import _CACHE
     from matcad.spec.measured import Measured
 
     rng = np.random.default_rng(seed)
@@ -124,7 +123,6 @@ def lab(seed: int, level: int, load: bool) -> dict:
                   "f_hz": tuple(f + rng.normal(0, NOISE_HZ) for f in (f_meas, *fs))}
     # as a spec file would hold it: the entry's drawing filled from the spec as loaded
     measured = spec_mod.from_dict(spec_mod.to_dict(dataclasses.replace(base, measured=(Measured(**entry),))))
-    _CACHE.clear()
     rows = []
     for fields in DESIGNS:
         s = variant(measured, fields)

@@ -9,7 +9,7 @@ import pytest
 
 from matcad import spec as spec_mod
 from matcad.prediction import bands
-from matcad.prediction import taxel as taxel_prediction
+from matcad.prediction import curves as curve_cache
 from matcad.listening import guard_hz
 from matcad.prediction.bands import TaxelBand, conflicts, taxel_band
 from matcad.acoustics.design import calibration
@@ -60,7 +60,7 @@ def test_mechanics_rise_once_per_cap_and_equal_to_predict_load(monkeypatch):
     calls = []
     real = solver.cap_curve
     monkeypatch.setattr(solver, "cap_curve", lambda s: calls.append(1) or real(s))
-    monkeypatch.setattr(taxel_prediction, "_CAP_CURVES", {})
+    monkeypatch.setattr(curve_cache, "_CAP_CURVES", {})
     s = spec_mod.from_dict(tomllib.loads(FAST))
     wide = dataclasses.replace(s, neck=dataclasses.replace(s.neck, diameter=2.6))
     b1, b2 = taxel_band(s), taxel_band(wide)

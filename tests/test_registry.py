@@ -232,7 +232,8 @@ def test_predict_takes_every_registered_model_or_says_why():
     from matcad.prediction import predict
 
     reasons = {"soft_wall": "serves wall.model = 'silicone' only", "elastic_wall": "serves wall.model = 'silicone'",
-               "relative": "needs a [reference] taxel"}
+               "relative": "needs a [reference] taxel", "calibration": "needs a [calibration] in the spec",
+               "as_built": "needs [[measured]] taxels in the spec"}
     for spec in (load_spec(LASER_ONLY), load_spec(PAPER)):
         for name in model_choices():
             try:

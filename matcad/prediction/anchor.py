@@ -23,6 +23,7 @@ import math
 from dataclasses import dataclass
 
 from matcad.acoustics.uncertainty import TEMPERATURE_TOL_C, BudgetLine, total
+from matcad.spec import calibrated_spec
 
 CALIBRATION_F0_SD = 0.01
 """Relative sd of a calibration's f(0) that carries no covariance (the paper's constants: it reports "~4.0 kHz")."""
@@ -79,10 +80,19 @@ class CalibrationAnchor:
         variance = (cal.cov[0, 0] if cal.covariance is not None else 0.0) + (cal.residual_std_mm3 or 0.0) ** 2 \
             + cal.cycle_std_mm3 ** 2
         self.sd = 0.5 * math.sqrt(variance) / cal.v0_mm3 if variance > 0 else CALIBRATION_F0_SD
-        self.physics = _physics_hz(spec)
+        self.physics = _physics_hz(calibrated_spec(spec))
+
+    def ratio(self, spec) -> float:
+        """This design's physics f0 over the calibrated taxel's (1 exactly when ``spec`` draws the calibrated
+        taxel)."""
+        return 1.0 if self.same(spec) else _physics_hz(spec) / self.physics
+
+    def same(self, spec) -> bool:
+        """Whether ``spec`` draws the calibrated taxel (its geometry equals the calibration's drawing)."""
+        return calibrated_spec(spec) == spec
 
     def f0_hz(self, spec) -> float:
-        return self.f_cal * (1.0 if spec is self.spec else _physics_hz(spec) / self.physics)
+        return self.f_cal * self.ratio(spec)
 
     def anchored(self, spec) -> Anchored:
         f0 = self.f0_hz(spec)
@@ -90,13 +100,13 @@ class CalibrationAnchor:
         lines = [BudgetLine("calibration f(0)", f"{self.cal.name}: Eq. 5 at F = 0, {100 * self.sd:.2g} % (1 sd)"
                                                 + ("" if self.cal.covariance is not None else ", no covariance given"),
                             -half, half)]
-        if spec is not self.spec:
+        if not self.same(spec):
             lines.append(_ratio_line(spec, f0))
         lines += _temperature_line(spec, f0)
         low, high = total(lines, f0)
         return Anchored(self.name, f0, (f0 + low, f0 + high), tuple(lines),
                         f"[calibration] {self.cal.name}: Eq. 5 f(0) = {self.f_cal:.0f} Hz"
-                        + ("" if spec is self.spec else f" x physics ratio {f0 / self.f_cal:.4f}"))
+                        + ("" if self.same(spec) else f" x physics ratio {f0 / self.f_cal:.4f}"))
 
 
 def _ratio_line(spec, f0_hz: float) -> BudgetLine:
@@ -121,7 +131,7 @@ class AsBuiltAnchor:
 
     def f0_hz(self, spec) -> float:
         from matcad.acoustics.design import design
-        from matcad.prediction.inference import f0_hz
+        from matcad.prediction.measurements import f0_hz
 
         return f0_hz(design(spec), self.inference.state, self.inference.model)
 

@@ -109,7 +109,7 @@ def eq5_rise(cal, max_force_n: float) -> tuple[float, float]:
 
 def mechanics_rise(spec, f0_hz: float, max_force_n: float, model: str = "") -> tuple[float, float, str]:
     """(min, max) of f(F)/f(0) over 0 <= F <= ``max_force_n`` (N) from the cap mechanics of the single-taxel
-    ``spec`` (its curve computed once per distinct cap: :func:`matcad.prediction.taxel.cap_curve`; as built when its
+    ``spec`` (its curve computed once per distinct cap: :func:`matcad.prediction.curves.cap_curve`; as built when its
     prediction's ``model`` is 'as_built'), and its source text; SpecError naming ``mechanics.max_force_n`` when the
     computed curve stops below that force."""
     from matcad.mechanics.frequency import at_forces, force_curve

@@ -19,19 +19,7 @@ from matcad.acoustics.predict import LoadPoint, Prediction
 from matcad.acoustics.predict import predict as predict_unloaded
 from matcad.acoustics.registry import ModelResult
 from matcad.prediction.anchor import ANCHORS, anchor
-
-_CAP_CURVES: dict = {}
-"""Cap mechanics curves by :class:`matcad.mechanics.case.CapCase`: one FElupe run per distinct cap per process."""
-
-
-def cap_curve(case):
-    """:func:`matcad.mechanics.solver.cap_curve` of a cap case, computed once per distinct case."""
-    if case not in _CAP_CURVES:
-        from matcad.mechanics import solver
-
-        _CAP_CURVES[case] = solver.cap_curve(case)
-    return _CAP_CURVES[case]
-
+from matcad.prediction.curves import cap_curve
 
 def load_model_of(spec, model: str):
     """(design, cap curve) that f(F) of the single-taxel ``spec`` is computed on: the drawn design and the grade's
@@ -99,12 +87,11 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
                                 "its volumes are not physical cavity volumes")
     if len(forces_n) and mechanics:
         from matcad.acoustics.fem import DEFAULT_LEVEL
-        from matcad.mechanics.case import cap_case
         from matcad.mechanics.frequency import load_points
 
         # the FEM route on the deformed outlines when the FEM is the chosen model; as built, when inferred
-        built, curve = load_model_of(spec, p.model)
-        rows, load_model = load_points(built, curve, forces_n, p.f0_hz,
+        built, cap = load_model_of(spec, p.model)
+        rows, load_model = load_points(built, cap, forces_n, p.f0_hz,
                                        (fem_level or DEFAULT_LEVEL) if p.model == "fem" else None)
         curve += tuple(LoadPoint(**row) for row in rows)
         if load_model["message"]:

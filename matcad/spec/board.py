@@ -15,6 +15,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from matcad.spec.calibration import Calibration
+from matcad.spec.drawn import filled
 from matcad.spec.sections import Cavity, EndCap, Neck, Needle, TaxelEntry
 
 ENTRY_FIELDS = {
@@ -89,8 +90,10 @@ def field_path(spec, index: int, key: str) -> str:
 
 def taxel_spec(spec, taxel: Taxel):
     """A single-taxel spec with ``taxel``'s geometry (its position dropped) and its own calibration when it has
-    one (else the spec's [calibration]): how per-taxel physics (predict, wall modes, cap mechanics) is applied to
+    one (else the spec's [calibration]; a taxel's own calibration was measured on this taxel as drawn): how per-taxel physics (predict, wall modes, cap mechanics) is applied to
     one taxel of a board."""
-    calibration = taxel.calibration if taxel.calibration is not None else spec.calibration
-    return dataclasses.replace(spec, cavity=taxel.cavity, neck=taxel.neck, end_cap=taxel.end_cap,
-                               needle=taxel.needle, calibration=calibration, array=None, taxel=())
+    own = dataclasses.replace(spec, cavity=taxel.cavity, neck=taxel.neck, end_cap=taxel.end_cap,
+                              needle=taxel.needle, array=None, taxel=())
+    if taxel.calibration is None:
+        return own
+    return dataclasses.replace(own, calibration=filled(taxel.calibration, own))

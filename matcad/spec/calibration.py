@@ -9,11 +9,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
+from matcad.spec.drawn import Drawn
 from matcad.spec.fields import LENGTH_MIN_MM, Section, SpecError, param
 
 
 @dataclass(frozen=True)
-class Calibration(Section):
+class Calibration(Drawn, Section):
     """Paper Eq. 5 constants: V_eff = v0_mm3 - a F^2 - b F (F in N)."""
 
     table: ClassVar[str] = "calibration"

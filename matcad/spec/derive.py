@@ -10,23 +10,18 @@ import copy
 import dataclasses
 from typing import Any
 
+from matcad.spec.drawn import drawn_spec
+
 
 def reference_spec(spec):
     """The reference taxel of ``spec``'s [reference] as a whole spec: this design with the reference's geometry."""
-    ref = spec.reference
+    return drawn_spec(spec, spec.reference, reference=None)
 
-    def pick(value, own):
-        return own if value is None else value
 
-    return dataclasses.replace(
-        spec, reference=None,
-        cavity=dataclasses.replace(spec.cavity, diameter=pick(ref.cavity_diameter, spec.cavity.diameter),
-                                   length=pick(ref.cavity_length, spec.cavity.length)),
-        neck=dataclasses.replace(spec.neck, diameter=pick(ref.neck_diameter, spec.neck.diameter),
-                                 length=pick(ref.neck_length, spec.neck.length)),
-        end_cap=dataclasses.replace(spec.end_cap,
-                                    outer_diameter=pick(ref.cap_outer_diameter, spec.end_cap.outer_diameter),
-                                    top_thickness=pick(ref.cap_top_thickness, spec.end_cap.top_thickness)))
+def calibrated_spec(spec):
+    """The taxel ``spec``'s [calibration] was measured on, as a whole spec: this design with the calibration's
+    drawn geometry (filled at load from the spec as loaded, :func:`matcad.spec.drawn.filled`)."""
+    return drawn_spec(spec, spec.calibration)
 
 
 def variant(spec, section: str, **values: Any):

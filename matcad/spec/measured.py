@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
+from matcad.spec.drawn import Drawn, drawn_spec
 from matcad.spec.fields import LENGTH_MAX_MM, Section, SpecError, length_mm, param
 
 FILE_FIELDS = {
@@ -32,7 +33,7 @@ def _series(doc: str, unit: str, lo: float, hi: float) -> object:
 
 
 @dataclass(frozen=True)
-class Measured(Section):
+class Measured(Drawn, Section):
     """One built and measured taxel. Give at least one of: ``f0_hz`` (or ``analysis``), f(F) pairs (``force_n`` with
     ``f_hz``, or ``calibration_data``), force–displacement pairs (``displacement_mm`` with ``displacement_force_n``,
     or ``force_displacement``)."""
@@ -49,14 +50,6 @@ class Measured(Section):
     temperature_c: float | None = param("air temperature when it was measured; default [air] temperature_c "
                                         "(then +-3 degC is added to the uncertainty)", "degC", None,
                                         lo=-273.15, hi=1000.0)
-    cavity_diameter: float | None = length_mm("cavity diameter it was drawn with; default this spec's", None)
-    cavity_length: float | None = length_mm("cavity length it was drawn with; default this spec's", None)
-    neck_diameter: float | None = length_mm("neck diameter it was drawn with; default this spec's", None)
-    neck_length: float | None = length_mm("sheet (neck length) it was drawn with; default this spec's", None)
-    cap_outer_diameter: float | None = length_mm("end-cap outer diameter it was drawn with; default this spec's",
-                                                 None)
-    cap_top_thickness: float | None = length_mm("end-cap top thickness it was drawn with; default this spec's",
-                                                None)
     measured_neck_diameter: float | None = length_mm(
         "its neck as built, the mean of both faces (pin gauges, a microscope); informs the neck offset", None)
     measured_neck_taper: float | None = param(
@@ -100,20 +93,7 @@ class Measured(Section):
 def measured_spec(spec, entry: Measured):
     """The spec of the drawing ``entry`` was built from: ``spec`` (as loaded) with the entry's drawn geometry, with no
     [reference], [calibration] or [[measured]] of its own (it is not itself anchored)."""
-    import dataclasses
-
-    def pick(value, own):
-        return own if value is None else value
-
-    return dataclasses.replace(
-        spec, reference=None, calibration=None, measured=(), array=None, taxel=(),
-        cavity=dataclasses.replace(spec.cavity, diameter=pick(entry.cavity_diameter, spec.cavity.diameter),
-                                   length=pick(entry.cavity_length, spec.cavity.length)),
-        neck=dataclasses.replace(spec.neck, diameter=pick(entry.neck_diameter, spec.neck.diameter),
-                                 length=pick(entry.neck_length, spec.neck.length)),
-        end_cap=dataclasses.replace(spec.end_cap,
-                                    outer_diameter=pick(entry.cap_outer_diameter, spec.end_cap.outer_diameter),
-                                    top_thickness=pick(entry.cap_top_thickness, spec.end_cap.top_thickness)))
+    return drawn_spec(spec, entry, reference=None, calibration=None, measured=(), array=None, taxel=())
 
 
 def resolve_files(entries, base_dir) -> list:

@@ -14,6 +14,7 @@ from typing import Any
 from matcad.materials import GRADES
 from matcad.spec.calibration import Calibration
 from matcad.spec.checks import cross_checks
+from matcad.spec.drawn import filled
 from matcad.spec.fields import SpecError, convert, did_you_mean, param, read_section
 from matcad.spec.measured import Measured
 from matcad.spec.sections import (CAP_OUTER_PER_D, CAP_TOP_PER_D, MAX_TAXELS, Air, Array, Cavity, EndCap,
@@ -139,22 +140,9 @@ def _resolve_defaults(spec: Spec) -> Spec:
     if wall.khz_modulus_factor is None:
         wall = dataclasses.replace(wall, khz_modulus_factor=grade.khz_modulus_factor)
     spec = dataclasses.replace(spec, end_cap=cap, machine=machine, silicone=silicone, wall=wall, taxel=entries)
-    return dataclasses.replace(spec, reference=spec.reference and _drawn(spec.reference, spec),
-                               measured=tuple(_drawn(e, spec) for e in spec.measured))
-
-
-DRAWN = {"cavity_diameter": ("cavity", "diameter"), "cavity_length": ("cavity", "length"),
-         "neck_diameter": ("neck", "diameter"), "neck_length": ("neck", "length"),
-         "cap_outer_diameter": ("end_cap", "outer_diameter"), "cap_top_thickness": ("end_cap", "top_thickness")}
-"""The drawn geometry a [reference] or [[measured]] taxel may give → the table and field of this spec it defaults
-to."""
-
-
-def _drawn(entry, spec):
-    """A [reference] or [[measured]] entry with the geometry it leaves out filled from ``spec`` as loaded, so that
-    it stays the taxel that was built when a design, sweep or budget varies this spec."""
-    return dataclasses.replace(entry, **{key: getattr(getattr(spec, table), name) for key, (table, name)
-                                         in DRAWN.items() if getattr(entry, key) is None})
+    return dataclasses.replace(spec, reference=spec.reference and filled(spec.reference, spec),
+                               calibration=spec.calibration and filled(spec.calibration, spec),
+                               measured=tuple(filled(e, spec) for e in spec.measured))
 
 
 def _proportional(own: float | None, shared: float | None, per_d: float, cavity_diameter: float) -> float:

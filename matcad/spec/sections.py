@@ -13,6 +13,7 @@ from typing import Any, ClassVar
 
 from matcad.materials import DEFAULT_GRADE, GRADES
 from matcad.spec.calibration import Calibration
+from matcad.spec.drawn import Drawn
 from matcad.spec.fields import LENGTH_MAX_MM, LENGTH_MIN_MM, Section, SpecError, length_mm, param
 
 CAP_OUTER_PER_D = 2.5
@@ -297,7 +298,7 @@ class Mechanics(Section):
 
 
 @dataclass(frozen=True)
-class Reference(Section):
+class Reference(Drawn, Section):
     """A taxel you built and recorded: matcad then predicts this design as the measured f0 times the physics
     ratio (this design / the reference), which cancels most of what the models miss. Geometry fields left out
     are this design's own; everything else (plate, mouth, silicone, air) is shared."""
@@ -307,12 +308,6 @@ class Reference(Section):
     f0_hz: float = param("measured unloaded resonance of the reference taxel", "Hz", lo=0.0, hi=1e7)
     f0_tolerance_hz: float = param("+- uncertainty of that measurement", "Hz", 20.0, lo=0.0, hi=1e7,
                                    lo_open=False)
-    cavity_diameter: float | None = length_mm("reference cavity diameter; default this design's", None)
-    cavity_length: float | None = length_mm("reference cavity length; default this design's", None)
-    neck_diameter: float | None = length_mm("reference neck diameter; default this design's", None)
-    neck_length: float | None = length_mm("reference neck length (sheet thickness); default this design's", None)
-    cap_outer_diameter: float | None = length_mm("reference end-cap outer diameter; default this design's", None)
-    cap_top_thickness: float | None = length_mm("reference end-cap top thickness; default this design's", None)
 
 
 MAX_TAXELS = 64

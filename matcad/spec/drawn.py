@@ -1,0 +1,55 @@
+"""The drawing of a taxel that was built and measured — a [reference], a [[measured]] entry, a [calibration] — and
+the spec of that drawing. Lengths in mm.
+
+Each of those sections may give the geometry the measured taxel was drawn with; what it leaves out is filled from
+the spec as loaded (:func:`filled`), so that it stays the taxel that was built when a design search, a sweep or an
+uncertainty budget varies the spec.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from matcad.spec.fields import length_mm
+
+
+@dataclass(frozen=True, kw_only=True)
+class Drawn:
+    """Geometry fields of a measured taxel's drawing (mm; None: this spec's as loaded)."""
+
+    cavity_diameter: float | None = length_mm("cavity diameter of the measured taxel's drawing; default this spec's "
+                                              "as loaded", None)
+    cavity_length: float | None = length_mm("cavity length of the measured taxel's drawing; default this spec's as "
+                                            "loaded", None)
+    neck_diameter: float | None = length_mm("neck diameter of the measured taxel's drawing; default this spec's as "
+                                            "loaded", None)
+    neck_length: float | None = length_mm("neck length (sheet) of the measured taxel's drawing; default this spec's "
+                                          "as loaded", None)
+    cap_outer_diameter: float | None = length_mm("end-cap outer diameter of the measured taxel's drawing; default "
+                                                 "this spec's as loaded", None)
+    cap_top_thickness: float | None = length_mm("end-cap top thickness of the measured taxel's drawing; default "
+                                                "this spec's as loaded", None)
+
+
+DRAWN = {"cavity_diameter": ("cavity", "diameter"), "cavity_length": ("cavity", "length"),
+         "neck_diameter": ("neck", "diameter"), "neck_length": ("neck", "length"),
+         "cap_outer_diameter": ("end_cap", "outer_diameter"), "cap_top_thickness": ("end_cap", "top_thickness")}
+"""Each :class:`Drawn` field → the table and field of the spec it stands for."""
+
+
+def filled(entry, spec):
+    """``entry`` (a :class:`Drawn` section) with the geometry it leaves out taken from ``spec``."""
+    return dataclasses.replace(entry, **{key: getattr(getattr(spec, table), name)
+                                         for key, (table, name) in DRAWN.items() if getattr(entry, key) is None})
+
+
+def drawn_spec(spec, entry, **changes):
+    """``spec`` with ``entry``'s drawn geometry (fields it leaves out stay ``spec``'s) and ``changes`` (other
+    top-level fields of the spec, e.g. ``reference=None``); validated like any replace."""
+    tables: dict = {}
+    for key, (table, name) in DRAWN.items():
+        if getattr(entry, key) is not None:
+            tables.setdefault(table, {})[name] = getattr(entry, key)
+    return dataclasses.replace(spec, **{t: dataclasses.replace(getattr(spec, t), **v) for t, v in tables.items()},
+                               **changes)
