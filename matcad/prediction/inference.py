@@ -206,31 +206,46 @@ _CACHE: dict = {}
 """Inferences by their data: one fit per lab per process (a design search asks for many predictions)."""
 
 
-def infer(spec) -> Inference:
-    """The as-built inference of ``spec``'s measured taxels ([[measured]], [reference]); ValueError without any."""
+def infer(spec, free: tuple[str, ...] | None = None) -> Inference:
+    """The as-built inference of ``spec``'s measured taxels ([[measured]], [reference]); ValueError without any.
+    ``free`` names the parameters the data may move (default all of :data:`matcad.prediction.asbuilt.PARAMETERS`):
+    the others stay at their prior's centre, which tests one explanation against another (docs/paper.md)."""
     data = taxels(spec)
     if not data:
         raise ValueError(f"{spec.name} has no [[measured]] taxel or [reference] to infer an as-built state from")
-    key = tuple((t.name, t.spec, t.temperature_c, t.temperature_stated, t.f0_hz, t.f0_sd_hz, t.forces_n, t.f_hz,
-                 t.displacements_mm, t.displacement_forces_n, t.neck_diameter_mm, t.neck_taper_mm, t.sheet_mm)
-                for t in data)
+    unknown = set(free or ()) - set(asbuilt.NAMES)
+    if unknown:
+        raise ValueError(f"no as-built parameter {', '.join(sorted(unknown))}; they are {', '.join(asbuilt.NAMES)}")
+    key = (free, tuple((t.name, t.spec, t.temperature_c, t.temperature_stated, t.f0_hz, t.f0_sd_hz, t.forces_n,
+                        t.f_hz, t.displacements_mm, t.displacement_forces_n, t.neck_diameter_mm, t.neck_taper_mm,
+                        t.sheet_mm) for t in data))
     if key not in _CACHE:
-        _CACHE[key] = _fit(spec, data)
+        _CACHE[key] = _fit(spec, data, free)
     return _CACHE[key]
 
 
-def _fit(spec, data: list[Taxel]) -> Inference:
+def _fit(spec, data: list[Taxel], free: tuple[str, ...] | None) -> Inference:
     from scipy.optimize import least_squares
 
     problem = Problem(spec, data)
-    z0 = np.zeros(problem.size)
-    z0[problem.lower > -np.inf] = 0.5  # a bounded parameter starts inside its bound
-    result = least_squares(problem.residuals, z0, bounds=(problem.lower, np.full(problem.size, np.inf)),
+    n = len(asbuilt.PARAMETERS)
+    moving = np.array([free is None or name in free for name in asbuilt.NAMES] + [True] * (problem.size - n))
+
+    def whole(x):
+        z = np.zeros(problem.size)
+        z[moving] = x
+        return z
+
+    lower = problem.lower[moving]
+    x0 = np.where(lower > -np.inf, 0.5, 0.0)  # a bounded parameter starts inside its bound
+    result = least_squares(lambda x: problem.residuals(whole(x)), x0, bounds=(lower, np.full(len(x0), np.inf)),
                            x_scale=1.0, xtol=FIT_TOLERANCE, ftol=FIT_TOLERANCE, gtol=FIT_TOLERANCE, diff_step=1e-4)
-    jac = result.jac
+    jac = np.zeros((len(result.fun), problem.size))
+    jac[:, moving] = result.jac
     covariance = np.linalg.pinv(jac.T @ jac)
-    explained = problem.residuals(result.x, explain=True)
+    z = whole(result.x)
+    explained = problem.residuals(z, explain=True)
     data_jac = jac[:len(explained)]
     chi2 = float(sum(r.z ** 2 for r in explained))
-    return Inference(spec, tuple(data), problem.prior, result.x, covariance, data_jac.T @ data_jac,
+    return Inference(spec, tuple(data), problem.prior, z, covariance, data_jac.T @ data_jac,
                      tuple(explained), problem.name, chi2, len(explained))
