@@ -20,6 +20,8 @@ from matcad.prediction import asbuilt
 from matcad.prediction.measurements import (TEMPERATURE_SD_C, Problem, Residual, Taxel, design_of, f0_hz,
                                             model_sd, taxels)
 
+PART_NECK_SD_MM = 0.03
+"""Part-to-part scatter of one laser's neck holes (sd, mm) that no lab state can carry."""
 CONFLICT_Z = 3.0
 """A parameter whose most probable value lies more than this many prior sd from its prior centre is reported as
 a conflict: the drawing (or the grade's data) is off by more than shop tolerances."""

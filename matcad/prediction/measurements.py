@@ -35,8 +35,6 @@ STAGE_ZERO_SD_MM = 0.5
 TEMPERATURE_SD_C = 3.0 / 1.96
 """sd of the air temperature of a measurement that did not state one: the budget's ±3 °C day-to-day swing taken as
 its 95 % range."""
-PART_NECK_SD_MM = 0.03
-"""Part-to-part scatter of one laser's neck holes (sd, mm) that no lab state can carry."""
 MODEL_ERROR_SIGMAS = 2.0
 """A model's max |error| against the FEM (model_errors.json) is taken as this many sd of its error."""
 @dataclass(frozen=True)
