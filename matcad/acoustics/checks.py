@@ -91,6 +91,22 @@ def evaluate(names, ev, f0_hz) -> dict:
     return {k: bool(v) for k, v in out.items()} if np.ndim(f0_hz) == 0 else out
 
 
-def warnings(model: str, checks: dict, ev) -> list[str]:
-    """The warning of every failed check of ``model``, in its order."""
-    return [CHECKS[name].warning(model, ev) for name, ok in checks.items() if not ok]
+REFERENCE = "reference_"
+"""Prefix of a check the 'relative' model ran on its reference taxel (a hybridised reference makes ratios
+unreliable, however clean this design is)."""
+
+
+def warnings(model: str, checks: dict, ev, reference_ev=None) -> list[str]:
+    """The warning of every failed check of ``model``, in its order; checks named :data:`REFERENCE` + a check ran
+    on the reference taxel (``reference_ev``)."""
+    out = []
+    for name, ok in checks.items():
+        if ok:
+            continue
+        if name.startswith(REFERENCE):
+            out.append(CHECKS[name[len(REFERENCE):]].warning(f"{model} (on the reference taxel)", reference_ev)
+                       + "; a ratio to this reference is unreliable: its doublet and the ratio's modulus spread are in "
+                         "the band")
+        else:
+            out.append(CHECKS[name].warning(model, ev))
+    return out

@@ -142,13 +142,13 @@ class Prediction:
 def _relative(ev: Evaluation, reference: Reference, model: str, this: ModelResult) -> ModelResult:
     """This design as the reference taxel's measured f0 times ``model``'s ratio (this design / reference); it
     carries ``this`` design's checks of that model."""
-    ref = reference.design
-    f_ref = float(registry.model(model).f0_hz(Evaluation(ref).res, ref.wall))
+    ref = registry.model(model).result(Evaluation(reference.design))
     f_model_hz = this.f0_hz
-    ratio = f_model_hz / f_ref
-    return ModelResult(reference.f0_hz * ratio, dict(this.checks),
+    ratio = f_model_hz / ref.f0_hz
+    both = dict(this.checks) | {f"{checks.REFERENCE}{name}": ok for name, ok in ref.checks.items()}
+    return ModelResult(reference.f0_hz * ratio, both,
                        f"measured reference {reference.f0_hz:g} Hz x {model} ratio {ratio:.4f} "
-                       f"(this design {f_model_hz:.0f} Hz / reference {f_ref:.0f} Hz by the same model)")
+                       f"(this design {f_model_hz:.0f} Hz / reference {ref.f0_hz:.0f} Hz by the same model)")
 
 
 def _paper_anchor(d: Design, chosen: str, f0_hz: float, band_low_hz: float) -> list[str]:
@@ -211,7 +211,8 @@ def predict(d: Design, reference: Reference | None = None, model: str | None = N
         p_low, p_high = total(budget(d, res, physics, f_physics, results[physics].valid), f_physics)
         physics_band = (f_physics + p_low, f_physics + p_high)
 
-    warnings = checks.warnings(chosen, results[chosen].checks, ev)
+    warnings = checks.warnings(chosen, results[chosen].checks, ev,
+                               Evaluation(reference.design) if reference is not None else None)
     eps = float(boundary_layer_shift(results[chosen].f0_hz, d.neck_diameter / 2))
     if eps > VISCOUS_REGIME_EPS:
         warnings.append(f"{chosen}: the {d.neck_diameter:g} mm neck is so narrow that boundary layers fill it "

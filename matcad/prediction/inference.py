@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from matcad.prediction import asbuilt
-from matcad.prediction.measurements import (TEMPERATURE_SD_C, Problem, Residual, Taxel, design_of, f0_hz,
-                                            model_sd, taxels)
+from matcad.prediction.measurements import (TEMPERATURE_SD_C, Problem, Residual, Taxel, design_of, drawing,
+                                            f0_hz, ratio_sd, taxels)
 
 PART_NECK_SD_MM = 0.03
 """Part-to-part scatter of one laser's neck holes (sd, mm) that no lab state can carry."""
@@ -33,6 +33,10 @@ WEIGHT_SHOWN = 0.3
 """A parameter's weight in a fixed combination (a unit vector in standard coordinates) that the report names."""
 FIT_TOLERANCE = 1e-10
 SAMPLES = 100
+DRAWS = 4
+"""Draws made per kept sample (those past a parameter's bound are dropped)."""
+PROPOSAL_WIDTH = 1.5
+"""The proposal's sd over the Laplace posterior's: wider, so the weights reach the posterior's tails."""
 """Posterior states a prediction is evaluated on (its 95 % range from their 2.5 and 97.5 percentiles)."""
 SAMPLE_SEED = 0
 
@@ -113,28 +117,46 @@ class Inference:
                 "correlated": pairs,
                 "beyond_tolerance": [n for n, zi in zip(names, self.z) if abs(zi) > CONFLICT_Z]}
 
-    def samples(self) -> np.ndarray:
-        """:data:`SAMPLES` states drawn from the Laplace posterior in standard coordinates (fixed draws, so a
-        prediction is reproducible), bounded parameters clipped at their bound."""
+    def samples(self) -> tuple[np.ndarray, np.ndarray]:
+        """(states in standard coordinates, their normalised weights): :data:`SAMPLES` draws from the Laplace
+        approximation widened :data:`PROPOSAL_WIDTH` times (fixed draws, so a prediction is reproducible; draws
+        past a bound are dropped), each weighted by the exact posterior over the proposal (importance sampling: the
+        prior times the data's likelihood, which the linearisation cannot see where the model jumps between a
+        doublet's peaks)."""
         n = len(asbuilt.PARAMETERS)
-        draws = np.random.default_rng(SAMPLE_SEED).standard_normal((SAMPLES, n))
-        root = np.linalg.cholesky(self.covariance[:n, :n] + 1e-12 * np.eye(n))
+        lower = np.array([p.lower_z for p in asbuilt.PARAMETERS])
+        draws = np.random.default_rng(SAMPLE_SEED).standard_normal((DRAWS * SAMPLES, n))
+        root = np.linalg.cholesky(PROPOSAL_WIDTH ** 2 * self.covariance[:n, :n] + 1e-12 * np.eye(n))
         z = self.z[:n] + draws @ root.T
-        return np.maximum(z, [p.lower_z for p in asbuilt.PARAMETERS])
+        keep = np.flatnonzero((z >= lower).all(axis=1))[:SAMPLES]
+        z, draws = z[keep], draws[keep]
+        problem = Problem(self.spec, list(self.taxels))
+        log_p = np.array([-0.5 * float(np.sum(problem.residuals(np.concatenate([zi, self.z[n:]])) ** 2))
+                          for zi in z])
+        log_w = log_p + 0.5 * np.sum(draws ** 2, axis=1)
+        w = np.exp(log_w - log_w.max())
+        return z, w / w.sum()
+
+    def effective_samples(self) -> float:
+        """Kish's effective sample size of :meth:`samples`' weights (1/Σw²): how many of them carry the band."""
+        _, w = self.samples()
+        return float(1.0 / np.sum(w ** 2))
 
     def predict(self, spec) -> PredictedF0:
         """f0 of the single-taxel ``spec`` built by this lab (Hz): the model on the most probable state, the 95 %
-        range over the posterior's states (sampled: a state may tip a doublet to its other peak), the model's own
-        error (over every benchmark case when the built design fails one of its checks), the air temperature of
-        use, part-to-part scatter, and the doublet's other peak when the built design has one."""
+        range over the posterior's states (sampled: a state may tip a doublet to its other peak; the model's shared
+        error is the state's ``model_factor``), the model's ratio error to the measured drawings (none for a drawing
+        that was measured; over every benchmark pair when the built design fails one of the model's checks), the air
+        temperature of use, part-to-part scatter, and the doublet's other peak when the built design has one."""
         from matcad.acoustics import registry
         from matcad.acoustics.evaluation import Evaluation
         from matcad.acoustics.resonator import elastic_wall_doublet_hz, resonator
 
         d = design_of(spec)
         f = f0_hz(d, self.state, self.model)
-        fs = np.array([f0_hz(d, asbuilt.state_at(z, self.prior), self.model) for z in self.samples()])
-        low, high = np.percentile(fs, [2.5, 97.5]) - f
+        zs, weights = self.samples()
+        fs = np.array([f0_hz(d, asbuilt.state_at(z, self.prior), self.model) for z in zs])
+        low, high = weighted_quantiles(fs, weights, (0.025, 0.975)) - f
         temperature = 0.0 if d.air.speed_of_sound_m_s else TEMPERATURE_SD_C / (d.air.temperature_c + 273.15) * f / 2
         built = asbuilt.built(d, self.state)
         up = f0_hz(built.replace(neck_diameter=built.neck_diameter + PART_NECK_SD_MM), asbuilt.State(), self.model)
@@ -145,8 +167,10 @@ class Inference:
         if self.model == "elastic_wall":
             shear, loss = registry.model(self.model).wall_arguments(built.wall)
             doublet = elastic_wall_doublet_hz(resonator(built), shear, loss)
-        return PredictedF0(f, float(min(low, 0.0)), float(max(high, 0.0)), self.model,
-                           model_sd(self.model, not failed) * f, temperature, part, failed, doublet)
+        measured = any(drawing(t.spec) == drawing(spec) for t in self.taxels)
+        model = 0.0 if measured else ratio_sd(self.model, not failed) * f
+        return PredictedF0(f, float(min(low, 0.0)), float(max(high, 0.0)), self.model, model, temperature, part,
+                           failed, doublet)
 
     def to_dict(self) -> dict:
         return {"model": self.model, "data": self.data_count, "chi2": self.chi2,
@@ -202,6 +226,15 @@ class PredictedF0:
     part_sd_hz: float
     failed_checks: tuple[str, ...] = ()
     doublet_hz: float | None = None
+
+
+def weighted_quantiles(values, weights, qs) -> np.ndarray:
+    """Quantiles ``qs`` (0-1) of ``values`` carrying normalised ``weights`` (the weighted empirical distribution,
+    interpolated between the midpoints of the sorted values' weights)."""
+    order = np.argsort(values)
+    v, w = np.asarray(values, dtype=float)[order], np.asarray(weights, dtype=float)[order]
+    cdf = np.cumsum(w) - 0.5 * w
+    return np.interp(qs, cdf, v)
 
 
 _CACHE: dict = {}

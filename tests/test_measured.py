@@ -1,0 +1,139 @@
+"""Measured beats modelled (issue 19): measured taxels in the spec ([[measured]], [reference], [calibration]), the
+anchored headline of `predict`, the listening band of `analyze`, and `matcad infer` — as a user runs them."""
+
+import dataclasses
+import json
+import tomllib
+import wave
+
+import numpy as np
+import pytest
+
+from matcad import spec as spec_mod
+from matcad.loop import synth
+from matcad.prediction import predict
+from matcad.spec import SpecError
+from tests.conftest import PAPER, run_cli
+
+FS = synth.FS
+
+
+def _paper_text() -> str:
+    """The paper template's text without its [calibration] table (the tests add what they measure)."""
+    text = open(PAPER, encoding="utf-8").read()
+    head, _, tail = text.partition("[calibration]")
+    rest = tail.split("\n[", 1)
+    return head + ("[" + rest[1] if len(rest) > 1 else "")
+
+
+def _write_tone(path, freq_hz: float, seconds: float = 2.0, seed: int = 0) -> None:
+    n = int(seconds * FS)
+    x = synth.taxel(np.full(n, freq_hz), FS, seed) + synth.coloured_noise(n, FS, seed + 1, 1.0, 0.01)
+    pcm = np.round(x / 0.2 * 32767).astype("<i2")
+    with wave.open(str(path), "wb") as w:
+        w.setnchannels(1)
+        w.setsampwidth(2)
+        w.setframerate(int(FS))
+        w.writeframes(pcm.tobytes())
+
+
+def test_analyze_finds_the_papers_own_taxel_with_the_paper_template(tmp_path):
+    """A 4.2 kHz tone (the paper's taxel sings at 4.0-4.5 kHz) is found with `--spec templates/mat-paper.toml`: the
+    band is the calibration's, not the physics' 4.3-7.5 kHz that refused it before."""
+    _write_tone(tmp_path / "tone.wav", 4200.0)
+    code, out, err = run_cli("analyze", tmp_path / "tone.wav", "--spec", PAPER, "--out", tmp_path / "a", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["band_hz"][0] < 4000 < 4500 < data["band_hz"][1]
+    assert data["median_hz"] == pytest.approx(4200.0, abs=2.0)
+
+
+def test_a_calibrated_spec_predicts_its_calibration_and_a_variant_moves_by_the_physics_ratio():
+    """The headline is the calibration's f(0); a design varied from it (a sweep, a design search) keeps the drawing
+    the calibration was measured on and moves by the chosen model's ratio; the physics stays visible."""
+    spec = spec_mod.load(PAPER)
+    p = predict(spec, mechanics=False)
+    assert p.model == "calibration" and p.anchored and p.f0_hz == pytest.approx(4010.4, abs=0.1)
+    assert spec.calibration.cavity_length == spec.cavity.length  # filled at load
+    longer = dataclasses.replace(spec, cavity=dataclasses.replace(spec.cavity, length=6.0))
+    q = predict(longer, mechanics=False)
+    ratio = q.physics_f0_hz / p.physics_f0_hz
+    assert q.f0_hz == pytest.approx(p.f0_hz * ratio, rel=1e-9) and q.f0_hz < p.f0_hz
+    assert "model ratio" in [b.source for b in q.budget] and "model ratio" not in [b.source for b in p.budget]
+    # an explicit physics model answers with physics only
+    assert predict(spec, model="elastic_wall", mechanics=False).f0_hz == pytest.approx(p.physics_f0_hz)
+
+
+def test_predict_json_carries_anchored_and_physics_numbers():
+    code, out, err = run_cli("predict", PAPER, "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["model"] == "calibration" and data["f0_hz"] == pytest.approx(4010.4, abs=0.1)
+    assert data["physics_model"] == "elastic_wall" and data["physics_f0_hz"] > 5000
+    assert data["physics_band_hz"][0] > data["band_hz"][1]
+
+
+def test_measured_taxels_read_from_the_files_analyze_and_calibrate_use(tmp_path, write_spec):
+    """[[measured]] file keys resolve relative to the spec's folder: analyze's report.json gives f0 and its sd, a
+    CSV gives f(F) or F(x) pairs; a missing file or a header without the columns is refused naming the key."""
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "report.json").write_text(json.dumps({"median_hz": 4050.0, "std_hz": 12.5}))
+    (tmp_path / "data" / "press.csv").write_text("# one press\nforce_n,frequency_hz\n0,4050\n5,4150\n10,4240\n")
+    (tmp_path / "data" / "fx.csv").write_text("displacement_mm,force_n\n0.5,6.9\n1.0,11.7\n")
+    text = _paper_text() + ('\n[[measured]]\nname = "built1"\nanalysis = "data/report.json"\n'
+                            'calibration_data = "data/press.csv"\nforce_displacement = "data/fx.csv"\n'
+                            'measured_neck_diameter = 2.31\n')
+    spec = spec_mod.load(write_spec(text))
+    (m,) = spec.measured
+    assert (m.f0_hz, m.f0_tolerance_hz) == (4050.0, 12.5)
+    assert m.force_n == (0.0, 5.0, 10.0) and m.f_hz == (4050.0, 4150.0, 4240.0)
+    assert m.displacement_mm == (0.5, 1.0) and m.displacement_force_n == (6.9, 11.7)
+    assert (m.neck_diameter, m.cavity_length) == (spec.neck.diameter, spec.cavity.length)  # the drawing, filled
+    for bad, where, why in (
+            ('analysis = "data/none.json"', "measured[1].analysis", "readable report.json"),
+            ('calibration_data = "data/fx.csv"', "measured[1].calibration_data", "force_n and frequency_hz"),
+            ('f0_hz = 4000.0\nanalysis = "data/report.json"', "measured[1].analysis", "not both")):
+        path = write_spec(_paper_text() + f"\n[[measured]]\n{bad}\n", name="bad.toml")
+        with pytest.raises(SpecError) as exc:
+            spec_mod.load(path)
+        assert exc.value.field == where and why in str(exc.value)
+        code, out, err = run_cli("predict", path)
+        assert code == 2 and where in err and "Traceback" not in err
+
+
+def test_measured_entries_are_checked(write_spec):
+    """Two entries of one name, an entry with no data, unequal f(F) columns: one clear refusal each."""
+    base = _paper_text()
+    for extra, where in (
+            ('[[measured]]\nname = "a"\nf0_hz = 4000.0\n[[measured]]\nname = "a"\nf0_hz = 4100.0\n', "measured"),
+            ('[[measured]]\nname = "a"\n', "measured[1]"),
+            ('[[measured]]\nforce_n = [0.0, 5.0]\nf_hz = [4000.0]\n', "measured[1]")):
+        with pytest.raises(SpecError) as exc:
+            spec_mod.load(write_spec(base + "\n" + extra, name="m.toml"))
+        assert exc.value.field.startswith(where), (extra, exc.value)
+
+
+def test_infer_command_writes_the_state_and_predict_is_anchored_as_built(tmp_path, write_spec):
+    """`matcad infer` prints and writes the inferred state (state.toml, report.json); `predict` of the same spec
+    is anchored 'as_built' with the physics-only number beside it; a spec with no measured taxel is refused."""
+    spec = write_spec(_paper_text() + '\n[[measured]]\nname = "built1"\nf0_hz = 4000.0\nf0_tolerance_hz = 20.0\n')
+    code, out, err = run_cli("infer", spec, "--out", tmp_path / "inf", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    state = tomllib.loads((tmp_path / "inf" / "state.toml").read_text())["state"]
+    assert set(state) == set(data["state"]) >= {"neck_offset_mm", "side_volume_mm3", "static_modulus_scale"}
+    for row in state.values():
+        assert row["low_95"] <= row["value"] <= row["high_95"]
+    # one f0 explains itself: the measured taxel is predicted back within its sd and its band holds it
+    assert abs(data["residuals"][0]["z"]) < 1.0
+    lo, hi = data["this_design"]["band_hz"]
+    assert lo < 4000.0 < hi and data["this_design"]["physics_f0_hz"] > 5000
+    # f0 alone moves neck and joined air together: the report says it cannot tell them apart
+    assert any({"neck_offset_mm", "side_volume_mm3"} <= set(group) for group in data["told_apart"]["not_told_apart"])
+    code, out, err = run_cli("predict", spec, "--json")
+    assert code == 0, err
+    p = json.loads(out)
+    assert p["model"] == "as_built" and p["f0_hz"] == pytest.approx(data["this_design"]["f0_hz"], rel=1e-9)
+    bare = write_spec(_paper_text(), name="bare.toml")
+    code, out, err = run_cli("infer", bare, "--out", tmp_path / "none")
+    assert code == 2 and "[[measured]]" in err and not (tmp_path / "none").exists()
