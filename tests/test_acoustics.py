@@ -153,7 +153,7 @@ def test_paper_template_prediction_against_the_measurement():
     # template above the rigid value, so the measurement lies below the physics band, and predict says so
     assert p.physics_model == "elastic_wall" and p.physics_band_hz[0] > 4010
     assert p.physics_f0_hz > p.models["transmission_line"].f0_hz
-    assert any("4.0 kHz" in w and "not explained by the wall" in w for w in p.warnings)
+    assert any("4.0 kHz" in w and "joined to the cavity" in w and "1.5x" in w for w in p.warnings)
 
 
 @pytest.mark.parametrize("scale,lo,hi", [

@@ -51,7 +51,7 @@ def test_report_manifest_matches_files(built):
     for warning in report["prediction"]["warnings"]:
         assert warning in (out / "report.md").read_text()
     if spec.name == "mat-paper":
-        assert "not explained by the wall" in (out / "report.md").read_text()
+        assert "joined to the cavity" in (out / "report.md").read_text()
 
 
 def test_dxf_units_layers_holes_outlines(built):

@@ -159,10 +159,12 @@ def _paper_anchor(d: Design, chosen: str, f0_hz: float, band_low_hz: float) -> l
     gap = 100 * (1 - PAPER_MEASURED_HZ / f0_hz)
     where = "below the band" if PAPER_MEASURED_HZ < band_low_hz else "inside the band's low tail"
     return [f"{chosen}: physics predicts {f0_hz:.0f} Hz for the paper's taxel; its one published measurement "
-            f"(~{PAPER_MEASURED_HZ / 1000:.1f} kHz unloaded) lies {gap:.0f} % lower, {where}. That gap is not "
-            "explained by the wall (the Dragon Skin cap's wall modes lie below f, which moves f up, not down); open "
-            "candidates: jet and mount flow effects, the real sheet thickness, the real cap shape. Build and record "
-            "one taxel and predict new designs relative to it."]
+            f"(~{PAPER_MEASURED_HZ / 1000:.1f} kHz unloaded) lies {gap:.0f} % lower, {where}, and the paper's pitch "
+            "per newton is 1.5x smaller than the cap mechanics give. Fed to the as-built inference, the paper's own "
+            "numbers (f0, Eq. 5, Fig. 8) are explained by air joined to the cavity (~35-60 mm^3: the guide's "
+            "clearance, gaps in the stack) with a silicone ~0.6x as stiff as the grade's; a narrower neck (the "
+            "paper's 'd = 2.10 mm' may be the needle's distance y) or a thicker sheet explain the f0 alone, not the "
+            "sensitivity (docs/paper.md). Record one taxel as [[measured]] and matcad predicts from it."]
 
 
 def _requested(d: Design, model: str, reference: Reference | None) -> None:
