@@ -1,7 +1,8 @@
 """One taxel's unloaded f0 onto a target: stock sheet first, then the continuous fields by root finding.
 
-The model is the one `matcad predict` chooses for the spec (transmission line, elastic wall, or the measured
-reference times its ratio), evaluated on its own (milliseconds); the answer is then confirmed by
+The model is the one `matcad predict` chooses for the spec (transmission line, elastic wall, the spec's measured
+anchor — its calibration or its lab's as-built state — or the measured reference times its ratio), evaluated on its
+own (milliseconds); the answer is then confirmed by
 :func:`matcad.prediction.predict` and held to the design rules (:func:`matcad.rules.check`).
 
 With several continuous fields there are many solutions; the solver moves them together along the steepest
@@ -22,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from matcad.design import RulesFailed, Unreachable
+from matcad.prediction.anchor import ANCHORS, anchor, available
 
 CONTINUOUS = ("neck.diameter", "cavity.diameter", "cavity.length")
 SHEET = "neck.length"
@@ -128,8 +130,9 @@ def parse_vary(spec, items, allowed=FIELDS) -> dict[str, tuple[float, float] | N
 
 
 def model_f0(spec, model: str, base: str) -> float:
-    """f0 (Hz) of ``spec`` by ``model`` exactly as :func:`matcad.prediction.predict` computes it: one of
-    the cheap models, or 'relative' (the measured reference f0 times ``base``'s ratio, this design / reference)."""
+    """f0 (Hz) of ``spec`` by ``model`` as :func:`matcad.prediction.predict` computes it: one of the cheap models,
+    an anchor of :mod:`matcad.prediction.anchor` ('calibration', 'as_built': the measured taxel's f0 carried by the
+    physics), or 'relative' (the measured reference f0 times ``base``'s ratio, this design / reference)."""
     from matcad.acoustics import registry
     from matcad.acoustics.design import design
     from matcad.acoustics.resonator import resonator
@@ -139,17 +142,21 @@ def model_f0(spec, model: str, base: str) -> float:
         d = design(s)
         return float(registry.model(name).f0_hz(resonator(d), d.wall))
 
+    if model in ANCHORS:
+        return anchor(spec, model).f0_hz(spec)
     if model == "relative":
         return spec.reference.f0_hz * f(spec, base) / f(reference_spec(spec), base)
     return f(spec, model)
 
 
 def chosen_model(spec) -> tuple[str, str]:
-    """(model, base): the model `predict` picks for ``spec`` and, for 'relative', the physics model it scales."""
+    """(model, base): the model `predict` picks for ``spec`` (an anchor where it has measurements) and the physics
+    model that carries a measurement to a new design."""
     from matcad.acoustics.registry import CHOSEN
 
     base = CHOSEN[spec.wall.model]
-    return ("relative" if spec.reference is not None else base), base
+    anchors = available(spec)
+    return (anchors[0] if anchors else "relative" if spec.reference is not None else base), base
 
 
 class _Route:

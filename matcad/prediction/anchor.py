@@ -70,8 +70,9 @@ class CalibrationAnchor:
         from matcad.acoustics.design import calibration, design
 
         self.spec = spec
-        d = design(spec)
-        cal = calibration(spec, d)
+        measured = calibrated_spec(spec)  # the same for every design varied from the calibrated spec
+        d = design(measured)
+        cal = calibration(measured, d)
         self.cal = cal
         f = float(cal.frequency_hz(0.0))
         if spec.calibration.k_mm3_hz2 is not None and cal.temperature_c is not None:
@@ -80,7 +81,7 @@ class CalibrationAnchor:
         variance = (cal.cov[0, 0] if cal.covariance is not None else 0.0) + (cal.residual_std_mm3 or 0.0) ** 2 \
             + cal.cycle_std_mm3 ** 2
         self.sd = 0.5 * math.sqrt(variance) / cal.v0_mm3 if variance > 0 else CALIBRATION_F0_SD
-        self.physics = _physics_hz(calibrated_spec(spec))
+        self.physics = _physics_hz(measured)
 
     def ratio(self, spec) -> float:
         """This design's physics f0 over the calibrated taxel's (1 exactly when ``spec`` draws the calibrated
@@ -130,6 +131,8 @@ class AsBuiltAnchor:
         self.inference = infer(spec)
 
     def f0_hz(self, spec) -> float:
+        """The model on ``spec`` built in the most probable state (Hz; milliseconds): what a design search solves
+        with; :meth:`anchored` gives the posterior median, the same to a fraction of its band away from a doublet."""
         from matcad.acoustics.design import design
         from matcad.prediction.measurements import f0_hz
 

@@ -143,8 +143,9 @@ class Inference:
         return float(1.0 / np.sum(w ** 2))
 
     def predict(self, spec) -> PredictedF0:
-        """f0 of the single-taxel ``spec`` built by this lab (Hz): the model on the most probable state, the 95 %
-        range over the posterior's states (sampled: a state may tip a doublet to its other peak; the model's shared
+        """f0 of the single-taxel ``spec`` built by this lab (Hz): the posterior median of the model over the
+        lab's states (not the most probable state's: near a cap mode one state's model may sit on a doublet's other
+        peak), the 95 % range over the posterior's states (sampled: a state may tip a doublet to its other peak; the model's shared
         error is the state's ``model_factor``), the model's ratio error to the measured drawings (none for a drawing
         that was measured; over every benchmark pair when the built design fails one of the model's checks), the air
         temperature of use, part-to-part scatter, and the doublet's other peak when the built design has one."""
@@ -153,10 +154,10 @@ class Inference:
         from matcad.acoustics.resonator import elastic_wall_doublet_hz, resonator
 
         d = design_of(spec)
-        f = f0_hz(d, self.state, self.model)
         zs, weights = self.samples()
         fs = np.array([f0_hz(d, asbuilt.state_at(z, self.prior), self.model) for z in zs])
-        low, high = weighted_quantiles(fs, weights, (0.025, 0.975)) - f
+        f, low, high = weighted_quantiles(fs, weights, (0.5, 0.025, 0.975))
+        low, high = low - f, high - f
         temperature = 0.0 if d.air.speed_of_sound_m_s else TEMPERATURE_SD_C / (d.air.temperature_c + 273.15) * f / 2
         built = asbuilt.built(d, self.state)
         up = f0_hz(built.replace(neck_diameter=built.neck_diameter + PART_NECK_SD_MM), asbuilt.State(), self.model)

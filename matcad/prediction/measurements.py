@@ -206,11 +206,11 @@ class Problem:
 
         self.spec = spec
         self.data = data
-        self.prior = asbuilt.priors(spec)
+        self.prior = asbuilt.priors(data[0].spec)  # the lab's, whatever design is predicted from it
         from matcad.acoustics import registry
         from matcad.acoustics.evaluation import Evaluation
 
-        self.name = model_name(spec)
+        self.name = model_name(data[0].spec)
         self.designs = [design(t.spec) for t in data]
         # the model's error that differs between the drawings measured (its shared part is the state's
         # model_factor): none when every measured taxel has one drawing
