@@ -1,0 +1,33 @@
+"""The helpers benchmarks/mechanics.py measures with (docs/mechanics.md quotes its numbers): the paper's Eq. 5 shift,
+our shift at equal force, observed convergence orders and Richardson's estimate, checked against closed forms."""
+
+import math
+
+import numpy as np
+import pytest
+
+from benchmarks.mechanics import curve_shift, observed_orders, paper_force_n, paper_shift, richardson
+
+
+def test_paper_shift_is_eq5_without_k():
+    """f/f0 = sqrt(V0/(V0 − bF − aF²)) with V0 = 32.21 mm³, a = −0.0086 mm³/N², b = 0.4626 mm³/N (paper Eq. 5)."""
+    for force in (1.0, 10.0, 20.0):
+        v = 32.21 - 0.4626 * force + 0.0086 * force ** 2
+        assert paper_shift([force])[0] == pytest.approx(math.sqrt(32.21 / v) - 1, rel=1e-12)
+    assert paper_shift([10.0])[0] == pytest.approx(0.06414, abs=1e-5)
+    assert paper_force_n(0.87) == pytest.approx(8.8719 * 0.87 + 2.876, rel=1e-12)
+
+
+def test_curve_shift_interpolates_like_predict_and_refuses_beyond_the_curve():
+    force, f = np.array([0.0, 2.0, 4.0]), np.array([100.0, 110.0, 130.0])
+    assert curve_shift(force, f, [1.0, 3.0, 4.0]) == pytest.approx([0.05, 0.2, 0.3], rel=1e-12)
+    assert np.isnan(curve_shift(force, f, [4.5])[0])
+
+
+@pytest.mark.parametrize("order", [0.5, 1.0, 2.0])
+def test_observed_order_and_richardson_recover_a_power_law(order):
+    """q(h) = q* + C h^p on h, h/2, h/4, h/8: every observed order is p and Richardson gives q* exactly."""
+    h = np.array([0.4, 0.2, 0.1, 0.05])
+    q = 11.0 + 3.0 * h ** order
+    assert observed_orders(q) == pytest.approx([order, order], rel=1e-9)
+    assert richardson(q[-2], q[-1], order) == pytest.approx(11.0, rel=1e-12)
