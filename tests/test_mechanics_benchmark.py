@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from benchmarks.mechanics import curve_shift, observed_orders, paper_force_n, paper_shift, richardson
+from benchmarks.mechanics import curve_shift, observed_orders, paper_force_n, paper_shift, richardson, steady
 
 
 def test_paper_shift_is_eq5_without_k():
@@ -31,3 +31,17 @@ def test_observed_order_and_richardson_recover_a_power_law(order):
     q = 11.0 + 3.0 * h ** order
     assert observed_orders(q) == pytest.approx([order, order], rel=1e-9)
     assert richardson(q[-2], q[-1], order) == pytest.approx(11.0, rel=1e-12)
+    assert steady(q)
+
+
+def test_richardson_by_hand_and_steady_refuses_a_jittered_sequence():
+    """Richardson by hand, from coarse 12 and fine 11.5:
+    11.5 + (11.5 − 12)/(2¹ − 1) = 11; at order 2: 11.5 − 0.5/3. A sequence whose differences shrink but whose
+    observed orders disagree (0.35 then 2.47: the cap's F at 1 mm) or change sign is not steady."""
+    assert richardson(12.0, 11.5, 1.0) == pytest.approx(11.0, rel=1e-12)
+    assert richardson(12.0, 11.5, 2.0) == pytest.approx(11.5 - 0.5 / 3, rel=1e-12)
+    assert observed_orders([3.0, 2.0, 1.75]) == pytest.approx([2.0], rel=1e-12)
+    assert not steady([11.6547, 11.4156, 11.2281, 11.1944])
+    assert not steady([1.0, 0.5, 0.6])
+    assert not steady([1.0, 0.9, 0.7])
+    assert steady([1.95062, 1.92659, 1.91286, 1.90490])
