@@ -7,7 +7,8 @@ G = 0.3 MPa, timed, and set beside the paper's own numbers without fitting anyth
 - V(x): our cavity volume and the paper's V_eff = 0.5576 x² − 3.2659 x + 30.74 mm³ (Fig. 8, A = d²/4).
 Target: < 20 s per curve on the project machine.
 
-``--caps`` adds how the cap's outer diameter and top thickness move stiffness and sensitivity (Ogden);
+``--caps`` adds how the cap's outer diameter, top thickness, modulus and plate contact move stiffness and
+sensitivity (Ogden);
 ``--convergence [H ...]`` adds F and V at x = 0.2 … 1 mm on a mesh sequence (default h = 0.4, 0.2, 0.1,
 0.05 mm, ~1–1.5 min; neo-Hookean, sticking; 0.025 mm adds 3–5 min), successive differences, observed orders,
 a Richardson estimate and the default mesh (h = 0.2 mm) against it.
@@ -40,8 +41,11 @@ PAPER_F_OF_X = (8.8719, 2.8760)
 """Paper Fig. 8: F = slope · x + intercept (N/mm, N), a line through its measurements at x = 0.87 … 2.87 mm."""
 PAPER_X_MM = (0.87, 1.37, 1.87, 2.37, 2.87)
 """Paper §IV-B: the displacements it measured (besides 0.05 and 0.17 mm 'to approximate initial contact')."""
-CAPS = ((8.0, 2.0), (10.0, 2.0), (12.0, 2.0), (8.0, 1.5), (8.0, 3.0))
-"""(end_cap.outer_diameter, end_cap.top_thickness) in mm for ``--caps``; the first is the template's."""
+CAPS = ((8.0, 2.0, G_MPA, "sticking"), (10.0, 2.0, G_MPA, "sticking"), (12.0, 2.0, G_MPA, "sticking"),
+        (8.0, 1.5, G_MPA, "sticking"), (8.0, 3.0, G_MPA, "sticking"), (8.0, 2.0, 0.2, "sticking"),
+        (8.0, 2.0, 0.46, "sticking"), (8.0, 2.0, G_MPA, "frictionless"))
+"""(end_cap.outer_diameter mm, end_cap.top_thickness mm, shear modulus MPa, plate contact) for ``--caps``; the
+first is the template's."""
 MESHES_MM = (0.4, 0.2, 0.1, 0.05)
 
 
@@ -93,10 +97,13 @@ def steady(values, ratio: float = 2.0, spread: float = 0.25) -> bool:
     return bool(np.ptp(p) <= spread)
 
 
-def paper_spec(material: str, *overrides: str):
+def paper_spec(material: str, *overrides: str, g_mpa: float = G_MPA, contact: str | None = None):
+    """The paper template with ``material`` at shear modulus ``g_mpa`` (and ``contact`` when given), after
+    ``key=value`` overrides."""
     spec = spec_mod.load_spec(ROOT / "templates" / "mat-paper.toml", list(overrides))[0]
-    return dataclasses.replace(spec, mechanics=dataclasses.replace(spec.mechanics, material=material,
-                                                                   shear_modulus_mpa=G_MPA))
+    mech = dataclasses.replace(spec.mechanics, material=material, shear_modulus_mpa=g_mpa,
+                               contact=contact or spec.mechanics.contact)
+    return dataclasses.replace(spec, mechanics=mech)
 
 
 def compare_with_paper(fc, curve):
@@ -169,6 +176,10 @@ def materials():
               f"{fc.turn_force_n} (predicted) vs ~25 N (paper, Fig. 7); fitted ratios (shape-dependent, not a "
               f"comparison): b/V0 = {e.b / e.v0_mm3:.5f} /N, a/V0 = {e.a / e.v0_mm3:.3e} /N² (paper "
               f"{0.4626 / 32.21:.5f}, {-0.0086 / 32.21:.3e})")
+        slope0 = 100 * fc.sensitivity_hz_per_n[0] / fc.states[0].f_hz
+        print(f"  initial slope of f/f0: the curve's df/dF(0)/f0 {slope0:.3f} %/N, the Eq. 5 fit's b/(2 V0) "
+              f"{100 * e.b / (2 * e.v0_mm3):.3f} %/N, the paper's "
+              f"{100 * 0.4626 / (2 * 32.21):.3f} %/N")
         compare_with_paper(fc, curve)
     spec = paper_spec("ogden")
     curve = cap_curve(cap_case(spec))
@@ -182,19 +193,26 @@ def materials():
 
 
 def caps():
-    """Stiffness and sensitivity against the cap's outer diameter and top thickness (Ogden, G_MPA, sticking)."""
-    print(f"\ncap size (Ogden, G = {G_MPA} MPa, sticking, 10 steps to 2 mm; f shift by transmission line):")
-    print(f"  {'cap Ø mm':>8} {'top mm':>6} {'F(0.2) N':>8} {'F(1) N':>7} {'F(2) N':>7} {'df/dF(0) %/N':>12} "
-          f"{'df/f0 @10 N':>11} {'df/f0 @1 mm':>11} {'complete':>8}")
-    for diameter, top in CAPS:
-        spec = paper_spec("ogden", f"end_cap.outer_diameter={diameter}", f"end_cap.top_thickness={top}")
+    """Stiffness and sensitivity against the cap's outer diameter, top thickness, modulus and plate contact (Ogden):
+    F at x = 0.2, 1, 2 mm, the initial slope of f, our Δf/f0 at 1, 10, 20 N over paper Eq. 5's, and f at 1 mm."""
+    forces = (1.0, 10.0, 20.0)
+    paper = paper_shift(forces)
+    print("\ncap variants (Ogden, 10 steps to 2 mm; f shift by transmission line; ratio = our df/f0 over paper "
+          "Eq. 5's at equal force):")
+    print(f"  {'cap Ø mm':>8} {'top mm':>6} {'G MPa':>5} {'contact':>12} {'F(0.2) N':>8} {'F(1) N':>7} {'F(2) N':>7} "
+          f"{'df/dF(0) %/N':>12} {'df/f0 @10 N':>11} {'ratio @1/10/20 N':>16} {'df/f0 @1 mm':>11} {'complete':>8}")
+    for diameter, top, g, contact in CAPS:
+        spec = paper_spec("ogden", f"end_cap.outer_diameter={diameter}", f"end_cap.top_thickness={top}", g_mpa=g,
+                          contact=contact)
         curve = cap_curve(cap_case(spec))
         fc = force_curve(design(spec), curve)
         force, x = curve.column("force_n"), curve.column("displacement_mm")
         f = np.array([s.f_hz for s in fc.states])
         at = [np.interp(xp, x, force) if xp <= x[-1] + 1e-9 else float("nan") for xp in (0.2, 1.0, 2.0)]
-        print(f"  {diameter:8.1f} {top:6.1f} {at[0]:8.2f} {at[1]:7.2f} {at[2]:7.2f} "
-              f"{100 * fc.sensitivity_hz_per_n[0] / f[0]:12.3f} {100 * curve_shift(force, f, [10.0])[0]:10.2f}% "
+        ours = curve_shift(force, f, forces)
+        print(f"  {diameter:8.1f} {top:6.1f} {g:5.2f} {contact:>12} {at[0]:8.2f} {at[1]:7.2f} {at[2]:7.2f} "
+              f"{100 * fc.sensitivity_hz_per_n[0] / f[0]:12.3f} {100 * ours[1]:10.2f}% "
+              f"{' / '.join(f'{r:.2f}' for r in ours / paper):>16} "
               f"{100 * (np.interp(1.0, x, f) / f[0] - 1):10.2f}% {str(curve.complete):>8}")
         if not curve.complete:
             print(f"    {curve.message}")
@@ -260,7 +278,7 @@ def convergence(meshes_mm):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--caps", action="store_true", help="add the cap-size sweep (5 curves, ~1 min)")
+    ap.add_argument("--caps", action="store_true", help="add the cap, modulus and contact variants (8 curves, 2-4 min)")
     ap.add_argument("--convergence", nargs="*", type=float, metavar="H",
                     help=f"add the mesh sequence (element sizes in mm, default {' '.join(map(str, MESHES_MM))})")
     ap.add_argument("--skip-materials", action="store_true", help="skip the default three-material run")
