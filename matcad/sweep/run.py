@@ -95,9 +95,11 @@ class SweepResult:
 def allowed_models(spec) -> list[str]:
     """Model names a sweep of ``spec`` accepts: the registered models evaluated for its wall
     (:mod:`matcad.acoustics.registry`), and the derived ``relative`` when it has a [reference]."""
-    from matcad.acoustics.registry import DERIVED, MODELS
+    from matcad.acoustics.registry import MODELS
+    from matcad.prediction.anchor import available
 
-    return [m.name for m in MODELS if spec.wall.model in m.walls] + (list(DERIVED) if spec.reference else [])
+    return ([m.name for m in MODELS if spec.wall.model in m.walls] + available(spec)
+            + (["relative"] if spec.reference else []))
 
 
 def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor: Executor = Executor(),
