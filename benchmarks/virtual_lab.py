@@ -132,11 +132,11 @@ def lab(seed: int, level: int, load: bool) -> dict:
                      "band_hz": list(p.band_hz),
                      "physics_hz": p.physics_f0_hz, "model": p.model,
                      "as_built_error": p.f0_hz / truth - 1, "physics_error": p.physics_f0_hz / truth - 1,
-                     "inside": p.band_hz[0] <= truth <= p.band_hz[1]})
+                     "inside": bool(p.band_hz[0] <= truth <= p.band_hz[1])})
     from matcad.prediction.inference import infer
 
     inference = infer(measured)
-    recovered = {name: {"hidden": getattr(state, name), "low": lo, "high": hi, "inside": lo <= getattr(state, name) <= hi}
+    recovered = {name: {"hidden": getattr(state, name), "low": lo, "high": hi, "inside": bool(lo <= getattr(state, name) <= hi)}
                  for name, _, lo, hi in inference.intervals()}
     return {"seed": seed, "level": level, "load": load, "hidden": dataclasses.asdict(state),
             "measured_f0_hz": f_meas, "rows": rows, "recovered": recovered, "seconds": time.perf_counter() - t0}
