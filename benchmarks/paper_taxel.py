@@ -36,7 +36,7 @@ X_MM = (0.05, 0.17, 0.87, 1.37, 1.87, 2.37, 2.87)
 F_OF_X = (8.8719, 2.876)
 """The paper's Fig. 8 line F = slope·x + intercept (N/mm, N)."""
 HYPOTHESES = {
-    "the drawing (only the model's shared error)": (),
+    "the drawing (nothing moves)": (),
     "neck cut wider or narrower, tapered": ("neck_offset_mm", "neck_taper_mm"),
     "sheet thicker or thinner": ("sheet_offset_mm",),
     "joined air": ("side_volume_mm3",),
@@ -45,8 +45,7 @@ HYPOTHESES = {
     "neck + static modulus": ("neck_offset_mm", "neck_taper_mm", "static_modulus_scale"),
     "everything": None,
 }
-"""Each hypothesis: the as-built parameters it lets move (None: all of them); the model's shared error
-(``model_factor``, its prior the model's max |error| against the FEM as 2 sd) moves in every one."""
+"""Each hypothesis: the as-built parameters it lets move (None: all of them)."""
 NECK_1_16_IN = 1.5875
 """A 1/16 in neck (mm): the reading in which the paper's "d = 2.10 mm" is the needle's distance y."""
 
@@ -81,7 +80,6 @@ def lab_spec(level: str, drawing: dict | None = None):
 def fit_row(name: str, free, level: str, drawing: dict | None = None) -> dict:
     from matcad.prediction.inference import infer
 
-    free = None if free is None else (*free, "model_factor")
     inf = infer(lab_spec(level, drawing), free)
     moving = set(free) if free is not None else None
     state = {n: {"value": v, "low_95": lo, "high_95": hi} for n, v, lo, hi in inf.intervals()

@@ -116,7 +116,7 @@ def test_one_f0_cannot_tell_neck_from_joined_air_and_a_hypothesis_can_be_pinned(
     pinned = infer(lab, free=("side_volume_mm3",))
     state = pinned.state
     assert state.side_volume_mm3 == pytest.approx(30.0, rel=0.2)
-    assert (state.neck_offset_mm, state.static_modulus_scale, state.model_factor) == (0.0, 1.0, 1.0)
+    assert (state.neck_offset_mm, state.sheet_offset_mm, state.static_modulus_scale) == (0.0, 0.0, 1.0)
     with pytest.raises(ValueError, match="no as-built parameter"):
         infer(lab, free=("neck_width",))
 

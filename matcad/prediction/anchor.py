@@ -142,16 +142,18 @@ class AsBuiltAnchor:
         p = self.inference.predict(spec)
         f0 = p.f0_hz
         names = ", ".join(t.name for t in self.inference.taxels)
-        lines = [BudgetLine("as-built state", f"inferred from {len(self.inference.taxels)} measured taxel(s) "
+        state = (BudgetLine("measured", f"this drawing was measured ({', '.join(p.measured)}): its f0 +-1.96 sd",
+                            p.state_low_hz, p.state_high_hz) if p.measured else
+                 BudgetLine("as-built state", f"inferred from {len(self.inference.taxels)} measured taxel(s) "
                                               f"({names}), {self.inference.data_count} data: 95 % of its states",
-                            p.state_low_hz, p.state_high_hz),
+                            p.state_low_hz, p.state_high_hz))
+        lines = [state,
                  BudgetLine("part to part", "one laser's neck holes +-0.03 mm (1 sd)", -Z95 * p.part_sd_hz,
                             Z95 * p.part_sd_hz)]
-        if p.model_sd_hz > 0:  # none for a drawing that was measured: the model's shared error is in the state
-            lines.insert(1, BudgetLine("model", f"{p.model}: max |error| of a ratio to the measured designs vs FEM "
-                                                "as 2 sd" + (f" (failing {', '.join(p.failed_checks)})"
-                                                             if p.failed_checks else ""),
-                                       -Z95 * p.model_sd_hz, Z95 * p.model_sd_hz))
+        if p.model_sd_hz > 0:  # none for a drawing that was measured
+            lines.insert(1, BudgetLine("model", f"{p.model} on the built design: max |error| vs FEM as 2 sd"
+                                                + (f" (failing {', '.join(p.failed_checks)})" if p.failed_checks
+                                                   else ""), -Z95 * p.model_sd_hz, Z95 * p.model_sd_hz))
         if p.doublet_hz is not None:
             gap = p.doublet_hz - f0
             lines.append(BudgetLine("doublet", f"a cap mode near f: the cavity also peaks at {p.doublet_hz:.0f} Hz "

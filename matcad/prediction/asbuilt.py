@@ -73,14 +73,6 @@ def _cavity_volume(spec) -> float:
     return float(drafted_cavity_volume_mm3(spec.cavity.diameter, spec.cavity.length, spec.mold.draft_deg))
 
 
-def _model_sd(spec) -> float:
-    """sd of ln(true f0 / the chosen model's) for the spec's wall: the model's max |error| against the FEM over
-    every benchmark geometry (model_errors.json) over :data:`MODEL_ERROR_SIGMAS`."""
-    from matcad.acoustics.registry import CHOSEN, model_errors
-
-    return model_errors()[CHOSEN[spec.wall.model]]["max_abs_all"] / MODEL_ERROR_SIGMAS
-
-
 def _sheet_sd(spec) -> float:
     from matcad.acoustics.uncertainty import sheet_tolerance_mm
 
@@ -101,9 +93,6 @@ PARAMETERS = (
               "lognormal", lambda spec: (1.0, KHZ_FACTOR_SD)),
     Parameter("static_modulus_scale", "", "silicone's static modulus over the grade's (the cap mechanics' and "
               "the wall's)", "lognormal", lambda spec: (1.0, STATIC_MODULUS_SD)),
-    Parameter("model_factor", "", "true f0 over the chosen model's: the part of its error every taxel of a lab "
-              "shares (what differs between designs is its ratio error)", "lognormal",
-              lambda spec: (1.0, _model_sd(spec))),
 )
 """Every as-built unknown, in the order of a state's vector."""
 NAMES = tuple(p.name for p in PARAMETERS)
@@ -119,7 +108,6 @@ class State:
     side_volume_mm3: float = 0.0
     khz_modulus_scale: float = 1.0
     static_modulus_scale: float = 1.0
-    model_factor: float = 1.0
 
     def vector(self) -> np.ndarray:
         return np.array([getattr(self, n) for n in NAMES])

@@ -12,13 +12,15 @@ part-to-part scatter and, where a cap mode makes a doublet, the other peak (docs
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from matcad.prediction import asbuilt
 from matcad.prediction.measurements import (TEMPERATURE_SD_C, Problem, Residual, Taxel, design_of, drawing,
-                                            f0_hz, ratio_sd, taxels)
+                                            f0_hz, model_sd, taxels)
 
 PART_NECK_SD_MM = 0.03
 """Part-to-part scatter of one laser's neck holes (sd, mm) that no lab state can carry."""
@@ -32,6 +34,8 @@ CORRELATED = 0.8
 WEIGHT_SHOWN = 0.3
 """A parameter's weight in a fixed combination (a unit vector in standard coordinates) that the report names."""
 FIT_TOLERANCE = 1e-10
+Z95 = 1.959963984540054
+"""Standard normal quantile of a 95 % two-sided range."""
 SAMPLES = 100
 DRAWS = 4
 """Draws made per kept sample (those past a parameter's bound are dropped)."""
@@ -145,10 +149,10 @@ class Inference:
     def predict(self, spec) -> PredictedF0:
         """f0 of the single-taxel ``spec`` built by this lab (Hz): the posterior median of the model over the
         lab's states (not the most probable state's: near a cap mode one state's model may sit on a doublet's other
-        peak), the 95 % range over the posterior's states (sampled: a state may tip a doublet to its other peak; the model's shared
-        error is the state's ``model_factor``), the model's ratio error to the measured drawings (none for a drawing
-        that was measured; over every benchmark pair when the built design fails one of the model's checks), the air
-        temperature of use, part-to-part scatter, and the doublet's other peak when the built design has one."""
+        peak), the 95 % range over the posterior's states (importance-weighted samples), the model's own error
+        (over every benchmark case when the built design fails one of its checks), the air temperature of use,
+        part-to-part scatter, and the doublet's other peak when the built design has one. A drawing that was
+        measured is its measurement (the inverse-variance mean of its taxels' f0, at this air), not the model."""
         from matcad.acoustics import registry
         from matcad.acoustics.evaluation import Evaluation
         from matcad.acoustics.resonator import elastic_wall_doublet_hz, resonator
@@ -168,10 +172,17 @@ class Inference:
         if self.model == "elastic_wall":
             shear, loss = registry.model(self.model).wall_arguments(built.wall)
             doublet = elastic_wall_doublet_hz(resonator(built), shear, loss)
-        measured = any(drawing(t.spec) == drawing(spec) for t in self.taxels)
-        model = 0.0 if measured else ratio_sd(self.model, not failed) * f
-        return PredictedF0(f, float(min(low, 0.0)), float(max(high, 0.0)), self.model, model, temperature, part,
-                           failed, doublet)
+        same = [t for t in self.taxels if t.f0_hz is not None and drawing(t.spec) == drawing(spec)]
+        if same:  # a drawing that was measured: its measurement, carried to this air (f follows sqrt(T))
+            kelvin = d.air.temperature_c + 273.15
+            fs = np.array([t.f0_hz * np.sqrt(kelvin / (t.temperature_c + 273.15)) for t in same])
+            w = 1.0 / np.array([max(t.f0_sd_hz, 1e-9) ** 2 for t in same])
+            f = float(np.sum(w * fs) / np.sum(w))
+            half = Z95 / math.sqrt(float(np.sum(w)))
+            return PredictedF0(f, -half, half, self.model, 0.0, temperature, part, failed, None,
+                               tuple(t.name for t in same))
+        return PredictedF0(f, float(min(low, 0.0)), float(max(high, 0.0)), self.model,
+                           model_sd(self.model, not failed) * f, temperature, part, failed, doublet)
 
     def to_dict(self) -> dict:
         return {"model": self.model, "data": self.data_count, "chi2": self.chi2,
@@ -216,7 +227,8 @@ class PredictedF0:
     """A design's f0 built in an inferred state (Hz) and its uncertainty by source: the 95 % range over the
     posterior's states (offsets, low ≤ 0 ≤ high), the model's own error (sd; over every benchmark case where the
     built design fails one of the model's checks, named in ``failed_checks``), the air temperature of use and
-    part-to-part scatter (sd), and the other peak of a doublet (None: one peak wins)."""
+    part-to-part scatter (sd), the other peak of a doublet (None: one peak wins), and the measured taxels whose
+    drawing this is (then f0 and its range are theirs)."""
 
     f0_hz: float
     state_low_hz: float
@@ -227,6 +239,7 @@ class PredictedF0:
     part_sd_hz: float
     failed_checks: tuple[str, ...] = ()
     doublet_hz: float | None = None
+    measured: tuple[str, ...] = ()
 
 
 def weighted_quantiles(values, weights, qs) -> np.ndarray:

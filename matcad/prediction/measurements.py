@@ -92,16 +92,13 @@ def model_name(spec) -> str:
     return CHOSEN[spec.wall.model]
 
 
-def ratio_sd(name: str, valid: bool = True) -> float:
-    """Relative sd of model ``name``'s ratio of two designs' f0 against the FEM's: its max |error| of a ratio over
-    the benchmark's pairs (where its checks pass, or all of them) over
-    :data:`~matcad.prediction.asbuilt.MODEL_ERROR_SIGMAS`. What the model gets wrong for one design and not for
-    another; the shared part is the state's ``model_factor``."""
+def model_sd(name: str, valid: bool = True) -> float:
+    """Relative sd of model ``name``'s f0 against the FEM: its max |error| over the benchmark geometries (where its
+    checks pass, or all of them) over :data:`~matcad.prediction.asbuilt.MODEL_ERROR_SIGMAS`."""
     from matcad.acoustics.registry import model_errors
+    from matcad.acoustics.uncertainty import model_error_share
 
-    error = model_errors()[name]
-    share = error["ratio_max_abs"] if valid else error.get("ratio_max_abs_all", error["ratio_max_abs"])
-    return float(share) / asbuilt.MODEL_ERROR_SIGMAS
+    return float(model_error_share(model_errors()[name], valid)) / asbuilt.MODEL_ERROR_SIGMAS
 
 
 def drawing(spec) -> tuple:
@@ -125,7 +122,7 @@ def f0_hz(d, state: asbuilt.State, name: str) -> float:
     from matcad.acoustics.resonator import resonator
 
     b = asbuilt.built(d, state)
-    return float(registry.model(name).f0_hz(resonator(b), b.wall)) * state.model_factor
+    return float(registry.model(name).f0_hz(resonator(b), b.wall))
 
 
 def shift_ratios(d, state: asbuilt.State, curve, forces_n) -> np.ndarray:
@@ -212,11 +209,9 @@ class Problem:
 
         self.name = model_name(data[0].spec)
         self.designs = [design(t.spec) for t in data]
-        # the model's error that differs between the drawings measured (its shared part is the state's
-        # model_factor): none when every measured taxel has one drawing
-        several = len({drawing(t.spec) for t in data}) > 1
-        self.sd_model = [ratio_sd(self.name, registry.model(self.name).result(Evaluation(d)).valid) / math.sqrt(2)
-                         if several else 0.0 for d in self.designs]
+        # each taxel's model error: over every benchmark case where its drawing fails one of the model's checks
+        self.sd_model = [model_sd(self.name, registry.model(self.name).result(Evaluation(d)).valid)
+                         for d in self.designs]
         self.curves = [measured_curve(t) if t.mechanics else None for t in data]
         self.zeros = [i for i, t in enumerate(data) if t.displacements_mm]
         self.temperature_sd = []  # relative f sd from an unstated measurement temperature
