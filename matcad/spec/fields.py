@@ -22,14 +22,26 @@ LENGTH_MIN_MM = 1e-3
 LENGTH_MAX_MM = 1e5
 
 
+class _Missing:
+    """The ``value`` of a SpecError about a table or field that is not there at all (no ``= None`` in messages)."""
+
+    def __repr__(self) -> str:
+        return "(missing)"
+
+
+MISSING: Any = _Missing()
+
+
 class SpecError(ValueError):
-    """Bad spec input. ``field`` is the dotted spec key, ``value`` what was given, ``allowed`` the rule."""
+    """Bad spec input. ``field`` is the dotted spec key, ``value`` what was given (:data:`MISSING` when nothing
+    was), ``allowed`` the rule."""
 
     def __init__(self, field_name: str, value: Any, allowed: str):
         self.field = field_name
         self.value = value
         self.allowed = allowed
-        super().__init__(f"{field_name} = {shorten(value)}: {allowed}")
+        given = "" if value is MISSING else f" = {shorten(value)}"
+        super().__init__(f"{field_name}{given}: {allowed}")
 
 
 def param(doc: str, unit: str = "", default: Any = dataclasses.MISSING, *, kind: str = "number",
@@ -160,7 +172,7 @@ def read_section(cls: type, path: str, data: Any) -> Any:
         if name in data:
             values[name] = convert(f"{path}.{name}", data[name], dict(f.metadata))
         elif f.default is dataclasses.MISSING:
-            raise SpecError(f"{path}.{name}", None, f"is required ({f.metadata['doc']})")
+            raise SpecError(f"{path}.{name}", MISSING, f"is required ({f.metadata['doc']})")
     own = cls.table
     try:
         return cls(**values)
@@ -185,5 +197,5 @@ class Section:
             if value is None and f.default is None:
                 continue
             if value is None and f.default is dataclasses.MISSING:
-                raise SpecError(f"{path}.{f.name}", None, f"is required ({f.metadata['doc']})")
+                raise SpecError(f"{path}.{f.name}", MISSING, f"is required ({f.metadata['doc']})")
             object.__setattr__(self, f.name, convert(f"{path}.{f.name}", value, dict(f.metadata)))

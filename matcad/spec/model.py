@@ -14,7 +14,7 @@ from typing import Any
 from matcad.materials import GRADES
 from matcad.spec.calibration import Calibration
 from matcad.spec.checks import cross_checks
-from matcad.spec.fields import SpecError, convert, did_you_mean, param, read_section
+from matcad.spec.fields import MISSING, SpecError, convert, did_you_mean, param, read_section
 from matcad.spec.sections import (CAP_OUTER_PER_D, CAP_TOP_PER_D, MAX_TAXELS, Air, Array, Cavity, EndCap,
                                   Fasteners, Guide, Machine, Mechanics, Microphone, Mold, Mount, Neck, Needle,
                                   Outputs, Plate, Reference, Silicone, Spacer, TaxelEntry, Wall)
@@ -53,7 +53,7 @@ class Spec:
         for section, cls in SECTIONS.items():
             value = getattr(self, section)
             if value is None and section in REQUIRED_SECTIONS:
-                raise SpecError(section, None, f"is required: add a [{section}] table")
+                raise SpecError(section, MISSING, f"is required: add a [{section}] table")
             if value is not None and not isinstance(value, cls):
                 raise SpecError(section, value, f"must be a {cls.__name__} section")
         object.__setattr__(self, "taxel", tuple(self.taxel))
@@ -78,7 +78,7 @@ def from_dict(data: dict) -> Spec:
             raise SpecError(key, data[key], did_you_mean(key, known))
     name_meta = dict(dataclasses.fields(Spec)[0].metadata)
     if "name" not in data:
-        raise SpecError("name", None, f"is required ({name_meta['doc']})")
+        raise SpecError("name", MISSING, f"is required ({name_meta['doc']})")
     values: dict[str, Any] = {"name": convert("name", data["name"], name_meta)}
     for section, cls in SECTIONS.items():
         if section in data and data[section] is None and section not in REQUIRED_SECTIONS:
@@ -86,7 +86,7 @@ def from_dict(data: dict) -> Spec:
         if section in data:
             values[section] = read_section(cls, section, data[section])
         elif section in REQUIRED_SECTIONS:
-            raise SpecError(section, None, f"is required: add a [{section}] table")
+            raise SpecError(section, MISSING, f"is required: add a [{section}] table")
     if "taxel" in data:
         values["taxel"] = _taxel_entries(data["taxel"])
     return _resolve_defaults(Spec(**values))  # Spec.__post_init__ runs the cross-field checks

@@ -13,7 +13,8 @@ from typing import Any, ClassVar
 
 from matcad.materials import DEFAULT_GRADE, GRADES
 from matcad.spec.calibration import Calibration
-from matcad.spec.fields import LENGTH_MAX_MM, LENGTH_MIN_MM, Section, SpecError, length_mm, param
+from matcad.spec.fields import (LENGTH_MAX_MM, LENGTH_MIN_MM, MISSING, Section, SpecError, length_mm,
+                               param)
 
 CAP_OUTER_PER_D = 2.5
 CAP_TOP_PER_D = 0.6
@@ -340,7 +341,7 @@ class Array(Section):
                                                      f"(columns = {self.columns})")
         for count, pitch in (("columns", "pitch_x"), ("rows", "pitch_y")):
             if getattr(self, count) > 1 and getattr(self, pitch) is None:
-                raise SpecError(f"array.{pitch}", None, f"is required when array.{count} > 1 (mm between neck "
+                raise SpecError(f"array.{pitch}", MISSING, f"is required when array.{count} > 1 (mm between neck "
                                                         "axes)")
 
 
