@@ -34,7 +34,7 @@ SPEC_CASES = {
     "deep-nesting-recursion": ("x = " + "[" * 5000 + "]" * 5000 + "\n" + MINIMAL, "spec file"),
     "deep-tables": (MINIMAL + "[cavity.a" + ".b" * 40 + "]\nz = 1\n", "spec file"),
     "int-309-digits-overflow": (MINIMAL.replace("length = 4.76", "length = " + "9" * 320), "cavity.length"),
-    "int-beyond-parser-digit-limit": (MINIMAL.replace("length = 4.76", "length = " + "9" * 5000), "spec file"),
+    "int-beyond-parser-digit-limit": (MINIMAL.replace("length = 4.76", "length = " + "9" * 5000), "cavity.length"),
     "name-trailing-newline": (MINIMAL.replace('name = "t"', 'name = "abc\\n"'), "name"),
     "huge-value-echo-truncated": (MINIMAL.replace('name = "t"', 'name = "' + "x" * 200_000 + '"'), "name"),
 }
@@ -554,3 +554,177 @@ def test_export_failure_is_an_os_error_not_a_runtime_error(tmp_path, monkeypatch
         mesh.write_stl(Box(1, 1, 1), tmp_path / "a.stl", 0.01, 0.1)
     with pytest.raises(OSError, match="no space left"):
         mesh.write_step(Box(1, 1, 1), tmp_path / "a.step")
+
+
+# ---- issue 21: --set obeys the spec file's limits and refuses text after its value ----------------------------
+
+@pytest.mark.parametrize("value,needles", [
+    ("9" * 5000, ["neck.diameter", "5000 digits"]),
+    ("[" * 3000 + "]" * 3000, ["--set neck.diameter", "deeper than 32"]),
+    ("2.0\n[air]\ntemperature_c=-20", ["--set neck.diameter", "text after its value", "temperature_c=-20"]),
+])
+def test_set_values_obey_the_file_limits(value, needles):
+    code, out, err = run_cli("check", PAPER, "--set", f"neck.diameter={value}")
+    _assert_clean(code, err, 2, *needles)
+    assert len(err) < 600 and out == ""
+
+
+def test_set_comment_after_a_value_is_no_trailing_text():
+    from matcad.spec.io import parse_assignment
+
+    assert parse_assignment("neck.diameter=2.0  # calipered") == (["neck", "diameter"], 2.0)
+    assert parse_assignment("wall.model=silicone") == (["wall", "model"], "silicone")
+
+
+def test_file_integer_beyond_the_digit_limit_names_its_field(write_spec):
+    code, _, err = run_cli("check", write_spec(MINIMAL.replace("length = 4.76", "length = " + "9" * 5000)))
+    _assert_clean(code, err, 2, "cavity.length", "5000 digits", "line 4")
+    assert "ValueError" not in err
+
+
+# ---- issue 21: files from the user's world --------------------------------------------------------------------
+
+def test_utf8_bom_spec_and_csv_are_read_as_without_it(tmp_path):
+    spec = tmp_path / "bom.toml"
+    spec.write_bytes(b"\xef\xbb\xbf" + LASER_ONLY.encode())
+    plain = tmp_path / "plain.toml"
+    plain.write_text(LASER_ONLY)
+    code_bom, out_bom, err = run_cli("predict", spec, "--json")
+    assert code_bom == 0, err
+    assert json.loads(out_bom)["f0_hz"] == json.loads(run_cli("predict", plain, "--json")[1])["f0_hz"]
+    rows = "force_n,frequency_hz\n" + "".join(f"{f},{4500 + 9 * f + 0.1 * f * f}\n" for f in range(0, 20, 2))
+    data = tmp_path / "bom.csv"
+    data.write_bytes(b"\xef\xbb\xbf" + rows.encode())
+    plain_csv = tmp_path / "plain.csv"
+    plain_csv.write_text(rows)
+    code, out, err = run_cli("calibrate", data, "--spec", PAPER, "--out", tmp_path / "c", "--json")
+    assert code == 0, err
+    want = json.loads(run_cli("calibrate", plain_csv, "--spec", PAPER, "--out", tmp_path / "d", "--json")[1])
+    got = json.loads(out)
+    assert got["points"] == 10 and (got["a"], got["b"]) == (want["a"], want["b"])
+
+
+@pytest.mark.parametrize("rows", ["force_n;frequency_hz\n0;4500,5\n2;4520,1\n",
+                                  "force_n,frequency_hz\n0,\"4500,5\"\n2,\"4520,1\"\n"])
+def test_european_csv_is_named_as_such(rows, tmp_path):
+    data = tmp_path / "eu.csv"
+    data.write_text(rows)
+    code, _, err = run_cli("calibrate", data, "--spec", PAPER, "--out", tmp_path / "c")
+    _assert_clean(code, err, 2, "European", "';' between columns", "decimal mark")
+    assert not (tmp_path / "c").exists()
+
+
+def test_spec_in_inches_gets_a_unit_note(write_spec):
+    inches = 'name = "t"\n[cavity]\ndiameter = 0.125\nlength = 0.1875\n[neck]\ndiameter = 0.0827\nlength = 0.25\n'
+    code, _, err = run_cli("predict", write_spec(inches))
+    assert code == 0, err
+    assert "inches?" in err and "cavity.diameter = 3.175" in err and "neck.length = 6.35" in err
+    code, _, err = run_cli("predict", PAPER)
+    assert "inches" not in err
+
+
+def test_band_in_khz_gets_a_hint(tmp_path):
+    wav = tmp_path / "r.wav"
+    wavfile.write(wav, 44100, (np.sin(2 * np.pi * 4600 * np.arange(44100) / 44100) * 2e4).astype(np.int16))
+    code, _, err = run_cli("analyze", wav, "--band", "4.5", "5.5", "--out", tmp_path / "a")
+    _assert_clean(code, err, 2, "kHz", "--band 4500 5500")
+    assert not (tmp_path / "a").exists()
+
+
+@pytest.mark.parametrize("target", ["C:\\Users\\lab\\out", "D:/kits", "kits\\paper"])
+def test_windows_out_path_is_refused_on_posix(target, tmp_path):
+    code, _, err = run_cli("build", ROOT / "templates" / "mat-laser-only.toml", "--out", target, cwd=tmp_path)
+    _assert_clean(code, err, 2, "Windows path", "--out")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv,code,field", [
+    (["predict", PAPER, "--set", "neck.diameter=-1"], 2, "neck.diameter"),
+    (["check", "missing.toml"], 2, "spec file"),
+    (["calibrate", "missing.csv", "--spec", PAPER], 2, None),
+])
+def test_json_error_object_on_stdout(argv, code, field):
+    got, out, err = run_cli(*argv, "--json")
+    assert got == code, err
+    error = json.loads(out)["error"]
+    assert error["exit_code"] == code and error["field"] == field and error["message"] in err
+    assert error["written"] == []
+
+
+def test_json_error_object_for_a_loop_refusal(tmp_path):
+    wav = tmp_path / "silence.wav"
+    wavfile.write(wav, 44100, np.zeros(44100, np.int16))
+    code, out, err = run_cli("analyze", wav, "--band", "4000", "5500", "--json", "--out", tmp_path / "a")
+    assert code == 1 and json.loads(out)["error"]["message"] in err
+
+
+@pytest.mark.parametrize("text,field", [("name = 't'\n[cavity]\ndiameter = 3\nlength = 4\n", "neck"),
+                                        (MINIMAL.replace("length = 6.35\n", ""), "neck.length"),
+                                        ("[cavity]\ndiameter = 3\n", "name")])
+def test_missing_table_or_field_is_named_without_none(text, field, write_spec):
+    code, _, err = run_cli("check", write_spec(text))
+    _assert_clean(code, err, 2, f"{field}: is required")
+    assert "None" not in err
+
+
+# ---- issue 21: partly fixed before ----------------------------------------------------------------------------
+
+def test_full_stdout_says_truthfully_what_was_written(tmp_path):
+    """`> /dev/full`: the kit is written whole, then the summary cannot be printed; the message says so (exit 2),
+    never that nothing was written. A command that writes nothing says that."""
+    import subprocess
+    import sys
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(LASER_ONLY)
+    kit = tmp_path / "k"
+    for extra in ([], ["--json"]):
+        with open("/dev/full", "w") as full:
+            proc = subprocess.run([sys.executable, "-m", "matcad", "build", spec, "--out", kit, *extra], cwd=ROOT,
+                                  stdout=full, stderr=subprocess.PIPE, text=True)
+        _assert_clean(proc.returncode, proc.stderr, 2, "standard output", "written and is complete", str(kit))
+        assert _kit_intact(kit)
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "matcad", "check", spec], cwd=ROOT, stdout=full,
+                              stderr=subprocess.PIPE, text=True)
+    _assert_clean(proc.returncode, proc.stderr, 2, "standard output", "nothing was written")
+
+
+def test_float_wav_at_1e300_is_refused_without_numpy_warnings(tmp_path):
+    wav = tmp_path / "f.wav"
+    wavfile.write(wav, 44100, np.array([1e300, -1e300, 0.5] * 3000, np.float64))
+    code, _, err = run_cli("analyze", wav, "--band", "4000", "5500", "--out", tmp_path / "a")
+    _assert_clean(code, err, 2, "recording", "1e+300")
+    assert "Warning" not in err and "nan" not in err
+
+
+def test_subnormal_calibration_frequencies_are_refused_cleanly(tmp_path):
+    data = tmp_path / "sub.csv"
+    data.write_text("force_n,frequency_hz\n0,1e-319\n1,1.02e-319\n2,1.04e-319\n3,1.03e-319\n")
+    code, _, err = run_cli("calibrate", data, "--spec", PAPER, "--out", tmp_path / "c")
+    _assert_clean(code, err, 2, "calibration data", "row 2", "frequency")
+    assert "Warning" not in err and "did you mean" not in err
+    from matcad.spec import frequency_notes
+
+    assert frequency_notes([1e-300]) == [] and frequency_notes([4.5, 4.6])  # kHz still gets its note
+
+
+def test_force_on_an_unforceable_rule_says_it_cannot_be_forced(write_spec, tmp_path):
+    path = write_spec(PAPER.read_text() + "\n[needle]\ntheta_deg = 1e-6\n")
+    code, out, err = run_cli("build", path, "--force", "--out", tmp_path / "k")
+    _assert_clean(code, err, 1, "--force cannot override", "needle.bore")
+    assert "use --force" not in err
+    code, out, err = run_cli("build", path, "--force", "--json", "--out", tmp_path / "k")
+    assert code == 1 and json.loads(out)["unforceable"] == ["needle.bore"]
+    code, _, err = run_cli("build", path, "--out", tmp_path / "k")
+    _assert_clean(code, err, 1, "--force cannot override needle.bore")
+    assert not (tmp_path / "k").exists()
+
+
+@pytest.mark.parametrize("seconds", [0.094, 0.12, 0.138])
+def test_short_clean_tone_says_it_is_too_short(seconds, tmp_path):
+    wav = tmp_path / "short.wav"
+    t = np.arange(int(44100 * seconds)) / 44100
+    wavfile.write(wav, 44100, (np.sin(2 * np.pi * 4600 * t) * 2e4).astype(np.int16))
+    code, _, err = run_cli("analyze", wav, "--band", "4000", "5500", "--out", tmp_path / "a")
+    _assert_clean(code, err, 1, "too short for a run of 2 frames", "record longer")
