@@ -728,3 +728,47 @@ def test_short_clean_tone_says_it_is_too_short(seconds, tmp_path):
     wavfile.write(wav, 44100, (np.sin(2 * np.pi * 4600 * t) * 2e4).astype(np.int16))
     code, _, err = run_cli("analyze", wav, "--band", "4000", "5500", "--out", tmp_path / "a")
     _assert_clean(code, err, 1, "too short for a run of 2 frames", "record longer")
+
+
+# ---- issue 21: numbers inside their range that crashed ---------------------------------------------------------
+
+@pytest.mark.parametrize("setting,field", [("wall.khz_modulus_factor=[1e-300, 1e-300]", "wall.khz_modulus_factor"),
+                                           ("wall.khz_modulus_factor=[0.5, 1.0]", "wall.khz_modulus_factor"),
+                                           ("wall.shear_modulus_mpa=[1e-300, 1e-300]", "wall.shear_modulus_mpa")])
+@pytest.mark.parametrize("command", ["check", "predict"])
+def test_unphysical_wall_moduli_are_refused_at_the_spec(setting, field, command):
+    """G = G_static × factor underflowed to 0 (exit 70): an elastomer's storage modulus never falls with frequency
+    (factor >= 1) and no cast silicone is softer than ~1 kPa, so both are refused naming the field."""
+    code, _, err = run_cli(command, PAPER, "--set", setting)
+    _assert_clean(code, err, 2, field)
+
+
+@pytest.mark.parametrize("template", ["mat-paper.toml", "mat-array-4.toml"])
+def test_lossless_wall_follows_the_helmholtz_branch(template):
+    """η → 0 (loss_factor = [0, 0] is allowed): the resonance stays the taxel's, continuous with a lightly damped
+    wall, never an undamped wall mode's spike (the paper's taxel gave 3033 Hz for 5288 Hz before)."""
+    from matcad.prediction import predict
+
+    base = spec_mod.load(ROOT / "templates" / template)
+    base = spec_mod.taxel_spec(base, spec_mod.taxels(base)[0])
+    f = {}
+    for eta in (0.0, 1e-9, 1e-3, 0.01, 0.05):
+        f[eta] = predict(dataclasses.replace(base, wall=dataclasses.replace(base.wall, loss_factor=(eta, eta))))
+    assert f[0.0].f0_hz == pytest.approx(f[0.01].f0_hz, rel=0.005)
+    assert f[0.0].f0_hz == pytest.approx(f[1e-9].f0_hz, rel=1e-6)
+    for eta, p in f.items():
+        assert p.band_hz[0] > 0.85 * f[0.05].band_hz[0] and p.band_hz[1] < 1.15 * f[0.05].band_hz[1], (eta, p.band_hz)
+
+
+def test_rigid_fem_whose_cavity_energy_check_fails_warns_not_crashes():
+    """`predict --model fem` on a rigid wall where the FEM's mode keeps too little of its energy in the cavity
+    (mat-array-4's taxel t4): a warning naming the check (matcad.acoustics.checks 'mode_in_cavity'), the
+    transmission line's answer kept — it was exit 70 (KeyError: 'mode_in_cavity')."""
+    from matcad.prediction import predict
+
+    board = spec_mod.load(ROOT / "templates" / "mat-array-4.toml")
+    board = dataclasses.replace(board, wall=dataclasses.replace(board.wall, model="rigid"))
+    t4 = spec_mod.taxel_spec(board, next(t for t in spec_mod.taxels(board) if t.name == "t4"))
+    p = predict(t4, model="fem", fem_level=2)
+    assert not p.models["fem"].valid
+    assert any("keeps less than 0.3 of its energy in the cavity" in w for w in p.warnings), p.warnings
