@@ -46,12 +46,12 @@ def load_calibration(path: str | Path) -> Calibration:
     return read_section(Calibration, "calibration", data["calibration"])
 
 
-def _depth(value: Any, limit: int) -> int:
+def nesting_depth(value: Any, limit: int) -> int:
     """Nesting depth of parsed TOML data, stopping once it passes ``limit``."""
     if limit < 0 or not isinstance(value, (dict, list)):
         return 0
     items = value.values() if isinstance(value, dict) else value
-    return 1 + max((_depth(v, limit - 1) for v in items), default=0)
+    return 1 + max((nesting_depth(v, limit - 1) for v in items), default=0)
 
 
 def read_toml(path: str | Path, what: str, limit: int) -> dict:
@@ -103,7 +103,7 @@ def parse_toml(text: str, what: str, where: str, value_of: str | None = None) ->
         place = "" if value_of else f" ({what} {where}, line {line})"
         raise SpecError(value_of or key, digits, f"is an integer of {len(digits)} digits{place}: no spec number "
                                                  f"has more than a few, and Python reads at most {limit}") from None
-    if _depth(data, MAX_NESTING) > MAX_NESTING:
+    if nesting_depth(data, MAX_NESTING) > MAX_NESTING:
         raise SpecError(what, where, f"nests tables or arrays deeper than {MAX_NESTING} levels")
     return data
 
