@@ -2,6 +2,10 @@
 beside the paper's Fig. 8 fits (F = 8.8719 x + 2.876 N; V_eff = 0.5576 x² − 3.2659 x + 30.74 mm³ with A = d²/4)
 and its Eq. 5 calibration. Target: < 20 s per curve on the project machine.
 Run: OMP_NUM_THREADS=1 PYTHONPATH=. /work/venv/bin/python benchmarks/mechanics.py
+
+`... benchmarks/mechanics.py steps` instead prints the paper template's own cap (its spec's material) asked in
+1/2/3/4/10 load steps, and to 3 mm in 10: where each curve ends, its force there, its Newton iterations and
+df/dF at 0 N (the curve's tangent) — the end must not depend on the step count (issue 21).
 """
 
 import dataclasses
@@ -84,5 +88,23 @@ def main():
         print(f"  F {s.force_n:6.2f} N: TL {s.f_tl_hz:7.0f} Hz, FEM {fem_f} Hz")
 
 
+def steps_table():
+    print("paper template as shipped: steps, travel asked, where the curve ends, F there, Newton iterations, "
+          "df/dF at 0 N, time")
+    base = spec_mod.load(ROOT / "templates" / "mat-paper.toml")
+    for steps, travel in ((1, 2.0), (2, 2.0), (3, 2.0), (4, 2.0), (10, 2.0), (10, 3.0)):
+        spec = dataclasses.replace(base, mechanics=dataclasses.replace(base.mechanics, steps=steps,
+                                                                       displacement_mm=travel))
+        t0 = time.perf_counter()
+        curve = cap_curve(cap_case(spec))
+        seconds = time.perf_counter() - t0
+        end = curve.column("displacement_mm")[-1] if curve.steps else 0.0
+        force = curve.column("force_n")[-1] if curve.steps else 0.0
+        slope = force_curve(design(spec), curve).sensitivity_hz_per_n[0] if curve.steps else float("nan")
+        print(f"  {steps:>2} steps to {travel:g} mm: ends at {end:.3g} mm, F {force:.2f} N, "
+              f"{curve.newton_iterations} iterations, df/dF(0) {slope:.1f} Hz/N, {seconds:.1f} s"
+              + ("" if curve.complete else f" ({curve.message[:90]})"))
+
+
 if __name__ == "__main__":
-    main()
+    steps_table() if sys.argv[1:] == ["steps"] else main()

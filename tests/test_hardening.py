@@ -772,3 +772,66 @@ def test_rigid_fem_whose_cavity_energy_check_fails_warns_not_crashes():
     p = predict(t4, model="fem", fem_level=2)
     assert not p.models["fem"].valid
     assert any("keeps less than 0.3 of its energy in the cavity" in w for w in p.warnings), p.warnings
+
+
+# ---- issue 21: cap mechanics step cuts recover ------------------------------------------------------------------
+
+def _paper_cap(steps: int, displacement_mm: float = 2.0, **end_cap):
+    from matcad.mechanics.case import cap_case
+    from matcad.mechanics.solver import cap_curve
+
+    spec = spec_mod.load(PAPER)
+    spec = dataclasses.replace(spec, end_cap=dataclasses.replace(spec.end_cap, **end_cap), mechanics=dataclasses.replace(
+        spec.mechanics, steps=steps, displacement_mm=displacement_mm))
+    return spec, cap_curve(cap_case(spec))
+
+
+def test_a_cut_step_restores_the_condensed_state_so_steps_do_not_set_the_end():
+    """A failed Newton step restored the displacements but not the nearly-incompressible solid's condensed pressure
+    and volume ratio: the paper cap's curve stopped at 0 mm with 1 step (budget spent, "df/dF = 0.0 Hz/N") and at
+    1.5 mm with 4. Restored (FElupe checkpoint/restore), 1 and 10 steps both reach 2 mm at the same force."""
+    _, one = _paper_cap(1)
+    _, ten = _paper_cap(10)
+    for curve in (one, ten):
+        assert curve.complete and curve.column("displacement_mm")[-1] == pytest.approx(2.0), curve.message
+    assert one.column("force_n")[-1] == pytest.approx(ten.column("force_n")[-1], rel=0.01)
+
+
+def test_df_dF_at_0_is_the_curve_tangent_not_a_one_step_difference():
+    """df/dF at 0 N from the parabola through the first three states: 4 and 10 steps agree to 1 % (a one-step
+    difference gave 54.5 and 57.4 Hz/N); the same curve's one-step difference lies below it (f(F) is concave)."""
+    from matcad.acoustics.design import design
+    from matcad.mechanics.frequency import force_curve
+
+    slopes = {}
+    for steps in (4, 10):
+        spec, curve = _paper_cap(steps)
+        fc = force_curve(design(spec), curve)
+        slopes[steps] = fc.sensitivity_hz_per_n[0]
+        one_step = (fc.states[1].f_hz - fc.states[0].f_hz) / (fc.states[1].force_n - fc.states[0].force_n)
+        assert one_step < slopes[steps]
+    assert slopes[4] == pytest.approx(slopes[10], rel=0.01)
+
+
+def test_tangent_is_exact_on_a_parabola_and_none_without_a_step():
+    """The tangent at 0 N is exact for f = a + bF + cF² on uneven states (a one-step difference is off by c·F1);
+    with one state (no step converged) it is NaN, told as None / "n/a", never "df/dF = 0.0 Hz/N"."""
+    from matcad.mechanics.frequency import tangent_hz_per_n
+
+    forces = np.array([0.0, 0.7, 1.9, 3.2])
+    slope = tangent_hz_per_n(forces, 4000 + 57 * forces - 0.8 * forces ** 2)
+    assert slope == pytest.approx(57 - 1.6 * forces, rel=1e-12)
+    assert np.isnan(tangent_hz_per_n([0.0], [4000.0])).all()
+
+
+@pytest.mark.slow
+def test_curve_end_does_not_depend_on_steps_or_travel():
+    """Paper cap: 1/2/3/4/10 steps all reach 2 mm (0/1.0/1.33/1.5/2.0 mm before); asking 3 mm does not stop it
+    short of 2 mm (1.5 mm before); the Ø6 cap with a 1 mm top reaches 1.5 mm (a 'crease' stop at 1.2 mm before)."""
+    for steps in (1, 2, 3, 4, 10):
+        _, curve = _paper_cap(steps)
+        assert curve.complete, (steps, curve.message)
+    _, longer = _paper_cap(10, 3.0)
+    assert longer.column("displacement_mm")[-1] > 2.0, longer.message
+    _, small = _paper_cap(10, 1.5, outer_diameter=6.0, top_thickness=1.0)
+    assert small.complete, small.message
