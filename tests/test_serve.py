@@ -326,3 +326,15 @@ def test_stopping_mid_build_ends_the_build_and_removes_its_folder(tmp_path):
     assert not list(temp.glob("matcad-serve-*")), list(temp.rglob("*"))
     for pid in children:
         assert not os.path.exists(f"/proc/{pid}") or "Z" in open(f"/proc/{pid}/stat").read().split(")")[1][:3]
+
+
+@pytest.mark.parametrize("payload,status", [
+    (b"GARBAGE\r\n\r\n", 400), (b"GET / HTTP/1.1\r\nHost: x\r\n" + b"X: y\r\n" * 101 + b"\r\n", 431),
+    (b"PUT / HTTP/1.1\r\nHost: x\r\n\r\n", 501), (b"GET / HTTP/1.1\r\nX: " + b"y" * 70_000 + b"\r\n\r\n", 431)])
+def test_protocol_errors_are_json_too(url, payload, status):
+    """A garbled request line, a method the server lacks, too many or too long headers: the same JSON error
+    object as every other refusal (the library's HTML error page before). A request line without a version is
+    HTTP/0.9: its reply is the body alone, with no status line."""
+    got, body = _raw(_port(url), payload)
+    assert got == (status if payload.startswith((b"GET", b"PUT")) else "closed")
+    assert json.loads(body)["error"]["message"].startswith(str(status))

@@ -101,6 +101,15 @@ class Handler(BaseHTTPRequestHandler):
         except OSError:
             pass
 
+    def send_error(self, code, message=None, explain=None) -> None:
+        """The protocol's own refusals (a garbled request line, a method other than GET and POST, over-long
+        headers) as the same JSON error object as every other refusal, not the library's HTML page."""
+        self.close_connection = True
+        try:
+            self._json(code, error(None, f"{code} {message or self.responses.get(code, ('',))[0]}"[:200]))
+        except OSError:
+            pass
+
     def _send(self, status: int, body: bytes, ctype: str) -> None:
         self.connection.settimeout(WRITE_TIMEOUT_S)
         self.send_response(status)
