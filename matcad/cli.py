@@ -15,6 +15,7 @@ the temporary folder is removed.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
@@ -177,7 +178,7 @@ def main(argv: list[str] | None = None) -> int:
         _private_caches()
         from matcad.commands import parser
 
-        args = parser().parse_args(argv)
+        args = _parse(parser(), sys.argv[1:] if argv is None else [str(a) for a in argv])
         return _dispatch(args)
     except KeyboardInterrupt:
         return _interrupted(args)
@@ -191,6 +192,42 @@ def main(argv: list[str] | None = None) -> int:
         if not _SIGNALLED:  # after a signal both stay ignored: the process is on its way out
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
+
+
+def _parse(top, argv: list[str]):
+    """``top.parse_args(argv)``; a usage error (argparse's exit 2: an unknown option, an --out refused by its type)
+    of a command asked for ``--json`` also prints the JSON error object on stdout, like every other error exit."""
+    told: list[str] = []
+    stderr = sys.stderr
+
+    class Tee:
+        def write(self, text):
+            told.append(text)
+            return stderr.write(text)
+
+        def __getattr__(self, name):
+            return getattr(stderr, name)
+
+    sys.stderr = Tee()
+    try:
+        return top.parse_args(argv)
+    except SystemExit as exc:
+        options = argv[:argv.index("--")] if "--" in argv else argv
+        if exc.code == 2 and "--json" in options:
+            import json
+            import re
+
+            from matcad.errors import EXIT_CODES
+
+            message = ("".join(told).strip().splitlines() or ["usage error"])[-1].partition("error: ")[2]
+            field = re.match(r"argument ([^:]+): ", message)
+            error = {"exit_code": EXIT_INPUT, "meaning": EXIT_CODES[EXIT_INPUT],
+                     "field": field.group(1).split("/")[-1] if field else None, "message": message, "written": []}
+            with contextlib.suppress(OSError, ValueError):
+                print(json.dumps({"error": error}, indent=2), flush=True)
+        raise
+    finally:
+        sys.stderr = stderr
 
 
 def _dispatch(args) -> int:

@@ -651,6 +651,18 @@ def test_json_error_object_on_stdout(argv, code, field):
     assert error["written"] == []
 
 
+@pytest.mark.parametrize("argv,field", [(["build", PAPER, "--out", "C:\\kits"], "--out"),
+                                        (["predict", PAPER, "--nosuch"], None), (["predict", PAPER, "--load"], "--load")])
+def test_json_error_object_for_a_usage_error(argv, field):
+    """argparse's own refusals (an --out refused by its type, an unknown option, a missing value) exit 2 before a
+    command runs: with --json they print the JSON error object too (stdout was empty before; found by
+    benchmarks/fuzz.py world)."""
+    code, out, err = run_cli(*argv, "--json")
+    assert code == 2 and "error:" in err
+    error = json.loads(out)["error"]
+    assert error["exit_code"] == 2 and error["field"] == field and error["message"] in err
+
+
 def test_json_error_object_for_a_loop_refusal(tmp_path):
     wav = tmp_path / "silence.wav"
     wavfile.write(wav, 44100, np.zeros(44100, np.int16))
