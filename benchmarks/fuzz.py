@@ -415,7 +415,7 @@ def cat_serve(n: int, rng: random.Random, work: Path):
 
     from matcad.serve import server as srv
 
-    srv.REQUEST_DEADLINE_S = 1.0
+    deadline, srv.REQUEST_DEADLINE_S = srv.REQUEST_DEADLINE_S, 1.0
     server = srv.make_server(0)
     port = server.server_address[1]
     threading.Thread(target=server.serve_forever, daemon=True).start()
@@ -521,6 +521,7 @@ def cat_serve(n: int, rng: random.Random, work: Path):
     finally:
         server.shutdown()
         server.server_close()
+        srv.REQUEST_DEADLINE_S = deadline
 
 
 CATEGORIES = {"specs": cat_specs, "extremes": cat_extremes, "toml": cat_toml, "files": cat_files, "wav": cat_wav,
