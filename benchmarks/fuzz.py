@@ -13,6 +13,16 @@ temporary folder left over, and, for builds, a kit whose files match its manifes
   calibration calibration files with random covariances, ranges and constants
   out         --out targets: '.', nested, an existing file, a folder with a user's file, a symlink
   faults      SIGINT / SIGTERM / SIGKILL at random moments of a build (tests/test_hardening.py's injector)
+  sets        --set values: > 4300-digit integers, deep nesting, text after the value, over-long strings, bad keys,
+              NaN/inf/1e400, tables and arrays where numbers belong (issue 21)
+  world       files from the user's world: UTF-8 BOM and CRLF specs, UTF-16 and Latin-1 specs, specs in inches,
+              European CSVs (';', decimal comma), BOM CSVs, Windows --out paths, analyze --band in kHz (issue 21)
+  serve       the design server on 127.0.0.1 (in this process): hostile Host/Origin/Content-Type headers, bodies
+              nested, truncated, oversized, random bytes, bad lengths, other methods, garbage request lines,
+              disconnects and resets; it holds when every reply is a status of its table with a JSON error, the
+              server prints nothing and still answers a good prediction (issue 21)
+
+Every `--json` run must also leave exactly one JSON document on stdout, whatever its exit code.
 
 Run: .venv/bin/python benchmarks/fuzz.py [N] [category ...]   (N examples per category, default 200;
 `specs` runs 10 N of its cheap examples and `faults` N / 10 kills)
@@ -61,6 +71,13 @@ def run(argv: list[str], allowed=(0, 1, 2)) -> tuple[int, str]:
         raise Breach(f"{argv}: exit {code}: {text[-300:]}")
     if code == 2 and not text.strip():
         raise Breach(f"{argv}: exit 2 without a message")
+    if "--json" in argv and "--live" not in argv:
+        try:
+            doc = json.loads(out.getvalue())
+        except ValueError:
+            raise Breach(f"{argv}: exit {code}, stdout is no JSON document: {out.getvalue()[:200]!r}") from None
+        if code == 2 and not (isinstance(doc, dict) and doc.get("error", {}).get("exit_code") == 2):
+            raise Breach(f"{argv}: exit 2 without a JSON error object: {out.getvalue()[:200]!r}")
     return code, text
 
 
@@ -306,8 +323,210 @@ def cat_faults(n: int, rng: random.Random, work: Path):
     yield one
 
 
+def cat_sets(n: int, rng: random.Random, work: Path):
+    spec = ROOT / "templates" / "mat-laser-only.toml"
+    keys = ["neck.diameter", "cavity.length", "name", "wall.model", "wall.khz_modulus_factor", "air.temperature_c",
+            "wall.loss_factor", "mechanics.steps", "plate.label", "neck", "nosuch.key", "a.b.c", "", ".x", "neck."]
+    makers = [
+        lambda: "9" * rng.randint(300, 8000), lambda: "-" + "9" * rng.randint(4300, 6000),
+        lambda: (lambda d: "[" * d + "]" * d)(rng.randint(20, 50000)), lambda: "[" * rng.randint(1, 40000),
+        lambda: (lambda d: "{a=" * d + "1" + "}" * d)(rng.randint(20, 3000)),
+        lambda: rng.choice(["2.0", "1", "silicone"]) + rng.choice(["\n[air]\ntemperature_c=-20", " extra",
+                                                                   "\nx=1", "\r\ny=2", " # comment", "\n"]),
+        lambda: '"' + "x" * rng.choice([100, 70000, 1_100_000]) + '"', lambda: "x" * rng.choice([100, 1_100_000]),
+        lambda: rng.choice(["nan", "inf", "-inf", "1e400", "-0.0", "5e-324", "1e-300", "0x10", "true", "{a=1}",
+                            "[1,2]", "2024-01-01", "'é'", "日本", '"a\\u0000"', "", "=", "1e-320"]),
+    ]
+    for _ in range(n):
+        sets = []
+        for _ in range(rng.randint(1, 3)):
+            sets += ["--set", f"{rng.choice(keys)}={rng.choice(makers)()}"]
+        argv = [rng.choice(["check", "predict"]), spec, *sets] + (["--json"] if rng.random() < 0.5 else [])
+        yield lambda a=argv: run(a)
+
+
+def cat_world(n: int, rng: random.Random, work: Path):
+    laser = (ROOT / "templates" / "mat-laser-only.toml").read_text(encoding="utf-8")
+    inches = 'name = "t"\n[cavity]\ndiameter = 0.125\nlength = 0.1875\n[neck]\ndiameter = 0.0827\nlength = 0.25\n'
+    from scipy.io import wavfile
+    import numpy as np
+
+    wav = work / "tone.wav"
+    wavfile.write(wav, 44100, (np.sin(2 * np.pi * 4600 * np.arange(22050) / 44100) * 2e4).astype(np.int16))
+    rows = [(f, 4500 + 9 * f + 0.1 * f * f) for f in range(0, 20, 2)]
+
+    def csv_bytes():
+        sep, dec = rng.choice([(",", "."), (";", ","), (";", "."), ("\t", ","), (",", ",")])
+        quote = '"' if sep == dec else ""
+        text = f"force_n{sep}frequency_hz\n" + "".join(
+            f"{quote}{str(a).replace('.', dec)}{quote}{sep}{quote}{str(round(b, 2)).replace('.', dec)}{quote}\n"
+            for a, b in rows)
+        if rng.random() < 0.3:
+            text = text.replace("\n", "\r\n")
+        data = text.encode(rng.choice(["utf-8", "utf-8-sig", "utf-16"]))
+        return data
+
+    def spec_bytes():
+        text = rng.choice([laser, inches, laser.replace('name = "', 'name = "é')])
+        if rng.random() < 0.3:
+            text = text.replace("\n", "\r\n")
+        return text.encode(rng.choice(["utf-8", "utf-8-sig", "utf-16", "latin-1"]), errors="replace")
+
+    for i in range(n):
+        kind = rng.choice(["spec", "csv", "out", "band"])
+        json_flag = ["--json"] if rng.random() < 0.5 else []
+        if kind == "spec":
+            path = work / "w.toml"
+            path.write_bytes(spec_bytes())
+            argv = [rng.choice(["check", "predict"]), path, *json_flag]
+        elif kind == "csv":
+            path = work / "w.csv"
+            path.write_bytes(csv_bytes())
+            argv = ["calibrate", path, "--spec", ROOT / "templates" / "mat-paper.toml", "--out", work / "c",
+                    *json_flag]
+        elif kind == "out":
+            target = rng.choice(["C:\\Users\\lab\\out", "D:/kits", "kits\\paper", "\\\\server\\share",
+                                 "c:", "ok-folder"])
+            argv = ["build", ROOT / "templates" / "mat-laser-only.toml", "--out", work / f"o{i}" / target
+                    if target == "ok-folder" else target, *json_flag]
+        else:
+            lo = rng.choice([4.5, 0.0045, 4500.0, 45.0, 1e-300])
+            argv = ["analyze", wav, "--band", lo, lo * rng.choice([1.2, 1.0, 0.5]), "--out", work / "a", *json_flag]
+
+        def one(a=argv):
+            cwd = os.getcwd()
+            os.chdir(work)
+            try:
+                run(a)
+            finally:
+                os.chdir(cwd)
+            _no_litter(work)
+            if any(work.glob("C:*")) or any(work.glob("*\\*")):
+                raise Breach(f"{a}: a Windows path became a folder here")
+        yield one
+
+
+def cat_serve(n: int, rng: random.Random, work: Path):
+    """Hostile HTTP against one in-process server (deadline lowered to 1 s to keep the run short)."""
+    import socket
+    import struct
+    import threading
+    import tomllib
+
+    from matcad.serve import server as srv
+
+    deadline, srv.REQUEST_DEADLINE_S = srv.REQUEST_DEADLINE_S, 1.0
+    server = srv.make_server(0)
+    port = server.server_address[1]
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    good = json.dumps({"spec": tomllib.loads((ROOT / "templates" / "mat-laser-only.toml").read_text())}).encode()
+    statuses = {200, 400, 403, 404, 408, 411, 413, 415, 422, 431, 501, 503, 505}
+
+    def exchange(payload: bytes, reset: bool = False, cut: bool = False):
+        with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+            s.sendall(payload)
+            if reset:
+                s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+                return None
+            if cut:
+                return None
+            data = b""
+            with contextlib.suppress(ConnectionResetError):
+                while chunk := s.recv(65536):
+                    data += chunk
+            return data
+
+    def request(path="/predict", body=good, method="POST", **headers):
+        fields = {"Host": f"127.0.0.1:{port}", "Content-Type": "application/json",
+                  "Content-Length": str(len(body)), "Connection": "close"} | headers
+        head = f"{method} {path} HTTP/1.1\r\n" + "".join(f"{k}: {v}\r\n" for k, v in fields.items() if v is not None)
+        return head.encode() + b"\r\n" + body
+
+    def hostile() -> tuple[bytes, bool, bool]:
+        kind = rng.choice(["host", "origin", "ctype", "nested", "bytes", "length", "method", "garbage", "cut",
+                           "reset", "path", "good"])
+        if kind == "host":
+            return request(Host=rng.choice(["evil.example", f"evil.example:{port}", None, "", "127.0.0.1",
+                                            f"localhost:{port + 1}", "[::1]:" + str(port), "x" * 5000])), 0, 0
+        if kind == "origin":
+            return request(Origin=rng.choice(["null", "http://evil.example", f"http://127.0.0.1:{port}.evil",
+                                              f"https://127.0.0.1:{port}", "\u00e9"]),
+                           **{"Sec-Fetch-Site": rng.choice([None, "cross-site", "same-origin"])}), 0, 0
+        if kind == "ctype":
+            return request(**{"Content-Type": rng.choice([None, "text/plain", "multipart/form-data; boundary=x",
+                                                          "application/x-www-form-urlencoded", "application/jsonx",
+                                                          "APPLICATION/JSON"])}), 0, 0
+        if kind == "nested":
+            d = rng.randint(20, 60000)
+            body = rng.choice([b"[" * d + b"]" * d, b'{"spec": ' + b'{"a": ' * min(d, 9000) + b"1" +
+                               b"}" * min(d, 9000) + b"}", b"[" * d])
+            return request(body=body[:srv.MAX_BODY_BYTES]), 0, 0
+        if kind == "bytes":
+            return request(body=bytes(rng.randrange(256) for _ in range(rng.randint(1, 3000)))), 0, 0
+        if kind == "length":
+            body = good[:rng.randrange(len(good))] if rng.random() < 0.5 else good
+            return request(body=body, **{"Content-Length": rng.choice(["-1", "0", "abc", "1e3", str(2 ** 70),
+                                                                       str(len(good) + 50), None])}), 0, 0
+        if kind == "method":
+            return request(method=rng.choice(["PUT", "DELETE", "PATCH", "OPTIONS", "HEAD", "CONNECT", "TRACE",
+                                              "get"])), 0, 0
+        if kind == "garbage":
+            return bytes(rng.randrange(256) for _ in range(rng.randint(0, 400))) + b"\r\n\r\n", 0, 0
+        if kind == "cut":
+            full = request()
+            return full[:rng.randrange(len(full))], 0, True
+        if kind == "reset":
+            return request(), True, 0
+        if kind == "path":
+            return request(path=rng.choice(["/", "/schema.json", "/../etc/passwd", "/build?x=" + "y" * 9000,
+                                            "/predict%00", "*", "//predict"]), method=rng.choice(["GET", "POST"])), 0, 0
+        return request(), 0, 0
+
+    def check(payload: bytes, reset: bool, cut: bool):
+        data = exchange(payload, reset, cut)
+        if data is None:
+            return
+        head, _, body = data.partition(b"\r\n\r\n")
+        if not data.startswith(b"HTTP/"):  # HTTP/0.9: the body alone, or nothing for an empty request
+            body, status = data, None
+        else:
+            status = int(head.split(b" ", 2)[1])
+            if status not in statuses:
+                raise Breach(f"status {status} for {payload[:120]!r}")
+        if body and (status is None or status >= 400) and b"HEAD " not in payload[:5]:
+            try:
+                json.loads(body)["error"]["message"]
+            except (ValueError, KeyError, TypeError):
+                raise Breach(f"status {status}, no JSON error: {body[:120]!r} for {payload[:120]!r}") from None
+
+    def alive():
+        data = exchange(request())
+        if not data.startswith(b"HTTP/1.0 200") and not data.startswith(b"HTTP/1.1 200"):
+            raise Breach(f"a good prediction afterwards got {data[:120]!r}")
+
+    err = io.StringIO()
+    try:
+        with contextlib.redirect_stderr(err):
+            for i in range(n):
+                case = hostile()
+
+                def one(c=case, last=(i == n - 1 or i % 10 == 9)):
+                    check(*c)
+                    if last:
+                        time.sleep(1.2)  # the cut uploads reach their deadline
+                        alive()
+                    if err.getvalue():
+                        raise Breach(f"the server printed: {err.getvalue()[:300]}")
+                yield one
+    finally:
+        server.shutdown()
+        server.server_close()
+        srv.REQUEST_DEADLINE_S = deadline
+
+
 CATEGORIES = {"specs": cat_specs, "extremes": cat_extremes, "toml": cat_toml, "files": cat_files, "wav": cat_wav,
-              "csv": cat_csv, "calibration": cat_calibration, "out": cat_out, "faults": cat_faults}
+              "csv": cat_csv, "calibration": cat_calibration, "out": cat_out, "faults": cat_faults,
+              "sets": cat_sets, "world": cat_world, "serve": cat_serve}
 
 
 def main_(n: int, names: list[str]) -> None:

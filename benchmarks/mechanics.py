@@ -12,7 +12,10 @@ sensitivity (Ogden);
 ``--convergence [H ...]`` adds F and V at x = 0.2 … 1 mm on a mesh sequence (default h = 0.4, 0.2, 0.1,
 0.05 mm, ~1–1.5 min; neo-Hookean, sticking; 0.025 mm adds 3–5 min), successive differences, observed orders,
 a Richardson estimate and the default mesh (h = 0.2 mm) against it.
+``--steps`` adds the paper template's own cap asked in 1/2/3/4/10 load steps and to 3 mm: the curve's end must not
+depend on the step count.
 Run: OMP_NUM_THREADS=1 PYTHONPATH=. .venv/bin/python benchmarks/mechanics.py [--caps] [--convergence [H ...]]
+[--steps] [--skip-materials]
 """
 
 import argparse
@@ -276,12 +279,34 @@ def convergence(meshes_mm):
                   + ", ".join(f"x {x:.1f} {e:+.2f} %" for x, e in errs))
 
 
+def steps_table():
+    """The paper template's own cap asked in 1/2/3/4/10 load steps and to 3 mm in 10: where each curve ends, its
+    force there, its Newton iterations and df/dF at 0 N (the curve's tangent); the end must not depend on the step
+    count."""
+    print("paper template as shipped: steps, travel asked, where the curve ends, F there, Newton iterations, "
+          "df/dF at 0 N, time")
+    base = spec_mod.load(ROOT / "templates" / "mat-paper.toml")
+    for steps, travel in ((1, 2.0), (2, 2.0), (3, 2.0), (4, 2.0), (10, 2.0), (10, 3.0)):
+        spec = dataclasses.replace(base, mechanics=dataclasses.replace(base.mechanics, steps=steps,
+                                                                       displacement_mm=travel))
+        t0 = time.perf_counter()
+        curve = cap_curve(cap_case(spec))
+        seconds = time.perf_counter() - t0
+        end = curve.column("displacement_mm")[-1] if curve.steps else 0.0
+        force = curve.column("force_n")[-1] if curve.steps else 0.0
+        slope = force_curve(design(spec), curve).sensitivity_hz_per_n[0] if curve.steps else float("nan")
+        print(f"  {steps:>2} steps to {travel:g} mm: ends at {end:.3g} mm, F {force:.2f} N, "
+              f"{curve.newton_iterations} iterations, df/dF(0) {slope:.1f} Hz/N, {seconds:.1f} s"
+              + ("" if curve.complete else f" ({curve.message[:90]})"))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--caps", action="store_true", help="add the cap, modulus and contact variants (8 curves, 2-4 min)")
     ap.add_argument("--convergence", nargs="*", type=float, metavar="H",
                     help=f"add the mesh sequence (element sizes in mm, default {' '.join(map(str, MESHES_MM))})")
     ap.add_argument("--skip-materials", action="store_true", help="skip the default three-material run")
+    ap.add_argument("--steps", action="store_true", help="add the step-count table of the paper template's cap")
     args = ap.parse_args(argv)
     if not args.skip_materials:
         materials()
@@ -289,6 +314,8 @@ def main(argv=None):
         caps()
     if args.convergence is not None:
         convergence(tuple(args.convergence) or MESHES_MM)
+    if args.steps:
+        steps_table()
 
 
 if __name__ == "__main__":

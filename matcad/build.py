@@ -24,19 +24,38 @@ UNFORCEABLE = ("laser.drawn_size", "needle.bore")
 
 
 class DesignRuleFailure(Exception):
-    """The spec breaks at least one design rule at level error."""
+    """The spec breaks at least one design rule at level error; ``forced``: the build was asked with --force and
+    only rules of :data:`UNFORCEABLE` refused it."""
 
-    def __init__(self, findings: list[Finding]):
+    def __init__(self, findings: list[Finding], forced: bool = False):
         self.findings = findings
-        super().__init__("; ".join(f"{f.id}: {f.message}" for f in errors(findings)))
+        self.forced = forced
+        super().__init__("; ".join(f"{f.id}: {f.message}" for f in self.blocking))
+
+    @property
+    def blocking(self) -> list[Finding]:
+        """The errors that refused the build (with --force, only the unforceable ones)."""
+        return [f for f in errors(self.findings) if not self.forced or f.id in UNFORCEABLE]
 
     def to_dict(self) -> dict:
-        """`matcad build --json` of a refused build: nothing written, every finding."""
-        return {"verdict": "fail", "written": [], "findings": [f.to_dict() for f in self.findings]}
+        """`matcad build --json` of a refused build: nothing written, every finding, and those --force cannot
+        override."""
+        return {"verdict": "fail", "written": [], "findings": [f.to_dict() for f in self.findings],
+                "unforceable": sorted({f.id for f in self.blocking if f.id in UNFORCEABLE})}
 
     def to_text(self) -> str:
         """The errors that refused the build."""
-        return findings_text(errors(self.findings))
+        return findings_text(self.blocking)
+
+    def advice(self) -> str:
+        """What to do: fix the spec or use --force, or — for rules --force cannot override — fix the spec."""
+        ids = ", ".join(sorted({f.id for f in self.blocking if f.id in UNFORCEABLE}))
+        if self.forced:
+            return (f"design-rule errors --force cannot override ({ids}: the file itself could not be made "
+                    "correctly): nothing written (fix the spec)")
+        if ids:
+            return f"design-rule errors: nothing written (fix the spec; --force cannot override {ids})"
+        return "design-rule errors: nothing written (fix the spec or use --force)"
 
 
 @dataclass(frozen=True)
@@ -179,9 +198,9 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
     predictions = [predict(taxel_spec(spec, t)) for t in board]
     prediction = predictions[0]
     findings = check(spec, prediction if len(board) == 1 else None)
-    blocking = [f for f in errors(findings) if not force or f.id in UNFORCEABLE]
-    if blocking:
-        raise DesignRuleFailure(findings)
+    failure = DesignRuleFailure(findings, forced=force)
+    if failure.blocking:
+        raise failure
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
     bands = board_bands(spec)
     with staged_output(target) as tmp:

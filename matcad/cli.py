@@ -15,6 +15,7 @@ the temporary folder is removed.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
@@ -26,6 +27,8 @@ from matcad.errors import EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPT, EXIT_OK, EX
 
 _SIGNALLED: list[int] = []
 """The signal that interrupted this run, if any (set by :func:`_on_signal`)."""
+_STDOUT: list = []
+"""This run's standard output as the command saw it (:class:`_Stdout`), once dispatched."""
 
 
 def _on_signal(signum, frame) -> None:
@@ -83,7 +86,7 @@ def _deliberate(exc: ValueError) -> bool:
     return tb is not None and str(Path(tb.tb_frame.f_code.co_filename).resolve()).startswith(package)
 
 
-def _internal_error(exc: BaseException) -> int:
+def _internal_error(exc: BaseException, args=None) -> int:
     """Log the traceback to a fresh file in the temporary folder and print one line pointing at it."""
     import tempfile
     import time
@@ -97,16 +100,34 @@ def _internal_error(exc: BaseException) -> int:
             f.write(f"matcad {__version__}\nargv: {sys.argv!r}\n\n{text}")
     except OSError:
         log = "(no log: the temporary folder is not writable)"
-    print(f"matcad: internal error, please report it with the log {log} ({exc.__class__.__name__})",
-          file=sys.stderr)
-    return EXIT_INTERNAL
+    return _fail(args, EXIT_INTERNAL, f"internal error, please report it with the log {log} "
+                                      f"({exc.__class__.__name__})")
 
 
-def _interrupted() -> int:
+def _interrupted(args=None) -> int:
     terminated = bool(_SIGNALLED) and _SIGNALLED[0] == signal.SIGTERM
-    print(f"matcad: {'terminated' if terminated else 'interrupted'}; no output folder is left half-written",
-          file=sys.stderr)
-    return EXIT_TERMINATED if terminated else EXIT_INTERRUPT
+    return _fail(args, EXIT_TERMINATED if terminated else EXIT_INTERRUPT,
+                 f"{'terminated' if terminated else 'interrupted'}; no output folder is left half-written")
+
+
+def _fail(args, code: int, text: str, exc: BaseException | None = None) -> int:
+    """Print ``matcad: text`` on stderr and, when the command was asked for ``--json`` and has printed nothing yet,
+    the same as a JSON error object on stdout (``{"error": {"exit_code", "meaning", "field", "message",
+    "written"}}``): a script reading stdout always gets one JSON document. Returns ``code``."""
+    print(f"matcad: {text}", file=sys.stderr)
+    if getattr(args, "json", False) and not (_STDOUT and _STDOUT[0].used):
+        import json
+
+        from matcad.errors import EXIT_CODES
+        from matcad.output import WRITTEN
+
+        error = {"exit_code": code, "meaning": EXIT_CODES[code], "field": getattr(exc, "field", None),
+                 "message": str(exc) if exc is not None else text, "written": [str(p) for p in WRITTEN]}
+        try:
+            print(json.dumps({"error": error}, indent=2), flush=True)
+        except (OSError, ValueError):  # stdout itself is what failed: stderr has said it
+            _quiet_stdout()
+    return code
 
 
 def _quiet_stdout() -> None:
@@ -119,59 +140,137 @@ def _quiet_stdout() -> None:
         pass
 
 
+class _Stdout:
+    """Standard output as the command sees it, remembering a write that failed (a full disk, /dev/full), so that
+    the error is told apart from a failure to write the kit (only then does the CLI say what was written), and
+    whether the command printed anything (then a --json error object would break its JSON document)."""
+
+    def __init__(self, inner):
+        self.inner = inner
+        self.failed: OSError | None = None
+        self.used = False
+
+    def write(self, text):
+        self.used = self.used or bool(text)
+        try:
+            return self.inner.write(text)
+        except OSError as exc:
+            self.failed = exc
+            raise
+
+    def flush(self):
+        try:
+            return self.inner.flush()
+        except OSError as exc:
+            self.failed = exc
+            raise
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command; every outcome maps to one row of :data:`EXIT_CODES`."""
     previous = _install_signal_handlers()
+    _STDOUT.clear()
+    args = None
     try:
         _private_caches()
         from matcad.commands import parser
 
-        args = parser().parse_args(argv)
+        args = _parse(parser(), sys.argv[1:] if argv is None else [str(a) for a in argv])
         return _dispatch(args)
     except KeyboardInterrupt:
-        return _interrupted()
+        return _interrupted(args)
     except BaseException as exc:  # noqa: BLE001 - the last line of the exit-code table
         if isinstance(exc, SystemExit):  # argparse: usage error (2), --help/--version (0)
             raise
         if _SIGNALLED:  # an interrupt inside a C extension's import surfaces as ImportError/SystemError
-            return _interrupted()
-        return _internal_error(exc)
+            return _interrupted(args)
+        return _internal_error(exc, args)
     finally:
         if not _SIGNALLED:  # after a signal both stay ignored: the process is on its way out
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
 
 
+def _parse(top, argv: list[str]):
+    """``top.parse_args(argv)``; a usage error (argparse's exit 2: an unknown option, an --out refused by its type)
+    of a command asked for ``--json`` also prints the JSON error object on stdout, like every other error exit."""
+    told: list[str] = []
+    stderr = sys.stderr
+
+    class Tee:
+        def write(self, text):
+            told.append(text)
+            return stderr.write(text)
+
+        def __getattr__(self, name):
+            return getattr(stderr, name)
+
+    sys.stderr = Tee()
+    try:
+        return top.parse_args(argv)
+    except SystemExit as exc:
+        options = argv[:argv.index("--")] if "--" in argv else argv
+        if exc.code == 2 and "--json" in options:
+            import json
+            import re
+
+            from matcad.errors import EXIT_CODES
+
+            message = ("".join(told).strip().splitlines() or ["usage error"])[-1].partition("error: ")[2]
+            field = re.match(r"argument ([^:]+): ", message)
+            error = {"exit_code": EXIT_INPUT, "meaning": EXIT_CODES[EXIT_INPUT],
+                     "field": field.group(1).split("/")[-1] if field else None, "message": message, "written": []}
+            with contextlib.suppress(OSError, ValueError):
+                print(json.dumps({"error": error}, indent=2), flush=True)
+        raise
+    finally:
+        sys.stderr = stderr
+
+
 def _dispatch(args) -> int:
     from matcad.errors import LoopError, OutputError
+    from matcad.output import WRITTEN
     from matcad.spec import SpecError
 
+    WRITTEN.clear()  # a new run in the same interpreter
+    stdout = sys.stdout = _Stdout(sys.stdout)
+    _STDOUT[:] = [stdout]
     try:
-        return args.func(args)
+        code = args.func(args)
+        stdout.flush()  # a full standard output fails here at the latest, where what was written can be said
+        return code
     except SpecError as exc:
-        print(f"matcad: spec error: {exc}", file=sys.stderr)
-        return EXIT_INPUT
+        return _fail(args, EXIT_INPUT, f"spec error: {exc}", exc)
     except OutputError as exc:
-        print(f"matcad: error: {exc}", file=sys.stderr)
-        return EXIT_INPUT
+        return _fail(args, EXIT_INPUT, f"error: {exc}", exc)
     except LoopError as exc:
-        print(f"matcad: {exc}", file=sys.stderr)
-        return EXIT_RULES
+        return _fail(args, EXIT_RULES, str(exc), exc)
     except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours (before OSError: a subclass)
         _quiet_stdout()
         return EXIT_OK
     except OSError as exc:  # unwritable output folder, full disk, unreadable input: the user's file system
         from matcad.errors import shorten
 
+        if exc is stdout.failed:  # the result could not be printed: say truthfully what was written
+            _quiet_stdout()
+            done = (f"the output was written and is complete: {', '.join(map(str, WRITTEN))}" if WRITTEN
+                    else "nothing was written")
+            print(f"matcad: error: standard output: {exc.strerror or exc}: the result could not be printed; {done}",
+                  file=sys.stderr)
+            return EXIT_INPUT
         where = f"{shorten(str(exc.filename))}: " if exc.filename else ""
-        print(f"matcad: error: {where}{exc.strerror or exc} (check the path, its permissions and free space)",
-              file=sys.stderr)
-        return EXIT_INPUT
+        return _fail(args, EXIT_INPUT, f"error: {where}{exc.strerror or exc} (check the path, its permissions and "
+                                       "free space)", exc)
     except ValueError as exc:
         if not _deliberate(exc):
             raise
-        print(f"matcad: error: {exc}", file=sys.stderr)
-        return EXIT_INPUT
+        return _fail(args, EXIT_INPUT, f"error: {exc}", exc)
+    finally:
+        if sys.stdout is stdout:
+            sys.stdout = stdout.inner
 
 
 def quiet_exit() -> None:

@@ -57,8 +57,9 @@ def read_bounded(path: str | Path, what: str, limit: int) -> bytes:
 
 
 def read_text(path: str | Path, what: str, limit: int) -> str:
-    """As :func:`read_bounded`, decoded as UTF-8 (InputError if it is not)."""
+    """As :func:`read_bounded`, decoded as UTF-8 (InputError if it is not). A leading byte-order mark (Excel's
+    "CSV UTF-8", Windows editors) is dropped."""
     try:
-        return read_bounded(path, what, limit).decode("utf-8")
+        return read_bounded(path, what, limit).decode("utf-8-sig")
     except UnicodeDecodeError:
         raise InputError(f"{what} {path}: is not UTF-8 text") from None

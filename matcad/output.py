@@ -29,6 +29,10 @@ from pathlib import Path
 
 from matcad.errors import OutputError
 
+WRITTEN: list[Path] = []
+"""Folders this process has put in place, in order: a later failure (a full standard output after the kit was
+written) can then say truthfully what was written. The CLI clears it at the start of each run."""
+
 MANIFEST = ".matcad-manifest.json"
 """Written last into every output folder: {"matcad": version, "files": {relative path: {bytes, sha256}}}."""
 _LEFTOVER = re.compile(r"\.(?P<name>.+)\.(?P<kind>tmp|old)-(?P<pid>\d+)-(?P<start>\d+)-[0-9a-f]+")
@@ -200,6 +204,7 @@ def staged_output(target: Path):
         yield tmp
         write_manifest(tmp)
         _replace(tmp, target, target.parent / f".{target.name}.old-{tag}")
+        WRITTEN.append(target)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         for p in reversed(created):

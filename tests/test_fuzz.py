@@ -12,6 +12,7 @@ import os
 import tomllib
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -140,3 +141,20 @@ def test_garbage_files_are_exit_2(tmp_path):
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
             assert main(["check", str(path)]) == 2
         assert len(err.getvalue().strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("category", ["sets", "world", "serve"])
+def test_fuzz_categories_of_issue_21_hold(category, tmp_path):
+    """A fast slice of benchmarks/fuzz.py's issue-21 categories (--set values, files from the user's world, the
+    design server under hostile requests): every case keeps the contract (the benchmark runs hundreds)."""
+    import random
+
+    from benchmarks import fuzz
+
+    breaches = []
+    for case in fuzz.CATEGORIES[category](24, random.Random(21), tmp_path):
+        try:
+            case()
+        except AssertionError as exc:  # fuzz.Breach is one
+            breaches.append(str(exc)[:300])
+    assert breaches == []

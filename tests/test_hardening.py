@@ -34,7 +34,7 @@ SPEC_CASES = {
     "deep-nesting-recursion": ("x = " + "[" * 5000 + "]" * 5000 + "\n" + MINIMAL, "spec file"),
     "deep-tables": (MINIMAL + "[cavity.a" + ".b" * 40 + "]\nz = 1\n", "spec file"),
     "int-309-digits-overflow": (MINIMAL.replace("length = 4.76", "length = " + "9" * 320), "cavity.length"),
-    "int-beyond-parser-digit-limit": (MINIMAL.replace("length = 4.76", "length = " + "9" * 5000), "spec file"),
+    "int-beyond-parser-digit-limit": (MINIMAL.replace("length = 4.76", "length = " + "9" * 5000), "cavity.length"),
     "name-trailing-newline": (MINIMAL.replace('name = "t"', 'name = "abc\\n"'), "name"),
     "huge-value-echo-truncated": (MINIMAL.replace('name = "t"', 'name = "' + "x" * 200_000 + '"'), "name"),
 }
@@ -554,3 +554,296 @@ def test_export_failure_is_an_os_error_not_a_runtime_error(tmp_path, monkeypatch
         mesh.write_stl(Box(1, 1, 1), tmp_path / "a.stl", 0.01, 0.1)
     with pytest.raises(OSError, match="no space left"):
         mesh.write_step(Box(1, 1, 1), tmp_path / "a.step")
+
+
+# ---- issue 21: --set obeys the spec file's limits and refuses text after its value ----------------------------
+
+@pytest.mark.parametrize("value,needles", [
+    ("9" * 5000, ["neck.diameter", "5000 digits"]),
+    ("[" * 3000 + "]" * 3000, ["--set neck.diameter", "deeper than 32"]),
+    ("2.0\n[air]\ntemperature_c=-20", ["--set neck.diameter", "text after its value", "temperature_c=-20"]),
+])
+def test_set_values_obey_the_file_limits(value, needles):
+    code, out, err = run_cli("check", PAPER, "--set", f"neck.diameter={value}")
+    _assert_clean(code, err, 2, *needles)
+    assert len(err) < 600 and out == ""
+
+
+def test_set_comment_after_a_value_is_no_trailing_text():
+    from matcad.spec.io import parse_assignment
+
+    assert parse_assignment("neck.diameter=2.0  # calipered") == (["neck", "diameter"], 2.0)
+    assert parse_assignment("wall.model=silicone") == (["wall", "model"], "silicone")
+
+
+def test_file_integer_beyond_the_digit_limit_names_its_field(write_spec):
+    code, _, err = run_cli("check", write_spec(MINIMAL.replace("length = 4.76", "length = " + "9" * 5000)))
+    _assert_clean(code, err, 2, "cavity.length", "5000 digits", "line 4")
+    assert "ValueError" not in err
+
+
+# ---- issue 21: files from the user's world --------------------------------------------------------------------
+
+def test_utf8_bom_spec_and_csv_are_read_as_without_it(tmp_path):
+    spec = tmp_path / "bom.toml"
+    spec.write_bytes(b"\xef\xbb\xbf" + LASER_ONLY.encode())
+    plain = tmp_path / "plain.toml"
+    plain.write_text(LASER_ONLY)
+    code_bom, out_bom, err = run_cli("predict", spec, "--json")
+    assert code_bom == 0, err
+    assert json.loads(out_bom)["f0_hz"] == json.loads(run_cli("predict", plain, "--json")[1])["f0_hz"]
+    rows = "force_n,frequency_hz\n" + "".join(f"{f},{4500 + 9 * f + 0.1 * f * f}\n" for f in range(0, 20, 2))
+    data = tmp_path / "bom.csv"
+    data.write_bytes(b"\xef\xbb\xbf" + rows.encode())
+    plain_csv = tmp_path / "plain.csv"
+    plain_csv.write_text(rows)
+    code, out, err = run_cli("calibrate", data, "--spec", PAPER, "--out", tmp_path / "c", "--json")
+    assert code == 0, err
+    want = json.loads(run_cli("calibrate", plain_csv, "--spec", PAPER, "--out", tmp_path / "d", "--json")[1])
+    got = json.loads(out)
+    assert got["points"] == 10 and (got["a"], got["b"]) == (want["a"], want["b"])
+
+
+@pytest.mark.parametrize("rows", ["force_n;frequency_hz\n0;4500,5\n2;4520,1\n",
+                                  "force_n,frequency_hz\n0,\"4500,5\"\n2,\"4520,1\"\n"])
+def test_european_csv_is_named_as_such(rows, tmp_path):
+    data = tmp_path / "eu.csv"
+    data.write_text(rows)
+    code, _, err = run_cli("calibrate", data, "--spec", PAPER, "--out", tmp_path / "c")
+    _assert_clean(code, err, 2, "European", "';' between columns", "decimal mark")
+    assert not (tmp_path / "c").exists()
+
+
+def test_spec_in_inches_gets_a_unit_note(write_spec):
+    inches = 'name = "t"\n[cavity]\ndiameter = 0.125\nlength = 0.1875\n[neck]\ndiameter = 0.0827\nlength = 0.25\n'
+    code, _, err = run_cli("predict", write_spec(inches))
+    assert code == 0, err
+    assert "inches?" in err and "cavity.diameter = 3.175" in err and "neck.length = 6.35" in err
+    code, _, err = run_cli("predict", PAPER)
+    assert "inches" not in err
+
+
+def test_band_in_khz_gets_a_hint(tmp_path):
+    wav = tmp_path / "r.wav"
+    wavfile.write(wav, 44100, (np.sin(2 * np.pi * 4600 * np.arange(44100) / 44100) * 2e4).astype(np.int16))
+    code, _, err = run_cli("analyze", wav, "--band", "4.5", "5.5", "--out", tmp_path / "a")
+    _assert_clean(code, err, 2, "kHz", "--band 4500 5500")
+    assert not (tmp_path / "a").exists()
+
+
+@pytest.mark.parametrize("target", ["C:\\Users\\lab\\out", "D:/kits", "kits\\paper"])
+def test_windows_out_path_is_refused_on_posix(target, tmp_path):
+    code, _, err = run_cli("build", ROOT / "templates" / "mat-laser-only.toml", "--out", target, cwd=tmp_path)
+    _assert_clean(code, err, 2, "Windows path", "--out")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv,code,field", [
+    (["predict", PAPER, "--set", "neck.diameter=-1"], 2, "neck.diameter"),
+    (["check", "missing.toml"], 2, "spec file"),
+    (["calibrate", "missing.csv", "--spec", PAPER], 2, None),
+])
+def test_json_error_object_on_stdout(argv, code, field):
+    got, out, err = run_cli(*argv, "--json")
+    assert got == code, err
+    error = json.loads(out)["error"]
+    assert error["exit_code"] == code and error["field"] == field and error["message"] in err
+    assert error["written"] == []
+
+
+@pytest.mark.parametrize("argv,field", [(["build", PAPER, "--out", "C:\\kits"], "--out"),
+                                        (["predict", PAPER, "--nosuch"], None), (["predict", PAPER, "--load"], "--load")])
+def test_json_error_object_for_a_usage_error(argv, field):
+    """argparse's own refusals (an --out refused by its type, an unknown option, a missing value) exit 2 before a
+    command runs: with --json they print the JSON error object too (stdout was empty before; found by
+    benchmarks/fuzz.py world)."""
+    code, out, err = run_cli(*argv, "--json")
+    assert code == 2 and "error:" in err
+    error = json.loads(out)["error"]
+    assert error["exit_code"] == 2 and error["field"] == field and error["message"] in err
+
+
+def test_json_error_object_for_a_loop_refusal(tmp_path):
+    wav = tmp_path / "silence.wav"
+    wavfile.write(wav, 44100, np.zeros(44100, np.int16))
+    code, out, err = run_cli("analyze", wav, "--band", "4000", "5500", "--json", "--out", tmp_path / "a")
+    assert code == 1 and json.loads(out)["error"]["message"] in err
+
+
+@pytest.mark.parametrize("text,field", [("name = 't'\n[cavity]\ndiameter = 3\nlength = 4\n", "neck"),
+                                        (MINIMAL.replace("length = 6.35\n", ""), "neck.length"),
+                                        ("[cavity]\ndiameter = 3\n", "name")])
+def test_missing_table_or_field_is_named_without_none(text, field, write_spec):
+    code, _, err = run_cli("check", write_spec(text))
+    _assert_clean(code, err, 2, f"{field}: is required")
+    assert "None" not in err
+
+
+# ---- issue 21: partly fixed before ----------------------------------------------------------------------------
+
+def test_full_stdout_says_truthfully_what_was_written(tmp_path):
+    """`> /dev/full`: the kit is written whole, then the summary cannot be printed; the message says so (exit 2),
+    never that nothing was written. A command that writes nothing says that."""
+    import subprocess
+    import sys
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(LASER_ONLY)
+    kit = tmp_path / "k"
+    for extra in ([], ["--json"]):
+        with open("/dev/full", "w") as full:
+            proc = subprocess.run([sys.executable, "-m", "matcad", "build", spec, "--out", kit, *extra], cwd=ROOT,
+                                  stdout=full, stderr=subprocess.PIPE, text=True)
+        _assert_clean(proc.returncode, proc.stderr, 2, "standard output", "written and is complete", str(kit))
+        assert _kit_intact(kit)
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "matcad", "check", spec], cwd=ROOT, stdout=full,
+                              stderr=subprocess.PIPE, text=True)
+    _assert_clean(proc.returncode, proc.stderr, 2, "standard output", "nothing was written")
+
+
+def test_float_wav_at_1e300_is_refused_without_numpy_warnings(tmp_path):
+    wav = tmp_path / "f.wav"
+    wavfile.write(wav, 44100, np.array([1e300, -1e300, 0.5] * 3000, np.float64))
+    code, _, err = run_cli("analyze", wav, "--band", "4000", "5500", "--out", tmp_path / "a")
+    _assert_clean(code, err, 2, "recording", "1e+300")
+    assert "Warning" not in err and "nan" not in err
+
+
+def test_subnormal_calibration_frequencies_are_refused_cleanly(tmp_path):
+    data = tmp_path / "sub.csv"
+    data.write_text("force_n,frequency_hz\n0,1e-319\n1,1.02e-319\n2,1.04e-319\n3,1.03e-319\n")
+    code, _, err = run_cli("calibrate", data, "--spec", PAPER, "--out", tmp_path / "c")
+    _assert_clean(code, err, 2, "calibration data", "row 2", "frequency")
+    assert "Warning" not in err and "did you mean" not in err
+    from matcad.spec import frequency_notes
+
+    assert frequency_notes([1e-300]) == [] and frequency_notes([4.5, 4.6])  # kHz still gets its note
+
+
+def test_force_on_an_unforceable_rule_says_it_cannot_be_forced(write_spec, tmp_path):
+    path = write_spec(PAPER.read_text() + "\n[needle]\ntheta_deg = 1e-6\n")
+    code, out, err = run_cli("build", path, "--force", "--out", tmp_path / "k")
+    _assert_clean(code, err, 1, "--force cannot override", "needle.bore")
+    assert "use --force" not in err
+    code, out, err = run_cli("build", path, "--force", "--json", "--out", tmp_path / "k")
+    assert code == 1 and json.loads(out)["unforceable"] == ["needle.bore"]
+    code, _, err = run_cli("build", path, "--out", tmp_path / "k")
+    _assert_clean(code, err, 1, "--force cannot override needle.bore")
+    assert not (tmp_path / "k").exists()
+
+
+@pytest.mark.parametrize("seconds", [0.094, 0.12, 0.138])
+def test_short_clean_tone_says_it_is_too_short(seconds, tmp_path):
+    wav = tmp_path / "short.wav"
+    t = np.arange(int(44100 * seconds)) / 44100
+    wavfile.write(wav, 44100, (np.sin(2 * np.pi * 4600 * t) * 2e4).astype(np.int16))
+    code, _, err = run_cli("analyze", wav, "--band", "4000", "5500", "--out", tmp_path / "a")
+    _assert_clean(code, err, 1, "too short for a run of 2 frames", "record longer")
+
+
+# ---- issue 21: numbers inside their range that crashed ---------------------------------------------------------
+
+@pytest.mark.parametrize("setting,field", [("wall.khz_modulus_factor=[1e-300, 1e-300]", "wall.khz_modulus_factor"),
+                                           ("wall.khz_modulus_factor=[0.5, 1.0]", "wall.khz_modulus_factor"),
+                                           ("wall.shear_modulus_mpa=[1e-300, 1e-300]", "wall.shear_modulus_mpa")])
+@pytest.mark.parametrize("command", ["check", "predict"])
+def test_unphysical_wall_moduli_are_refused_at_the_spec(setting, field, command):
+    """G = G_static × factor underflowed to 0 (exit 70): an elastomer's storage modulus never falls with frequency
+    (factor >= 1) and no cast silicone is softer than ~1 kPa, so both are refused naming the field."""
+    code, _, err = run_cli(command, PAPER, "--set", setting)
+    _assert_clean(code, err, 2, field)
+
+
+@pytest.mark.parametrize("template", ["mat-paper.toml", "mat-array-4.toml"])
+def test_lossless_wall_follows_the_helmholtz_branch(template):
+    """η → 0 (loss_factor = [0, 0] is allowed): the resonance stays the taxel's, continuous with a lightly damped
+    wall, never an undamped wall mode's spike (the paper's taxel gave 3033 Hz for 5288 Hz before)."""
+    from matcad.prediction import predict
+
+    base = spec_mod.load(ROOT / "templates" / template)
+    base = spec_mod.taxel_spec(base, spec_mod.taxels(base)[0])
+    f = {}
+    for eta in (0.0, 1e-9, 1e-3, 0.01, 0.05):
+        f[eta] = predict(dataclasses.replace(base, wall=dataclasses.replace(base.wall, loss_factor=(eta, eta))))
+    assert f[0.0].f0_hz == pytest.approx(f[0.01].f0_hz, rel=0.005)
+    assert f[0.0].f0_hz == pytest.approx(f[1e-9].f0_hz, rel=1e-6)
+    for eta, p in f.items():
+        assert p.band_hz[0] > 0.85 * f[0.05].band_hz[0] and p.band_hz[1] < 1.15 * f[0.05].band_hz[1], (eta, p.band_hz)
+
+
+def test_rigid_fem_whose_cavity_energy_check_fails_warns_not_crashes():
+    """`predict --model fem` on a rigid wall where the FEM's mode keeps too little of its energy in the cavity
+    (mat-array-4's taxel t4): a warning naming the check (matcad.acoustics.checks 'mode_in_cavity'), the
+    transmission line's answer kept — it was exit 70 (KeyError: 'mode_in_cavity')."""
+    from matcad.prediction import predict
+
+    board = spec_mod.load(ROOT / "templates" / "mat-array-4.toml")
+    board = dataclasses.replace(board, wall=dataclasses.replace(board.wall, model="rigid"))
+    t4 = spec_mod.taxel_spec(board, next(t for t in spec_mod.taxels(board) if t.name == "t4"))
+    p = predict(t4, model="fem", fem_level=2)
+    assert not p.models["fem"].valid
+    assert any("keeps less than 0.3 of its energy in the cavity" in w for w in p.warnings), p.warnings
+
+
+# ---- issue 21: cap mechanics step cuts recover ------------------------------------------------------------------
+
+def _paper_cap(steps: int, displacement_mm: float = 2.0, **end_cap):
+    from matcad.mechanics.case import cap_case
+    from matcad.mechanics.solver import cap_curve
+
+    spec = spec_mod.load(PAPER)
+    spec = dataclasses.replace(spec, end_cap=dataclasses.replace(spec.end_cap, **end_cap), mechanics=dataclasses.replace(
+        spec.mechanics, steps=steps, displacement_mm=displacement_mm))
+    return spec, cap_curve(cap_case(spec))
+
+
+def test_a_cut_step_restores_the_condensed_state_so_steps_do_not_set_the_end():
+    """A failed Newton step restored the displacements but not the nearly-incompressible solid's condensed pressure
+    and volume ratio: the paper cap's curve stopped at 0 mm with 1 step (budget spent, "df/dF = 0.0 Hz/N") and at
+    1.5 mm with 4. Restored (FElupe checkpoint/restore), 1 and 10 steps both reach 2 mm at the same force."""
+    _, one = _paper_cap(1)
+    _, ten = _paper_cap(10)
+    for curve in (one, ten):
+        assert curve.complete and curve.column("displacement_mm")[-1] == pytest.approx(2.0), curve.message
+    assert one.column("force_n")[-1] == pytest.approx(ten.column("force_n")[-1], rel=0.01)
+
+
+def test_df_dF_at_0_is_the_curve_tangent_not_a_one_step_difference():
+    """df/dF at 0 N from the parabola through the first three states: 4 and 10 steps agree to 1 % (a one-step
+    difference gave 54.5 and 57.4 Hz/N); the same curve's one-step difference lies below it (f(F) is concave)."""
+    from matcad.acoustics.design import design
+    from matcad.mechanics.frequency import force_curve
+
+    slopes = {}
+    for steps in (4, 10):
+        spec, curve = _paper_cap(steps)
+        fc = force_curve(design(spec), curve)
+        slopes[steps] = fc.sensitivity_hz_per_n[0]
+        one_step = (fc.states[1].f_hz - fc.states[0].f_hz) / (fc.states[1].force_n - fc.states[0].force_n)
+        assert one_step < slopes[steps]
+    assert slopes[4] == pytest.approx(slopes[10], rel=0.01)
+
+
+def test_tangent_is_exact_on_a_parabola_and_none_without_a_step():
+    """The tangent at 0 N is exact for f = a + bF + cF² on uneven states (a one-step difference is off by c·F1);
+    with one state (no step converged) it is NaN, told as None / "n/a", never "df/dF = 0.0 Hz/N"."""
+    from matcad.mechanics.frequency import tangent_hz_per_n
+
+    forces = np.array([0.0, 0.7, 1.9, 3.2])
+    slope = tangent_hz_per_n(forces, 4000 + 57 * forces - 0.8 * forces ** 2)
+    assert slope == pytest.approx(57 - 1.6 * forces, rel=1e-12)
+    assert np.isnan(tangent_hz_per_n([0.0], [4000.0])).all()
+
+
+@pytest.mark.slow
+def test_curve_end_does_not_depend_on_steps_or_travel():
+    """Paper cap: 1/2/3/4/10 steps all reach 2 mm (0/1.0/1.33/1.5/2.0 mm before); asking 3 mm does not stop it
+    short of 2 mm (1.5 mm before); the Ø6 cap with a 1 mm top reaches 1.5 mm (a 'crease' stop at 1.2 mm before)."""
+    for steps in (1, 2, 3, 4, 10):
+        _, curve = _paper_cap(steps)
+        assert curve.complete, (steps, curve.message)
+    _, longer = _paper_cap(10, 3.0)
+    assert longer.column("displacement_mm")[-1] > 2.0, longer.message
+    _, small = _paper_cap(10, 1.5, outer_diameter=6.0, top_thickness=1.0)
+    assert small.complete, small.message

@@ -128,7 +128,9 @@ class Prediction:
         if m:
             turn = f"stops rising at {m['turn_force_n']:.3g} N" if m["turn_force_n"] is not None else \
                 f"still rising at the curve's end, {m['max_force_n']:.3g} N"
-            lines += [f"  cap mechanics: df/dF = {m['sensitivity_hz_per_n_at_0']:.1f} Hz/N at 0 N; f {turn}; "
+            slope = m["sensitivity_hz_per_n_at_0"]
+            slope = "n/a (no load step converged)" if slope is None else f"{slope:.1f} Hz/N"
+            lines += [f"  cap mechanics: df/dF = {slope} at 0 N; f {turn}; "
                       f"f shift by {m['route']}; {m['nodes']} nodes, {m['seconds']:.1f} s"]
             for key in ("eq5", "eq5_paper_convention"):
                 if m[key]:

@@ -48,6 +48,12 @@ HYBRID_BAND = 0.15
 """A coupled wall mode within ±15 % of f hybridises with the cavity: two resonances can compete, and the fast
 model's error there is larger (measured in docs/error_vs_runtime.md)."""
 SWEEP = (0.5, 2.0, 601)
+SELECT_LOSS = 0.05
+"""Below this loss factor (the lowest any grade's range reaches) the resonance is followed from it, not picked as
+the grid's largest peak (:func:`peak_ratio`)."""
+FOLLOW_STEPS = 8
+FOLLOW_FLOOR = 1e-4
+"""Geometric steps of the loss factor from SELECT_LOSS to this, then the loss factor asked for (0 included)."""
 UNIT_SHEAR_PA = 1e6
 UNIT_DENSITY = 1000.0
 """The table's cap is at a = 1 mm, G = 1 MPa, ρ = 1000 kg/m³."""
@@ -157,9 +163,9 @@ def _cavity_end_response(f_hz, c_m_s, neck_area, cavity_area, neck_length_eff, c
     return 1.0 / np.abs(p + rho * c * k * k / (2 * np.pi) * u)
 
 
-def _peak_hz(f_grid, response) -> float:
-    """Frequency of the largest value of ``response`` on the grid, refined by a parabola through 1/|H|²."""
-    i = int(np.clip(np.argmax(response), 1, len(f_grid) - 2))
+def _refine_hz(f_grid, response, i: int) -> float:
+    """Frequency of the grid maximum ``i`` of ``response``, refined by a parabola through 1/|H|² in log f."""
+    i = int(np.clip(i, 1, len(f_grid) - 2))
     y = 1.0 / response[i - 1:i + 2] ** 2
     x = np.log(f_grid[i - 1:i + 2])
     denom = y[0] - 2 * y[1] + y[2]
@@ -167,16 +173,40 @@ def _peak_hz(f_grid, response) -> float:
     return float(np.exp(x[1] + np.clip(shift, -1, 1) * (x[2] - x[1])))
 
 
+def _followed_peak_hz(f_grid, responses) -> float:
+    """The largest peak of ``responses[0]``, followed through the rows after it (each time to the nearest local
+    maximum of the next row) and refined on the last."""
+    i = int(np.argmax(responses[0]))
+    for r in responses[1:]:
+        maxima = np.flatnonzero((r[1:-1] > r[:-2]) & (r[1:-1] >= r[2:])) + 1
+        if len(maxima):
+            i = int(maxima[np.argmin(np.abs(maxima - i))])
+    return _refine_hz(f_grid, responses[-1], i)
+
+
+def _losses(loss_factor: float) -> np.ndarray:
+    """The loss factors the Helmholtz branch is followed through: ``loss_factor`` alone from
+    :data:`SELECT_LOSS` up, else from SELECT_LOSS down to it (geometric steps to :data:`FOLLOW_FLOOR`, then it)."""
+    if loss_factor >= SELECT_LOSS:
+        return np.array([loss_factor])
+    return np.append(np.geomspace(SELECT_LOSS, max(loss_factor, FOLLOW_FLOOR), FOLLOW_STEPS), loss_factor)
+
+
 def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
                loss_factor: float, side_volume: float = 0.0) -> float:
     """Peak of the cavity pressure with the elastic wall over the peak with a rigid wall (same network, air of
-    ``side_volume`` mm³ joined at the neck in both)."""
+    ``side_volume`` mm³ joined at the neck in both). Below :data:`SELECT_LOSS` the taxel's (Helmholtz) peak is found
+    at SELECT_LOSS and followed down to ``loss_factor``: an almost undamped wall mode rings as a sharp spike that can
+    out-peak it on the grid (η = 0 on the paper's taxel gave 3033 Hz, a wall mode, for its 5288 Hz), though it is
+    not the resonance the jet drives."""
     f = f_tl_hz * np.geomspace(*SWEEP[:2], SWEEP[2])
     geometry = (c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length)
-    soft = _peak_hz(f, _cavity_end_response(f, *geometry, dynamic_compliance_mm3_pa(f, wall, loss_factor),
-                                            side_volume))
-    rigid = _peak_hz(f, _cavity_end_response(f, *geometry, 0.0, side_volume))
-    return soft / rigid
+    losses = _losses(loss_factor)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # η = 0 exactly on a wall mode: C = ∞
+        compliance = np.stack([dynamic_compliance_mm3_pa(f, wall, eta) for eta in losses])
+        soft = np.nan_to_num(_cavity_end_response(f, *geometry, compliance, side_volume), nan=0.0, posinf=0.0)
+    rigid = _cavity_end_response(f, *geometry, 0.0, side_volume)
+    return _followed_peak_hz(f, soft) / _refine_hz(f, rigid, int(np.argmax(rigid)))
 
 
 DOUBLET_LEVEL = 0.5
@@ -191,8 +221,11 @@ def doublet_hz(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
     :data:`DOUBLET_LEVEL` of it."""
     f = f_tl_hz * np.geomspace(*SWEEP[:2], SWEEP[2])
     geometry = (c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length)
-    soft = _cavity_end_response(f, *geometry, dynamic_compliance_mm3_pa(f, wall, loss_factor), side_volume)
-    rigid = _peak_hz(f, _cavity_end_response(f, *geometry, 0.0, side_volume))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # η = 0 exactly on a wall mode: C = ∞
+        soft = np.nan_to_num(_cavity_end_response(f, *geometry, dynamic_compliance_mm3_pa(f, wall, loss_factor),
+                                                  side_volume), nan=0.0, posinf=0.0)
+    response = _cavity_end_response(f, *geometry, 0.0, side_volume)
+    rigid = _refine_hz(f, response, int(np.argmax(response)))
     inner = np.flatnonzero((soft[1:-1] > soft[:-2]) & (soft[1:-1] >= soft[2:])) + 1
     if len(inner) < 2:
         return None
@@ -200,7 +233,7 @@ def doublet_hz(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
     top, second = order[0], order[1]
     if soft[second] < DOUBLET_LEVEL * soft[top]:
         return None
-    return f_tl_hz * _peak_hz(f[second - 1:second + 2], soft[second - 1:second + 2]) / rigid
+    return f_tl_hz * _refine_hz(f, soft, int(second)) / rigid
 
 
 def quasi_static_valid(wall: Modes, f_hz: float) -> bool:

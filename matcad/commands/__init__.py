@@ -25,9 +25,17 @@ def command(name: str):
 
 
 def out_path(text: str) -> Path:
-    """``--out``: made absolute at once, so that `--out .` stays meaningful after the folder is replaced."""
+    """``--out``: made absolute at once, so that `--out .` stays meaningful after the folder is replaced. On POSIX a
+    Windows path (``C:\\Users\\lab\\out``, ``\\\\server\\share``, any backslash) is refused: it would make one folder
+    with that literal name in the current folder."""
     import os
+    import re
 
+    if os.sep == "/" and (re.match(r"[A-Za-z]:([\\/]|$)", text) or "\\" in text):
+        from matcad.errors import shorten
+
+        raise argparse.ArgumentTypeError(f"{shorten(text)} looks like a Windows path; on this system folders are "
+                                         "separated by '/' (e.g. --out out/kit or --out /home/you/kit)")
     return Path(os.path.abspath(text))
 
 

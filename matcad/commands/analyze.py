@@ -27,6 +27,11 @@ def band(args, spec) -> tuple[float, float]:
         lo, hi = args.band
         if not (0 <= lo < hi):
             raise ValueError(f"--band {lo:g} {hi:g} invalid, must be 0 <= LO < HI (Hz)")
+        from matcad.spec.notes import FREQUENCY_KHZ_MAX
+
+        if hi < FREQUENCY_KHZ_MAX:  # a taxel sings at kHz; a band below 100 Hz is a band typed in kHz
+            raise ValueError(f"--band {lo:g} {hi:g} invalid: the band is in Hz and lies below {FREQUENCY_KHZ_MAX:g} "
+                             f"Hz: kHz entered? did you mean --band {lo * 1000:g} {hi * 1000:g}?")
         return lo, hi
     if spec is not None:
         from matcad.listening import PREDICTED_MARGIN, listening_band

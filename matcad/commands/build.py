@@ -27,7 +27,7 @@ def run(args) -> int:
             print_json(exc.to_dict())
         else:
             print(exc.to_text())
-            print("matcad: design-rule errors: nothing written (fix the spec or use --force)", file=sys.stderr)
+            print(f"matcad: {exc.advice()}", file=sys.stderr)
         return EXIT_RULES
     print_json(result.to_dict()) if args.json else print(result.to_text(spec.name))
     return EXIT_OK

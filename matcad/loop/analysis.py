@@ -18,7 +18,8 @@ from matcad.errors import LoopError
 from matcad.loop import crossing
 from matcad.loop.segments import Segment
 from matcad.loop.spectrum import BandBins
-from matcad.loop.voicing import MIN_RUN, MIN_RUN_HARMONIC, STABLE_BINS, STRONG_DB, WEAK_DB, longest_run
+from matcad.loop.voicing import (MIN_RUN, MIN_RUN_HARMONIC, STABLE_BINS, STRONG_DB, STRONG_RUN, WEAK_DB,
+                                 longest_run)
 
 SECOND_SOURCE_FRACTION = 0.5
 
@@ -100,6 +101,20 @@ class Frames:
     other_level_db: np.ndarray
 
 
+def _why_unvoiced(excess: np.ndarray, fs: float) -> str:
+    """Why no frame counted as the tone: a recording too short for the shortest run that can count
+    (:data:`STRONG_RUN` frames), or no line strong or steady enough (levels dB over the floor)."""
+    hop = window_samples(fs) // 2
+    run_ms = 1e3 * (window_samples(fs) + (STRONG_RUN - 1) * hop) / fs
+    best = f"best frame {np.max(excess):.1f} dB"
+    if len(excess) < STRONG_RUN:
+        return (f"the recording holds {len(excess)} analysis frame ({WINDOW_S * 1e3:.0f} ms), too short for a run of "
+                f"{STRONG_RUN} frames ({run_ms:.0f} ms) at >= {STRONG_DB:g} dB, the least a tone needs to count (a lone "
+                f"frame is as often a noise peak; {best}): record longer")
+    return (f"no frame has a line >= {STRONG_DB:g} dB over the local noise floor, nor >= {WEAK_DB:g} dB steady for "
+            f"{MIN_RUN} frames ({best})")
+
+
 def conclude(frames: Frames, bins: BandBins, duration_s: float, loudest: str = "", plot=(None, None)) -> Analysis:
     """The :class:`Analysis` of the band ``bins`` of a recording ``duration_s`` (s) long. ``loudest``: the
     :func:`strongest_outside` text ('' when none); ``plot``: the pooled spectrogram (column times s, level dB
@@ -113,9 +128,7 @@ def conclude(frames: Frames, bins: BandBins, duration_s: float, loudest: str = "
         raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz: the recording is shorter than one "
                         f"{WINDOW_S * 1e3:.0f} ms analysis window")
     if not np.any(state == 1):
-        raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz: no frame has a line >= {STRONG_DB:g} dB over the "
-                        f"local noise floor, nor >= {WEAK_DB:g} dB steady for {MIN_RUN} frames (best frame "
-                        f"{np.max(excess):.1f} dB){hint}")
+        raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz: {_why_unvoiced(excess, bins.fs)}{hint}")
     # the taxel's line through hops and crossings of two tones
     ident = crossing.follow_taxel(times, track, state, frames.other_bin, frames.other_excess_db,
                                   frames.other_level_db, excess, band_freqs)

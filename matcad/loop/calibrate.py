@@ -6,6 +6,7 @@ frequencies Hz, volumes mm³.
 from __future__ import annotations
 
 import csv
+import re
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,18 @@ FORCE_LIMIT_N = 1e6
 """|F| above this is not a taxel load (and F² would overflow the fit): the spec's calibration.force_range_n bound."""
 FREQUENCY_LIMIT_HZ = 1e7
 """The spec's microphone.sample_rate_hz bound: no recorded tone lies above it."""
+FREQUENCY_MIN_HZ = 1e-3
+"""No tone a microphone records lies below 1 mHz (a column in kHz, 4.5, still passes and gets a unit note)."""
+_DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d+\s*$")
+
+
+def _european(row: list[str]) -> str:
+    """Why a row that holds no two numbers may be a European-locale CSV (';' between columns, ',' as the decimal
+    mark, as Excel writes it in many locales), or '' if it does not look like one."""
+    if any(";" in cell for cell in row) or any(_DECIMAL_COMMA.match(cell) for cell in row):
+        return ("; it looks like a European-locale CSV (';' between columns, ',' as the decimal mark): save it "
+                "with ',' between columns and '.' as the decimal mark (e.g. 0.5,4500.5)")
+    return ""
 
 
 def read_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
@@ -44,10 +57,11 @@ def read_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray | Non
             force, freq = float(row[i_f]), float(row[i_hz])
         except (ValueError, IndexError):
             raise ValueError(f"calibration data {path}, row {line}: {shorten(row)} must hold a force (N) and a "
-                             "frequency (Hz)") from None
-        if not (abs(force) <= FORCE_LIMIT_N and 0 < freq <= FREQUENCY_LIMIT_HZ):
+                             f"frequency (Hz){_european(row)}") from None
+        if not (abs(force) <= FORCE_LIMIT_N and FREQUENCY_MIN_HZ <= freq <= FREQUENCY_LIMIT_HZ):
             raise ValueError(f"calibration data {path}, row {line}: force {force!r} must be finite with |F| <= "
-                             f"{FORCE_LIMIT_N:g} N and frequency {freq!r} finite, 0 < f <= {FREQUENCY_LIMIT_HZ:g} Hz")
+                             f"{FORCE_LIMIT_N:g} N and frequency {freq!r} finite, {FREQUENCY_MIN_HZ:g} <= f <= "
+                             f"{FREQUENCY_LIMIT_HZ:g} Hz")
         forces.append(force)
         freqs.append(freq)
         if i_c is not None:

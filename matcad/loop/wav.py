@@ -136,18 +136,31 @@ def _decode(raw: bytes, info: WavInfo) -> np.ndarray:
     return x.reshape(-1, info.channels)
 
 
+FLOAT_PEAK_MAX = 1e12
+"""Largest |sample| a float recording may hold: its full scale is ±1, and integer sample values saved as floats
+reach 2³¹ ≈ 2.1e9; beyond 1e12 the numbers are no recording, and their squares would overflow the spectra."""
+
+
+def _mono(x: np.ndarray, info: WavInfo, name) -> np.ndarray:
+    """Frames × channels → mono (channels averaged); ValueError on NaN, infinite or absurdly large samples (checked
+    before averaging, which could overflow)."""
+    if not np.all(np.isfinite(x)):
+        raise ValueError(f"recording {name}: contains NaN or infinite samples")
+    peak = float(np.max(np.abs(x), initial=0.0))
+    if peak > FLOAT_PEAK_MAX:
+        raise ValueError(f"recording {name}: float samples reach {peak:.3g}; a float WAV's full scale is ±1 and "
+                         f"no recording holds samples beyond ±{FLOAT_PEAK_MAX:g}")
+    return x[:, 0] if info.channels == 1 else x.mean(axis=1)
+
+
 def read_frames(path: str | Path, info: WavInfo, start: int = 0, count: int | None = None) -> np.ndarray:
     """Frames ``start`` .. ``start + count`` of ``path`` as mono float64 in [-1, 1] (channels averaged).
-    Raises ValueError on NaN or infinite samples."""
+    Raises ValueError on NaN, infinite or absurdly large (:data:`FLOAT_PEAK_MAX`) samples."""
     count = info.frames - start if count is None else max(0, min(count, info.frames - start))
     with open_regular(path, "recording") as f:
         f.seek(info.data_offset + start * info.block_align)
         raw = f.read(count * info.block_align)
-    x = _decode(raw[:len(raw) // info.block_align * info.block_align], info)
-    x = x[:, 0] if info.channels == 1 else x.mean(axis=1)
-    if not np.all(np.isfinite(x)):
-        raise ValueError(f"recording {path}: contains NaN or infinite samples")
-    return x
+    return _mono(_decode(raw[:len(raw) // info.block_align * info.block_align], info), info, path)
 
 
 def read_mono(path: str | Path) -> tuple[np.ndarray, float]:
@@ -214,10 +227,7 @@ def iter_stream(stream, info: WavInfo, block_frames: int = 4096, name: str = "st
         whole = len(raw) // info.block_align * info.block_align
         if whole == 0:
             return
-        x = _decode(raw[:whole], info)
-        x = x[:, 0] if info.channels == 1 else x.mean(axis=1)
-        if not np.all(np.isfinite(x)):
-            raise ValueError(f"recording {name}: contains NaN or infinite samples")
+        x = _mono(_decode(raw[:whole], info), info, name)
         left = left - len(x) if left > 0 else left
         yield x
         if whole < want * info.block_align:

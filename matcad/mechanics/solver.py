@@ -10,8 +10,11 @@ outside of the body may roll onto the plate without friction. F is the plate's r
 
 Load steps are equal plate increments to ``displacement_mm``; a step whose Newton iterations (at most
 ``MAX_NEWTON``) do not converge, or that inverts a cell, is cut in half, at most ``MAX_CUTS`` times, and a whole
-curve spends at most ``NEWTON_BUDGET_PER_STEP`` × steps iterations; past either bound the curve stops at the last
-converged step and :attr:`CapCurve.message` says where and why.
+curve spends at most ``NEWTON_BUDGET_PER_STEP`` × max(steps, ``BUDGET_MIN_STEPS``) iterations; past either bound
+the curve stops at the last converged step and :attr:`CapCurve.message` says where and why. A failed step restores
+the last converged state of every item that keeps one (FElupe's ``checkpoint``/``restore``): the displacements and
+the nearly-incompressible solid's condensed pressure and volume ratio, so that the curve's end does not depend on
+``steps`` (paper cap, 1/2/3/4/10 steps: 0/1.0/1.33/1.5/2.0 mm of 2 mm before, all 2.0 mm now).
 """
 
 from __future__ import annotations
@@ -31,7 +34,10 @@ CONTACTS = ("sticking", "frictionless")
 MAX_NEWTON = 12
 MAX_CUTS = 5
 NEWTON_BUDGET_PER_STEP = 40
-"""All Newton iterations of a curve, failed ones included, stay below this × steps: a bound on the run time."""
+BUDGET_MIN_STEPS = 10
+"""All Newton iterations of a curve, failed ones included, stay below NEWTON_BUDGET_PER_STEP × max(steps,
+BUDGET_MIN_STEPS): a bound on the run time. A curve asked in fewer steps than the default 10 gets the default's
+budget, since its step cuts make the steps it did not ask for (1 step ran out after its first cut before)."""
 NEWTON_TOL = 1e-8
 PENALTY_PER_G_MM = 1e5
 """Contact penalty = this × G × outer radius (N/mm): a plate penetration below 1e-4 mm at the cap's forces."""
@@ -220,16 +226,17 @@ def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking",
     for target in np.linspace(step, displacement_mm, steps):
         while x_done < target - 1e-12 * displacement_mm:
             dx = min(inc, target - x_done)
-            if iterations > NEWTON_BUDGET_PER_STEP * steps:
+            if iterations > NEWTON_BUDGET_PER_STEP * max(steps, BUDGET_MIN_STEPS):
                 message = (f"stopped at x = {x_done:.4g} mm (last converged step) of {displacement_mm:g} mm: "
-                           f"{iterations} Newton iterations spent (budget {NEWTON_BUDGET_PER_STEP} per step), the "
-                           "curve is too hard to follow here")
+                           f"{iterations} Newton iterations spent (budget {NEWTON_BUDGET_PER_STEP} per step, at "
+                           f"least {BUDGET_MIN_STEPS} steps), the curve is too hard to follow here")
                 break
-            saved = u.values.copy()
+            saved = [(item, item.checkpoint()) for item in items if hasattr(item, "checkpoint")]
             try:
                 its, state = solve_at(x_done + dx)
             except (ValueError, ArithmeticError, RuntimeError, np.linalg.LinAlgError) as exc:
-                u.values[:] = saved
+                for item, checkpoint in saved:  # the displacements and the condensed pressure and volume ratio
+                    item.restore(checkpoint)
                 iterations += MAX_NEWTON
                 inc = dx / 2
                 if inc < step / 2 ** MAX_CUTS:

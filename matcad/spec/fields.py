@@ -24,14 +24,26 @@ VECTOR_MAX = 10_000
 """Most values a list field (a measured series) may hold."""
 
 
+class _Missing:
+    """The ``value`` of a SpecError about a table or field that is not there at all (no ``= None`` in messages)."""
+
+    def __repr__(self) -> str:
+        return "(missing)"
+
+
+MISSING: Any = _Missing()
+
+
 class SpecError(ValueError):
-    """Bad spec input. ``field`` is the dotted spec key, ``value`` what was given, ``allowed`` the rule."""
+    """Bad spec input. ``field`` is the dotted spec key, ``value`` what was given (:data:`MISSING` when nothing
+    was), ``allowed`` the rule."""
 
     def __init__(self, field_name: str, value: Any, allowed: str):
         self.field = field_name
         self.value = value
         self.allowed = allowed
-        super().__init__(f"{field_name} = {shorten(value)}: {allowed}")
+        given = "" if value is MISSING else f" = {shorten(value)}"
+        super().__init__(f"{field_name}{given}: {allowed}")
 
 
 def param(doc: str, unit: str = "", default: Any = dataclasses.MISSING, *, kind: str = "number",
@@ -168,7 +180,7 @@ def read_section(cls: type, path: str, data: Any) -> Any:
         if name in data:
             values[name] = convert(f"{path}.{name}", data[name], dict(f.metadata))
         elif f.default is dataclasses.MISSING:
-            raise SpecError(f"{path}.{name}", None, f"is required ({f.metadata['doc']})")
+            raise SpecError(f"{path}.{name}", MISSING, f"is required ({f.metadata['doc']})")
     own = cls.table
     try:
         return cls(**values)
@@ -193,5 +205,5 @@ class Section:
             if value is None and f.default is None:
                 continue
             if value is None and f.default is dataclasses.MISSING:
-                raise SpecError(f"{path}.{f.name}", None, f"is required ({f.metadata['doc']})")
+                raise SpecError(f"{path}.{f.name}", MISSING, f"is required ({f.metadata['doc']})")
             object.__setattr__(self, f.name, convert(f"{path}.{f.name}", value, dict(f.metadata)))

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from matcad.spec.drawn import Drawn, drawn_spec
-from matcad.spec.fields import LENGTH_MAX_MM, Section, SpecError, length_mm, param
+from matcad.spec.fields import LENGTH_MAX_MM, MISSING, Section, SpecError, length_mm, param
 
 FILE_FIELDS = {
     "analysis": (("f0_hz", "f0_tolerance_hz"), "a single-taxel report.json `matcad analyze` wrote: f0_hz is its "
@@ -73,12 +73,12 @@ class Measured(Drawn, Section):
                                         "displacement_force_n")):
             if (xs is None) != (ys is None):
                 given, missing = (x_name, y_name) if ys is None else (y_name, x_name)
-                raise SpecError(f"measured.{missing}", None, f"is required with measured.{given} (pairs)")
+                raise SpecError(f"measured.{missing}", MISSING, f"is required with measured.{given} (pairs)")
             if xs is not None and len(xs) != len(ys):
                 raise SpecError(f"measured.{y_name}", f"{len(ys)} values",
                                 f"must pair with measured.{x_name}: {len(xs)} values")
         if self.f0_hz is None and self.force_n is None and self.displacement_mm is None:
-            raise SpecError("measured.f0_hz", None, "is required unless f(F) pairs (force_n, f_hz) or "
+            raise SpecError("measured.f0_hz", MISSING, "is required unless f(F) pairs (force_n, f_hz) or "
                                                     "force-displacement pairs are given: a measured taxel needs data")
         if self.f0_hz is not None and not self.f0_tolerance_hz < self.f0_hz:
             raise SpecError("measured.f0_tolerance_hz", self.f0_tolerance_hz,

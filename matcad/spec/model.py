@@ -15,7 +15,7 @@ from matcad.materials import GRADES
 from matcad.spec.calibration import Calibration
 from matcad.spec.checks import cross_checks
 from matcad.spec.drawn import filled
-from matcad.spec.fields import SpecError, convert, did_you_mean, param, read_section
+from matcad.spec.fields import MISSING, SpecError, convert, did_you_mean, param, read_section
 from matcad.spec.measured import Measured
 from matcad.spec.sections import (CAP_OUTER_PER_D, CAP_TOP_PER_D, MAX_TAXELS, Air, Array, Cavity, EndCap,
                                   Fasteners, Guide, Machine, Mechanics, Microphone, Mold, Mount, Neck, Needle,
@@ -56,7 +56,7 @@ class Spec:
         for section, cls in SECTIONS.items():
             value = getattr(self, section)
             if value is None and section in REQUIRED_SECTIONS:
-                raise SpecError(section, None, f"is required: add a [{section}] table")
+                raise SpecError(section, MISSING, f"is required: add a [{section}] table")
             if value is not None and not isinstance(value, cls):
                 raise SpecError(section, value, f"must be a {cls.__name__} section")
         for key, cls in ARRAY_TABLES.items():
@@ -84,7 +84,7 @@ def from_dict(data: dict) -> Spec:
             raise SpecError(key, data[key], did_you_mean(key, known))
     name_meta = dict(dataclasses.fields(Spec)[0].metadata)
     if "name" not in data:
-        raise SpecError("name", None, f"is required ({name_meta['doc']})")
+        raise SpecError("name", MISSING, f"is required ({name_meta['doc']})")
     values: dict[str, Any] = {"name": convert("name", data["name"], name_meta)}
     for section, cls in SECTIONS.items():
         if section in data and data[section] is None and section not in REQUIRED_SECTIONS:
@@ -92,7 +92,7 @@ def from_dict(data: dict) -> Spec:
         if section in data:
             values[section] = read_section(cls, section, data[section])
         elif section in REQUIRED_SECTIONS:
-            raise SpecError(section, None, f"is required: add a [{section}] table")
+            raise SpecError(section, MISSING, f"is required: add a [{section}] table")
     for key, cls in ARRAY_TABLES.items():
         if key in data:
             values[key] = _entries(key, cls, data[key])

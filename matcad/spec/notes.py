@@ -2,7 +2,7 @@
 
 Validation (:mod:`matcad.spec`) refuses what is not physical; these notes catch what is physical but unlikely
 for a milli-scale taxel: a shear modulus entered in kPa, a temperature in kelvin, an angle in radians, a spec
-in metres, a sample rate in kHz, a calibration CSV in kHz. They never change a value; the CLI prints them and
+in metres or inches, a sample rate in kHz, a calibration CSV in kHz. They never change a value; the CLI prints them and
 the design page shows them with the prediction.
 """
 
@@ -18,9 +18,16 @@ THETA_RADIANS_MAX = math.pi / 2
 """A needle angle ≤ π/2 "degrees" is more likely radians (the paper's 75° is 1.31 rad)."""
 METRES_MAX = 0.05
 """Every main dimension below 0.05 "mm" reads as a spec written in metres."""
+INCHES_MAX = 1.0
+"""Every main dimension below 1 "mm" (and not metres) reads as a spec in inches: the paper's taxel is inch
+fractions (cavity 1/8 x 3/16 in, neck sheet 1/4 in), and a taxel under 1 mm would sing far above the microphone's
+band (the paper's in "mm": f0 ~ 142 kHz)."""
+MM_PER_INCH = 25.4
 SAMPLE_RATE_KHZ_MAX = 400.0
 FREQUENCY_KHZ_MAX = 100.0
 """Taxel tones are kHz; frequencies all below 100 "Hz" read as kHz."""
+FREQUENCY_KHZ_MIN = 0.02
+"""...unless even in kHz they would lie below hearing (20 Hz): then no unit slip explains them, and no note."""
 
 
 def spec_notes(spec, data: dict | None = None) -> list[str]:
@@ -42,6 +49,10 @@ def spec_notes(spec, data: dict | None = None) -> list[str]:
         meant = ", ".join(f"{k} = {v * 1000:g}" for k, v in dims.items())
         notes.append(f"every main dimension is below {METRES_MAX:g} mm: a spec in metres? lengths are mm; did you "
                      f"mean {meant}?")
+    elif all(v < INCHES_MAX for v in dims.values()):
+        meant = ", ".join(f"{k} = {v * MM_PER_INCH:.4g}" for k, v in dims.items())
+        notes.append(f"every main dimension is below {INCHES_MAX:g} mm: a spec in inches? lengths are mm (1 in = "
+                     f"{MM_PER_INCH:g} mm); did you mean {meant}?")
     rate = spec.microphone.sample_rate_hz
     if rate < SAMPLE_RATE_KHZ_MAX:
         notes.append(f"microphone.sample_rate_hz = {rate:g} Hz: kHz entered? did you mean {rate * 1000:g} (Hz)?")
@@ -52,9 +63,10 @@ def spec_notes(spec, data: dict | None = None) -> list[str]:
 
 
 def frequency_notes(frequencies_hz, what: str = "frequency_hz") -> list[str]:
-    """A note when every frequency is below :data:`FREQUENCY_KHZ_MAX` Hz (a column in kHz, probably)."""
+    """A note when every frequency is below :data:`FREQUENCY_KHZ_MAX` Hz (a column in kHz, probably), unless the
+    largest is below :data:`FREQUENCY_KHZ_MIN` (no unit slip explains that)."""
     values = [float(f) for f in frequencies_hz]
-    if values and max(values) < FREQUENCY_KHZ_MAX:
+    if values and FREQUENCY_KHZ_MIN <= max(values) < FREQUENCY_KHZ_MAX:
         return [f"{what}: every value is below {FREQUENCY_KHZ_MAX:g} Hz (max {max(values):g}): kHz entered? did you "
                 f"mean {max(values) * 1000:g} Hz for the largest?"]
     return []

@@ -14,7 +14,8 @@ from typing import Any, ClassVar
 from matcad.materials import DEFAULT_GRADE, GRADES
 from matcad.spec.calibration import Calibration
 from matcad.spec.drawn import Drawn
-from matcad.spec.fields import LENGTH_MAX_MM, LENGTH_MIN_MM, Section, SpecError, length_mm, param
+from matcad.spec.fields import (LENGTH_MAX_MM, LENGTH_MIN_MM, MISSING, Section, SpecError, length_mm,
+                               param)
 
 CAP_OUTER_PER_D = 2.5
 CAP_TOP_PER_D = 0.6
@@ -255,6 +256,11 @@ class Air(Section):
                                          "m/s", None, lo=50.0, hi=1e4, lo_open=False)
 
 
+WALL_SHEAR_MIN_MPA = 1e-3
+"""The softest cast silicone gels are ~1 kPa in shear; below, a wall is no solid (and G's range products
+underflow)."""
+
+
 @dataclass(frozen=True)
 class Wall(Section):
     """Cavity wall mechanics."""
@@ -265,14 +271,15 @@ class Wall(Section):
                        default="rigid", kind="choice", choices=("rigid", "silicone"))
     shear_modulus_mpa: tuple[float, float] | None = param(
         "[low, high] static shear modulus of the cured silicone; default from silicone.grade "
-        "(Dragon Skin 30: 0.2-0.6 MPa)", "MPa", None, kind="range", lo=0.0, hi=1e6)
+        "(Dragon Skin 30: 0.2-0.6 MPa); at least 1 kPa, the softest cast silicone gels", "MPa", None, kind="range",
+        lo=WALL_SHEAR_MIN_MPA, hi=1e6, lo_open=False)
     loss_factor: tuple[float, float] | None = param(
         "[low, high] loss factor eta of the silicone at kHz (G* = G(1 + i eta)); default from silicone.grade "
         "(Dragon Skin 30: 0.1-0.2)", "", None, kind="range", lo=0.0, hi=10.0, lo_open=False)
     khz_modulus_factor: tuple[float, float] | None = param(
         "[low, high] storage modulus at kHz over the static shear_modulus_mpa; default from silicone.grade "
-        "(Dragon Skin 30: 1.0-1.6, an assumption, see docs/materials.md)", "", None, kind="range", lo=0.0,
-        hi=1e3)
+        "(Dragon Skin 30: 1.0-1.6, an assumption, see docs/materials.md); at least 1: an elastomer's storage "
+        "modulus never falls with frequency", "", None, kind="range", lo=1.0, hi=1e3, lo_open=False)
 
 
 @dataclass(frozen=True)
@@ -335,7 +342,7 @@ class Array(Section):
                                                      f"(columns = {self.columns})")
         for count, pitch in (("columns", "pitch_x"), ("rows", "pitch_y")):
             if getattr(self, count) > 1 and getattr(self, pitch) is None:
-                raise SpecError(f"array.{pitch}", None, f"is required when array.{count} > 1 (mm between neck "
+                raise SpecError(f"array.{pitch}", MISSING, f"is required when array.{count} > 1 (mm between neck "
                                                         "axes)")
 
 
