@@ -75,7 +75,8 @@ def laser_coupon(spec: Spec, sheet: str = "plate") -> Flat:
     labels = tuple(Engraving(h.x - 0.9 * LABEL_MM, h.y - h.diameter / 2 - 0.5 - LABEL_MM, LABEL_MM,
                              f"{h.diameter:.2f}") for h in holes)
     thickness, measured = sheet_thickness_mm(spec, sheet)
-    return Flat(name=f"coupon_{sheet}", thickness=thickness, thickness_measured=measured,
+    return Flat(name=f"coupon_{sheet}", thickness=thickness, thickness_measured=measured, sheet=sheet,
+                thickness_example=getattr(spec, sheet).thickness_example,
                 kerf=sheet_kerf_mm(spec, sheet), width=width, depth=depth, holes=tuple(holes), engrave=labels)
 
 
