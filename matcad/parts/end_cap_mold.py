@@ -100,21 +100,30 @@ def lid_labels(spec) -> tuple:
     return taxel_labels(spec, lay, _flanges(spec, lay) + _features(spec, lay))
 
 
-def _nut_pocket(spec, lay: MoldLayout, x: float, y: float):
-    """A clamp nut's hex pocket in the base (closed below on FDM, a trap open to the base's underside on SLA)
-    and the bolt's clearance hole from it up to the parting plane (mm)."""
-    from build123d import Face, Solid, Vector, Wire
+def _hexagon(x: float, y: float, z: float, circumradius: float):
+    from build123d import Wire
 
+    return Wire.make_polygon([(x + circumradius * math.cos(math.radians(60 * k)),
+                               y + circumradius * math.sin(math.radians(60 * k)), z) for k in range(6)], close=True)
+
+
+def _nut_pocket(spec, lay: MoldLayout, x: float, y: float):
+    """A clamp nut's hex pocket in the base (closed below on FDM, a trap open to the base's underside on SLA),
+    its funnel roof (:func:`matcad.parts.mold_layout.nut_funnel_mm`) and the bolt's clearance hole from it up to
+    the parting plane (mm)."""
+    from build123d import Face, Solid, Vector
+
+    from matcad.parts.mold_layout import nut_funnel_mm
     from matcad.parts.solid import cylinder_up
 
     c = lay.clamp
     r = c.across_flats_mm / 2 / math.cos(math.pi / 6)
+    hole = bolt_clearance_mm(spec.mold.bolt, "normal") / 2
     z0 = -lay.base_height if c.open_below else c.pocket_bottom_z
-    hexagon = Face(Wire.make_polygon([(x + r * math.cos(math.radians(60 * k)), y + r * math.sin(math.radians(60 * k)),
-                                       z0) for k in range(6)], close=True))
-    pocket = Solid.extrude(hexagon, Vector(0, 0, c.pocket_top_z - z0))
-    hole = cylinder_up(bolt_clearance_mm(spec.mold.bolt, "normal") / 2, -c.pocket_top_z, x, y, c.pocket_top_z)
-    return [pocket, hole]
+    pocket = Solid.extrude(Face(_hexagon(x, y, z0, r)), Vector(0, 0, c.pocket_top_z - z0))
+    funnel = Solid.make_loft([_hexagon(x, y, c.pocket_top_z, r),
+                              _hexagon(x, y, c.pocket_top_z + nut_funnel_mm(c.bolt, spec.machine.printer), hole)])
+    return [pocket, funnel, cylinder_up(hole, -c.pocket_top_z, x, y, c.pocket_top_z)]
 
 
 def _slot_specs(spec, lay: MoldLayout) -> list[tuple[float, object]]:
@@ -170,7 +179,7 @@ def cast_caps(spec):
 
 PARTS = (Part("end_cap_mold_base", Kind.PRINTED, flag="end_cap_mold", make=mold_base, order=60, colour="#e0c090",
               pose=PrintPose(0.0, "flat underside; cap cavities and keys face up"),
-              view=("from above: cap cavities, fill ports, vents", 90.0, -90.0)),
+              view=("from above: cap pockets, keys, nut pockets", 90.0, -90.0)),
          Part("end_cap_mold_lid", Kind.PRINTED, flag="end_cap_mold", make=mold_lid, order=70, colour="#e0c090",
               pose=PrintPose(180.0, "outer (top) face; core pins point up, the parting face prints last"),
-              view=("from above (as printed, pins up): core pins, vents, key sockets", 90.0, -90.0)))
+              view=("from above (as printed, pins up): core pins, vents, ribbed key sockets", 90.0, -90.0)))

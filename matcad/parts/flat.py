@@ -115,7 +115,7 @@ class Flat:
     quantity: int = 1
     corner_radius: float = 0.5
     thickness_example: bool = False  # the measured thickness is a template's example, not the user's sheet
-    sheet: str = ""  # the acrylic sheet it is cut from (a key of features.SHEETS; '' for a one-off like a coupon)
+    sheet: str = ""  # the acrylic sheet it is cut from (a key of features.SHEETS)
 
     @property
     def area_mm2(self) -> float:
@@ -150,6 +150,7 @@ class CutPlan:
     texts: tuple[Engraving, ...] = ()
     reference_square: tuple[float, float, float] | None = None  # x0, y0, side
     extents: tuple[float, float, float, float] = field(default=(0, 0, 0, 0))
+    parts: tuple[str, ...] = ()  # a nested sheet's parts (matcad.export.sheets); () for one part's plan
 
 
 class DrawnSizeError(ValueError):

@@ -307,8 +307,20 @@ NUT_POCKET_CLEARANCE_MM = {"fdm": 0.3, "sla": 0.15}
 """Nut pocket across flats over the nut's: a printed hole comes out undersize, FDM more than SLA (mm)."""
 NUT_HEADROOM_MM = 0.2
 """Pocket height over the nut's: the layer that closes an FDM pocket must not touch the nut (mm)."""
-NUT_ROOF_MM = 2.0
-"""Base material kept between a nut pocket and the parting plane: it carries the clamp force (mm)."""
+NUT_ROOF_MM = 1.0
+"""Base material kept between the top of a nut pocket's funnel roof and the parting plane (mm)."""
+
+
+def nut_funnel_mm(bolt: str, printer: str) -> float:
+    """Height of the roof over a clamp nut's hex pocket: a hexagonal funnel from the pocket to a hexagon inscribed in
+    the bolt's clearance hole (a corner standing out of the hole would leave a ledge the slicer supports), its
+    corners overhanging 30° from vertical, the steepest overhang PrusaSlicer's default FDM profile prints
+    without support (:data:`matcad.parts.coupon.FDM_THETA_MIN_DEG`, measured) (mm)."""
+    from matcad.parts.coupon import FDM_THETA_MIN_DEG
+
+    pocket = (NUT_ACROSS_FLATS_MM[bolt] + NUT_POCKET_CLEARANCE_MM[printer]) / 2 / math.cos(math.pi / 6)
+    hole = bolt_clearance_mm(bolt, "normal") / 2  # the top hexagon inscribed in the hole: no ledge at its corners
+    return (pocket - hole) * math.tan(math.radians(FDM_THETA_MIN_DEG))
 NUT_FLOOR_MM = {"fdm": 1.0, "sla": 0.0}
 """Under the nut: FDM closes the pocket below (five 0.2 mm layers), SLA leaves the trap open to the bed (mm)."""
 
@@ -323,9 +335,10 @@ def clamp_nut(bolt: str, printer: str, base_height: float, lid_thickness: float)
     from matcad.parts.print_profile import profile
 
     m, s = NUT_HEIGHT_MM[bolt], NUT_ACROSS_FLATS_MM[bolt] + NUT_POCKET_CLEARANCE_MM[printer]
+    roof = nut_funnel_mm(bolt, printer) + NUT_ROOF_MM
     fits = [length for length in ISO_4762_LENGTHS_MM
             if lid_thickness - length >= -base_height + NUT_FLOOR_MM[printer]
-            and lid_thickness - length + m + NUT_HEADROOM_MM <= -NUT_ROOF_MM]
+            and lid_thickness - length + m + NUT_HEADROOM_MM <= -roof]
     length = max(fits) if fits else None
     bottom = lid_thickness - (length if length is not None else lid_thickness + base_height)
     top = bottom + m + NUT_HEADROOM_MM
@@ -335,4 +348,5 @@ def clamp_nut(bolt: str, printer: str, base_height: float, lid_thickness: float)
         top_print = base.layer_top_mm(top + base_height)
         top = top_print - base_height
         pause = round(top_print + base.layer_mm / 2, 6)
-    return ClampNut(bolt, length, m, bottom if printer == "fdm" else -base_height, top, s, printer == "sla", pause)
+    return ClampNut(bolt, length, m, round(bottom if printer == "fdm" else -base_height, 6), round(top, 6), s,
+                    printer == "sla", pause)

@@ -108,4 +108,5 @@ def mount_labels(spec) -> tuple:
 
 PARTS = (Part("needle_mount", Kind.PRINTED, flag="needle_mount", make=needle_mount, order=80, colour="#b4b4b4",
               pose=PrintPose(0.0, "flat underside; standoffs and the needle bore's mouth face up"),
-              view=("from the side: the needle bore at θ", 0.0, -90.0), label="needle mount (printed)"),)
+              view=("section through a needle's plane: its bore at θ", 0.0, -90.0), label="needle mount (printed)",
+              section="bore"),)

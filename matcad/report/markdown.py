@@ -101,6 +101,26 @@ def _drills_markdown(drills: list[dict]) -> list[str]:
             f"for the neck pilot{'s' if len(d['taxels']) > 1 else ''} of {', '.join(d['taxels'])}" for d in drills]
 
 
+def _files_to_make_markdown(sheets: list[dict] | None, job: dict | None) -> list[str]:
+    """The cut files (one per sheet, nested) and the print job (one 3MF, each part with its settings)."""
+    lines = []
+    if sheets:
+        lines += ["", "## Cut files, one per sheet", "",
+                  "Each sheet's parts nested in one file (engraving, then inner cuts, outlines last); "
+                  "`sheets_1to1.pdf` draws them at 1:1 to check the scale on paper first.", "",
+                  "| sheet | file | parts | kerf [mm] | size [mm] | PDF page |", "|---|---|---|---:|---|---|"]
+        lines += [f"| {s['thickness_mm']:g} mm | `{s['file']}` | {', '.join(s['parts'])} | {s['kerf_mm']:g} | "
+                  f"{s['width_mm']:.1f} × {s['height_mm']:.1f} | {s['pdf_page']['page']} |" for s in sheets]
+    if job:
+        lines += ["", f"## Print job (`{job['file']}`)", "",
+                  "| part | settings | material |", "|---|---|---|"]
+        lines += [f"| {o['name']} | {cell(', '.join(f'{k} {v}' for k, v in o['settings'].items()))} | "
+                  f"{cell(o['material'])} |" for o in job["objects"]]
+        lines += [f"- pause after the layer at z = {p['after_layer_z_mm']:.2f} mm ({p['part']}): {p['message']}"
+                  for p in job["pauses"]]
+    return lines
+
+
 def _taxels_markdown(board: list[dict] | None) -> list[str]:
     """A board's taxels: position, geometry, needle and unloaded prediction, one row each (mm, deg, Hz)."""
     if not board:
@@ -182,6 +202,7 @@ def sections(r: dict) -> str:
         f = bom["mount_fixing"]
         lines.append(f"- mount fixing: {f['count']} × {f['size']} screws {f['note']}")
     lines += _fabrication_markdown(r.get("fabrication"))
+    lines += _files_to_make_markdown(r.get("sheets"), r.get("print_job"))
     lines += _casting_markdown(r.get("casting"))
     lines += _taxels_markdown(board)
     lines += ["", "## Files", "", "| file | bytes | sha256 |", "|---|---:|---|"]
