@@ -140,11 +140,11 @@ def write_sheets(plans, spec, folder: Path) -> list[dict]:
 
 def write_print_job(spec, folder: Path, meshes: dict) -> dict | None:
     """The printer's 3MF (:mod:`matcad.export.threemf`) from the printed STLs just written (their print poses),
-    each with its print profile; an FDM mold base with the pause for its captive nuts. None without printed
-    parts."""
+    each with its print profile; an FDM mold base with the pause for its captive nuts; one file per bed load.
+    Returns the printer and each file's objects and pauses; None without printed parts."""
     import trimesh
 
-    from matcad.export.threemf import PrintPart, write_3mf
+    from matcad.export.threemf import PrintPart, plates, write_3mf
     from matcad.parts.print_profile import profile
     from matcad.report.fabrication import PRINT_FILE
 
@@ -166,7 +166,10 @@ def write_print_job(spec, folder: Path, meshes: dict) -> dict | None:
         parts.append(PrintPart(name, mesh.vertices, mesh.faces, profile(printer, name), pause))
     if not parts:
         return None
-    return write_3mf(parts, printer, folder / PRINT_FILE.format(printer=printer))
+    loads = plates(parts, printer)
+    stems = ([PRINT_FILE.format(printer=printer)] if len(loads) == 1 else
+             [PRINT_FILE.format(printer=f"{printer}_{k}") for k in range(1, len(loads) + 1)])
+    return {"printer": printer, "files": [write_3mf(load, printer, folder / stem) for load, stem in zip(loads, stems)]}
 
 
 def _write_solids(spec, folder: Path) -> dict[str, dict]:
@@ -246,7 +249,7 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
         job = write_print_job(spec, tmp, meshes) if meshes else None
         figures = render_figures(spec, prediction, tmp, meshes, plans) + [band_chart(bands, tmp / BANDS_PNG)]
         mold = layout(spec) if spec.outputs.end_cap_mold else None
-        report = make_report(spec, prediction, findings, holes, meshes, tmp, flats=flats, mold=mold) | {
+        report = make_report(spec, prediction, findings, holes, meshes, tmp, flats=flats, mold=mold, job=job) | {
             "figures": figures, "bands": bands, "sheets": sheets, "print_job": job}
         if len(board) > 1:
             report["taxels"] = board_report(spec, board, predictions)

@@ -1,6 +1,7 @@
 """A 3MF print job per printer (print_fdm.3mf, print_sla.3mf): every printed part of the kit as exported (its
-print pose, on its bed face), laid out on one bed, each with its own slicer settings — layer height, walls,
-infill, solid layers — and the material, and for an FDM mold base the pause that drops its captive nuts in.
+print pose, on its bed face), laid out on the bed, each with its own slicer settings — layer height, walls,
+infill, solid layers — and the material, and for an FDM mold base the pause that drops its captive nuts in. Parts
+that do not fit one bed go to further plates (print_sla_1.3mf, print_sla_2.3mf, ...), each a job of its own.
 
 3MF Core 2015/02 (mm) with PrusaSlicer's metadata, which PrusaSlicer, SuperSlicer and OrcaSlicer read:
 ``Metadata/Slic3r_PE.config`` (the project's printer technology, material and defaults),
@@ -52,13 +53,15 @@ class PrintPart:
     pause: tuple[float, str] | None = None
 
 
-def layout_mm(parts: list[PrintPart], printer: str) -> list[tuple[float, float]]:
-    """Where each part's footprint centre goes on the bed: rows left to right, :data:`GAP_MM` apart, the whole
-    block centred on :data:`BED_MM` (mm)."""
+def _footprint(part: PrintPart) -> tuple[float, float]:
     import numpy as np
 
-    bed_w, bed_h = BED_MM[printer]
-    sizes = [np.ptp(np.asarray(p.vertices)[:, :2], axis=0) for p in parts]
+    w, d = np.ptp(np.asarray(part.vertices)[:, :2], axis=0)
+    return float(w), float(d)
+
+
+def _rows(sizes: list[tuple[float, float]], bed_w: float) -> list[list[int]]:
+    """Indices of ``sizes`` in rows left to right, each row at most ``bed_w`` wide (a part wider stands alone)."""
     rows, row, width = [], [], 0.0
     for i, (w, _) in enumerate(sizes):
         if row and width + GAP_MM + w > bed_w:
@@ -66,7 +69,31 @@ def layout_mm(parts: list[PrintPart], printer: str) -> list[tuple[float, float]]
             row, width = [], 0.0
         width += (GAP_MM if row else 0.0) + w
         row.append(i)
-    rows.append(row)
+    return rows + [row]
+
+
+def plates(parts: list[PrintPart], printer: str) -> list[list[PrintPart]]:
+    """The parts split into bed loads of :data:`BED_MM`: rows of parts :data:`GAP_MM` apart, a new plate when the
+    next row would not fit (an SLA display holds the mold halves, not the mount beside them)."""
+    bed_w, bed_h = BED_MM[printer]
+    sizes = [_footprint(p) for p in parts]
+    out, plate, depth = [], [], 0.0
+    for row in _rows(sizes, bed_w):
+        h = max(sizes[i][1] for i in row)
+        if plate and depth + GAP_MM + h > bed_h:
+            out.append(plate)
+            plate, depth = [], 0.0
+        depth += (GAP_MM if plate else 0.0) + h
+        plate += [parts[i] for i in row]
+    return out + [plate]
+
+
+def layout_mm(parts: list[PrintPart], printer: str) -> list[tuple[float, float]]:
+    """Where each part's footprint centre goes on the bed: rows left to right, :data:`GAP_MM` apart, the whole
+    block centred on :data:`BED_MM` (mm)."""
+    bed_w, bed_h = BED_MM[printer]
+    sizes = [_footprint(p) for p in parts]
+    rows = _rows(sizes, bed_w)
     heights = [max(sizes[i][1] for i in r) for r in rows]
     y = (sum(heights) + GAP_MM * (len(rows) - 1)) / 2 + bed_h / 2
     out = [(0.0, 0.0)] * len(parts)

@@ -33,11 +33,6 @@ RIB_WIDTH_MM = {"fdm": 0.8, "sla": 0.5}
 printed fat is shaved or flexed as the bolts pull the lid down (the crush-rib practice of printed press fits)."""
 RIB_ANGLES_DEG = (90.0, 210.0, 330.0)
 """Three ribs 120° apart: each lateral direction pushes the key into at least one of them."""
-LABEL_HEIGHTS_MM = (2.0, 1.5)
-"""Capital heights of the taxel names recessed in printed parts (mm): DejaVu strokes about 0.09 em, 0.18 mm at
-2 mm, a 0.4 mm nozzle's recess still reads."""
-LABEL_DEPTH_MM = 0.4
-"""Depth of printed labels: two 0.2 mm FDM layers."""
 
 
 def _key(spec, grow: float, x: float, y: float):
@@ -66,13 +61,13 @@ def _ribbed_socket(spec, x: float, y: float):
 def taxel_labels(spec, lay: MoldLayout, keepout) -> tuple:
     """The taxel name over each cap position of a board's mold, placed on the block's face clear of ``keepout``
     circles (x, y, radius); () for a single taxel's mold, whose caps are all the same (mm)."""
-    from matcad.parts.labels import place_labels
+    from matcad.parts.labels import PRINTED_LABEL_HEIGHTS_MM, place_labels
     from matcad.spec import taxels
 
     if len(taxels(spec)) < 2:
         return ()
     return place_labels([(t.name, x, 0.0) for x, t in zip(lay.cap_x, lay.slots)], keepout, lay.block_x,
-                        lay.block_y, heights=LABEL_HEIGHTS_MM)
+                        lay.block_y, heights=PRINTED_LABEL_HEIGHTS_MM)
 
 
 def _flanges(spec, lay: MoldLayout) -> list[tuple[float, float, float]]:
@@ -144,6 +139,7 @@ def mold_base(spec):
     a board's taxel names beside the pockets (mm)."""
     from build123d import Box
 
+    from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
     from matcad.parts.solid import TOP, engraved
 
     lay = layout(spec)
@@ -151,7 +147,7 @@ def mold_base(spec):
     block = block.fuse(*(_key(spec, 0.0, x, y) for x, y in lay.keys))
     return block.cut(*[_upside_down(cap_envelope(s), x) for x, s in _slot_specs(spec, lay)],
                      *[f for x, y in lay.bolts for f in _nut_pocket(spec, lay, x, y)],
-                     *engraved(base_labels(spec), 0.0, LABEL_DEPTH_MM))
+                     *engraved(base_labels(spec), 0.0, PRINTED_LABEL_DEPTH_MM))
 
 
 def mold_lid(spec):
@@ -159,6 +155,7 @@ def mold_lid(spec):
     bolt holes, a board's taxel names beside the fill ports on its top face (mm)."""
     from build123d import Box
 
+    from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
     from matcad.parts.solid import BOTTOM, cylinder_up, engraved
 
     lay = layout(spec)
@@ -169,7 +166,7 @@ def mold_lid(spec):
     return lid.cut(*[_ribbed_socket(spec, x, y) for x, y in lay.keys],
                    *[cylinder_up(o.diameter / 2, o.z_top - o.z_bottom, o.x, o.y, o.z_bottom) for o in lay.openings],
                    *[cylinder_up(bolt, m.lid_thickness, x, y, 0.0) for x, y in lay.bolts],
-                   *engraved(lid_labels(spec), m.lid_thickness, LABEL_DEPTH_MM))
+                   *engraved(lid_labels(spec), m.lid_thickness, PRINTED_LABEL_DEPTH_MM))
 
 
 def cast_caps(spec):

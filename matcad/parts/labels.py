@@ -23,6 +23,11 @@ ASCENT = 1.05
 above it (measured from the glyph outlines)."""
 GRID_MM = 0.25
 """Step of the candidate positions searched."""
+PRINTED_LABEL_HEIGHTS_MM = (2.0, 1.5)
+"""Capital heights of the taxel names recessed in printed parts (mm): DejaVu strokes about 0.09 em, 0.18 mm at
+2 mm, a 0.4 mm nozzle's recess still reads."""
+PRINTED_LABEL_DEPTH_MM = 0.4
+"""Depth of printed labels: two 0.2 mm FDM layers."""
 
 
 def label_size_mm(text: str, height: float) -> tuple[float, float]:

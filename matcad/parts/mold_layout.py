@@ -314,13 +314,13 @@ NUT_ROOF_MM = 1.0
 def nut_funnel_mm(bolt: str, printer: str) -> float:
     """Height of the roof over a clamp nut's hex pocket: a hexagonal funnel from the pocket to a hexagon inscribed in
     the bolt's clearance hole (a corner standing out of the hole would leave a ledge the slicer supports), its
-    corners overhanging 30° from vertical, the steepest overhang PrusaSlicer's default FDM profile prints
-    without support (:data:`matcad.parts.coupon.FDM_THETA_MIN_DEG`, measured) (mm)."""
-    from matcad.parts.coupon import FDM_THETA_MIN_DEG
+    corners overhanging :data:`matcad.parts.print_profile.FDM_MAX_OVERHANG_DEG` from vertical, the steepest
+    PrusaSlicer's default FDM profile prints without support (measured) (mm)."""
+    from matcad.parts.print_profile import FDM_MAX_OVERHANG_DEG
 
     pocket = (NUT_ACROSS_FLATS_MM[bolt] + NUT_POCKET_CLEARANCE_MM[printer]) / 2 / math.cos(math.pi / 6)
     hole = bolt_clearance_mm(bolt, "normal") / 2  # the top hexagon inscribed in the hole: no ledge at its corners
-    return (pocket - hole) * math.tan(math.radians(FDM_THETA_MIN_DEG))
+    return (pocket - hole) / math.tan(math.radians(FDM_MAX_OVERHANG_DEG))
 NUT_FLOOR_MM = {"fdm": 1.0, "sla": 0.0}
 """Under the nut: FDM closes the pocket below (five 0.2 mm layers), SLA leaves the trap open to the bed (mm)."""
 

@@ -48,7 +48,7 @@ def needle_mount(spec):
     name recessed beside its mouth on the top face. No manifold: each needle takes its own air line."""
     from build123d import Box, Pos
 
-    from matcad.parts.end_cap_mold import LABEL_DEPTH_MM
+    from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
     from matcad.parts.solid import BOTTOM, TOP, cylinder_up, engraved
     from matcad.spec import taxels
 
@@ -75,7 +75,7 @@ def needle_mount(spec):
              + bores
              + [cylinder_up(bolt_clearance_mm(FIXING_BOLT, "normal") / 2, EAR_THICKNESS_MM, x, y, top - thick)
                 for x, y in ear_holes_mm(spec)])
-    return body.cut(*holes, *engraved(mount_labels(spec), top, LABEL_DEPTH_MM))
+    return body.cut(*holes, *engraved(mount_labels(spec), top, PRINTED_LABEL_DEPTH_MM))
 
 
 def bore_mouth_mm(spec, taxel) -> tuple[float, float, float]:
@@ -90,8 +90,7 @@ def bore_mouth_mm(spec, taxel) -> tuple[float, float, float]:
 def mount_labels(spec) -> tuple:
     """A board's taxel names recessed in the mount's top face, each beside its needle bore's mouth, clear of the
     other mouths, the bolt pilots (or standoffs) and the dowel holes; () for a single taxel (mm)."""
-    from matcad.parts.end_cap_mold import LABEL_HEIGHTS_MM
-    from matcad.parts.labels import place_labels
+    from matcad.parts.labels import PRINTED_LABEL_HEIGHTS_MM, place_labels
     from matcad.spec import taxels
 
     board = taxels(spec)
@@ -104,7 +103,7 @@ def mount_labels(spec) -> tuple:
     keepout = (mouths + [(x, y, post) for x, y in plate_bolt_positions_mm(spec)]
                + [(x, y, dowel) for x, y in plate_dowel_positions_mm(spec)])
     return place_labels([(t.name, x, y) for t, (x, y, _) in zip(board, mouths)], keepout, spec.plate.width,
-                        spec.plate.depth, heights=LABEL_HEIGHTS_MM)
+                        spec.plate.depth, heights=PRINTED_LABEL_HEIGHTS_MM)
 
 PARTS = (Part("needle_mount", Kind.PRINTED, flag="needle_mount", make=needle_mount, order=80, colour="#b4b4b4",
               pose=PrintPose(0.0, "flat underside; standoffs and the needle bore's mouth face up"),

@@ -12,6 +12,11 @@ import math
 from dataclasses import dataclass
 
 PRINTERS = ("fdm", "sla")
+FDM_MAX_OVERHANG_DEG = 30.0
+"""Steepest overhang from vertical that FDM prints without support: PrusaSlicer with automatic supports (its
+default profile, 0.3 mm layers; tests/test_real_clients.py) puts support under the needle mount's bore at θ = 45°
+(171 mm³) and 52.5° (110 mm³), none at 60° and above (measured), i.e. at overhangs of 30° and less. Bores, nut
+funnels and every other printed ceiling keep to it."""
 
 
 @dataclass(frozen=True)
@@ -59,10 +64,17 @@ PROFILES: dict[str, dict[str, PrintProfile]] = {
 """Print profile per ``machine.printer`` and part name."""
 
 
+DEFAULT_PROFILES = {
+    "fdm": PrintProfile(0.2, 0.2, 3, 20.0, 4, FDM_MATERIAL, "the slicer's usual settings: a part with no profile "
+                        "of its own"),
+    "sla": PROFILES["sla"]["needle_mount"],
+}
+"""The profile of a registered printed part that :data:`PROFILES` does not name (a part added by one module)."""
+
+
 def profile(printer: str, part: str) -> PrintProfile:
-    """The print profile of ``part`` on ``printer`` (a :data:`PRINTERS` process)."""
+    """The print profile of ``part`` on ``printer`` (a :data:`PRINTERS` process); :data:`DEFAULT_PROFILES` for a
+    part without one of its own."""
     if printer not in PROFILES:
         raise ValueError(f"printer {printer!r} invalid, must be one of {PRINTERS}")
-    if part not in PROFILES[printer]:
-        raise ValueError(f"part {part!r} has no print profile, must be one of {sorted(PROFILES[printer])}")
-    return PROFILES[printer][part]
+    return PROFILES[printer].get(part, DEFAULT_PROFILES[printer])

@@ -189,9 +189,10 @@ def kit_hardware(spec, mold: MoldLayout | None) -> dict:
 
 
 def make_report(spec, prediction, findings, holes, meshes, folder: Path, *, flats: list[Flat],
-                mold: MoldLayout | None) -> dict:
+                mold: MoldLayout | None, job: dict | None = None) -> dict:
     """The report's data for ``spec`` built into ``folder``: ``holes`` as cut and ``meshes`` (STL read-back
-    checks) from the writers, ``flats`` the laser parts cut, ``mold`` the mold's layout (None without a mold)."""
+    checks) from the writers, ``flats`` the laser parts cut, ``mold`` the mold's layout (None without a mold),
+    ``job`` the print job written (:func:`matcad.build.write_print_job`, None without one)."""
     return {
         "matcad_version": __version__,
         "name": spec.name,
@@ -202,7 +203,7 @@ def make_report(spec, prediction, findings, holes, meshes, folder: Path, *, flat
         "verdict": "fail" if any(f.level == "error" for f in findings) else "pass",
         "bom": bill_of_materials(spec, flats, mold),
         "casting": casting(spec, mold),
-        "fabrication": fabrication(spec, flats),
+        "fabrication": fabrication(spec, flats, job),
         "meshes": meshes,
         "files": manifest(folder),
     }

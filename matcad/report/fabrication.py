@@ -106,10 +106,10 @@ def _drill_text(rows: list[dict]) -> str:
             "per size (bill of materials); check each hole with the drill's shank before the next size")
 
 
-def steps(spec: Spec, caliper: list[dict]) -> list[dict]:
+def steps(spec: Spec, caliper: list[dict], print_files: list[str] = ()) -> list[dict]:
     """The kit made and assembled in order: each step with what to do, on which sheet or machine, which files;
-    ``caliper`` is :func:`sheets_to_caliper` of the laser parts. A board's steps name its taxels as the parts
-    are engraved."""
+    ``caliper`` is :func:`sheets_to_caliper` of the laser parts, ``print_files`` the 3MF print jobs written. A
+    board's steps name its taxels as the parts are engraved."""
     from matcad.parts.features import SHEETS, sheet_kerf_mm, sheet_thickness_mm
     from matcad.parts.neck_plate import drill_plan
     from matcad.spec import taxels
@@ -144,9 +144,9 @@ def steps(spec: Spec, caliper: list[dict]) -> list[dict]:
              "scrap)")
     printed = [part for part in wanted(spec, Kind.PRINTED)]
     if printed:
-        step(f"printer ({spec.machine.printer})", [PRINT_FILE.format(printer=spec.machine.printer),
-                                                   *(f"{part.name}.stl" for part in printed)],
-             _print_text(spec, [part.name for part in printed]))
+        jobs = list(print_files) or [PRINT_FILE.format(printer=spec.machine.printer)]
+        step(f"printer ({spec.machine.printer})", [*jobs, *(f"{part.name}.stl" for part in printed)],
+             _print_text(spec, [part.name for part in printed], jobs))
     if o.end_cap_mold:
         step("bench", ["end_cap_mold_base.stl", "end_cap_mold_lid.stl"], "Cast the caps: follow the casting guide")
     if o.needle_mount:
@@ -166,8 +166,8 @@ def steps(spec: Spec, caliper: list[dict]) -> list[dict]:
     return out
 
 
-def _print_text(spec: Spec, names: list[str]) -> str:
-    """The print step: the 3MF with each part's settings, the captive nuts, the STL fallback."""
+def _print_text(spec: Spec, names: list[str], jobs: list[str]) -> str:
+    """The print step: the 3MF job(s) with each part's settings, the captive nuts, the STL fallback."""
     from matcad.parts.mold_layout import layout
     from matcad.parts.print_profile import profile
 
@@ -175,8 +175,8 @@ def _print_text(spec: Spec, names: list[str]) -> str:
     parts = "; ".join(f"{n}: {p.layer_mm:g} mm layers, " + (f"{p.walls} walls, {p.infill_pct:g} % infill"
                                                             if p.walls else "solid")
                       for n in names for p in [profile(printer, n)])
-    text = (f"Open {PRINT_FILE.format(printer=printer)} in the slicer: each part lies on its bed face, with its "
-            f"settings ({parts}; {profile(printer, names[0]).material})")
+    text = (f"Open {' then '.join(jobs)} in the slicer ({'one bed load each' if len(jobs) > 1 else 'one bed'}): "
+            f"each part lies on its bed face, with its settings ({parts}; {profile(printer, names[0]).material})")
     if spec.outputs.end_cap_mold:
         lay = layout(spec)
         c = lay.clamp
@@ -188,8 +188,9 @@ def _print_text(spec: Spec, names: list[str]) -> str:
     return text + ". No supports: the STLs are the same parts in the same poses"
 
 
-def fabrication(spec: Spec, flats: list[Flat]) -> dict:
-    """The report's fabrication section for the laser parts ``flats``: sheets to caliper, the seal, the fits, the
-    ordered steps."""
+def fabrication(spec: Spec, flats: list[Flat], job: dict | None = None) -> dict:
+    """The report's fabrication section for the laser parts ``flats`` and the print ``job`` written (its 3MF
+    files): sheets to caliper, the seal, the fits, the ordered steps."""
     caliper = sheets_to_caliper(flats)
-    return {"caliper": caliper, "seal": seal(spec), "fits": fits(spec, flats), "steps": steps(spec, caliper)}
+    return {"caliper": caliper, "seal": seal(spec), "fits": fits(spec, flats),
+            "steps": steps(spec, caliper, [f["file"] for f in (job or {}).get("files", ())])}

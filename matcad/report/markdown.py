@@ -112,12 +112,12 @@ def _files_to_make_markdown(sheets: list[dict] | None, job: dict | None) -> list
         lines += [f"| {s['thickness_mm']:g} mm | `{s['file']}` | {', '.join(s['parts'])} | {s['kerf_mm']:g} | "
                   f"{s['width_mm']:.1f} × {s['height_mm']:.1f} | {s['pdf_page']['page']} |" for s in sheets]
     if job:
-        lines += ["", f"## Print job (`{job['file']}`)", "",
-                  "| part | settings | material |", "|---|---|---|"]
-        lines += [f"| {o['name']} | {cell(', '.join(f'{k} {v}' for k, v in o['settings'].items()))} | "
-                  f"{cell(o['material'])} |" for o in job["objects"]]
+        lines += ["", f"## Print job ({job['printer']})", "",
+                  "| file | part | settings | material |", "|---|---|---|---|"]
+        lines += [f"| `{f['file']}` | {o['name']} | {cell(', '.join(f'{k} {v}' for k, v in o['settings'].items()))} | "
+                  f"{cell(o['material'])} |" for f in job["files"] for o in f["objects"]]
         lines += [f"- pause after the layer at z = {p['after_layer_z_mm']:.2f} mm ({p['part']}): {p['message']}"
-                  for p in job["pauses"]]
+                  for f in job["files"] for p in f["pauses"]]
     return lines
 
 
