@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from matcad.materials import grade
 from matcad.parts.features import cap_volume_mm3
 from matcad.parts.mold_layout import layout
+from matcad.parts.print_profile import PRINT_FILE
 
 if TYPE_CHECKING:
     from matcad.spec import Spec
@@ -100,8 +101,9 @@ def casting_guide(spec: Spec) -> CastingGuide:
             "printing)" if c.open_below else f"the {len(lay.bolts)} {c.bolt} nuts the base print captured at its pause")
     board = len(taxels(spec)) > 1
     steps = (
-        f"Print the mold ({mold.label}): end_cap_mold_base and end_cap_mold_lid as exported (print.3mf holds them "
-        f"oriented with their settings; or the STLs, flat face down, no supports). Clear every vent with a "
+        f"Print the mold ({mold.label}): end_cap_mold_base and end_cap_mold_lid as exported "
+        f"({PRINT_FILE.format(printer=spec.machine.printer)}, or its _1, _2, ... files when the parts take more "
+        "than one bed, holds them oriented with their settings; or the STLs, flat face down, no supports). Clear every vent with a "
         f"{spec.mold.vent:g} mm drill or pin.",
         *(("SLA: post-cure the printed mold fully, or barrier-coat it, and cast a test drop (cure inhibition, "
            "above).",) if mold.inhibition else ()),

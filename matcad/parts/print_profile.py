@@ -12,6 +12,8 @@ import math
 from dataclasses import dataclass
 
 PRINTERS = ("fdm", "sla")
+PRINT_FILE = "print_{printer}.3mf"
+"""The printer's 3MF print job; ``print_{printer}_1.3mf``, ``_2``, ... when the parts take more than one bed."""
 FDM_MAX_OVERHANG_DEG = 30.0
 """Steepest overhang from vertical that FDM prints without support: PrusaSlicer with automatic supports (its
 default profile, 0.3 mm layers; tests/test_real_clients.py) puts support under the needle mount's bore at θ = 45°

@@ -77,7 +77,7 @@ def _mesh_axes(ax, mesh, elev: float, azim: float, title: str) -> int:
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(np.maximum(hi - lo, 1e-6 * max(hi - lo)))
+    ax.set_box_aspect(np.maximum(hi - lo, 1e-6 * max(hi - lo)), zoom=0.9)  # a long part seen from above stays whole
     ax.view_init(elev=elev, azim=azim)
     ax.set_proj_type("ortho")
     ax.set_title(textwrap.fill(title, 48), fontsize=8)

@@ -16,6 +16,7 @@ from matcad import __version__
 from matcad.acoustics.geometry import drafted_cavity_volume_mm3, drafted_tip_diameter_mm
 from matcad.parts.features import (SHEET_STATUSES, bolt_nominal_mm, cap_volume_mm3, plate_bolt_positions_mm,
                                    plate_dowel_positions_mm, sheet_kerf_mm)
+from matcad.parts.print_profile import PRINT_FILE
 from matcad.parts.stack import bolt_span_mm
 from matcad.report.fabrication import fabrication
 from matcad.report.files import manifest
@@ -177,7 +178,8 @@ def kit_hardware(spec, mold: MoldLayout | None) -> dict:
                              "standard": "ISO 4762", "nuts": len(mold.bolts), "nut_standard": "ISO 4032",
                              "washers": len(mold.bolts),
                              "note": ("captive: press each nut into its hex trap under the base after printing"
-                                      if c.open_below else "captive: the base print (print.3mf) pauses when its "
+                                      if c.open_below else "captive: the base print "
+                                      f"({PRINT_FILE.format(printer='fdm')}) pauses when its "
                                       f"layers reach z = {c.pocket_top_z + mold.base_height:.2f} mm: drop each nut "
                                       "into its pocket, resume")}
         out["release_agent"] = RELEASE_AGENT

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.parts.features import sheet_status
+from matcad.parts.print_profile import PRINT_FILE
 from matcad.parts.registry import Kind, wanted
 from matcad.parts.stack import squeeze_range_mm
 
@@ -91,8 +92,6 @@ def fits(spec: Spec, flats: list[Flat]) -> list[dict]:
 
 SHEET_FILE = "sheet_{sheet}.dxf"
 """Every part cut from one acrylic sheet, nested (:mod:`matcad.export.sheets`)."""
-PRINT_FILE = "print_{printer}.3mf"
-"""Every printed part for one printer, oriented, with its settings (:mod:`matcad.export.threemf`)."""
 SCALE_FILE = "sheets_1to1.pdf"
 """The sheets at 1:1 on paper, to check the scale before cutting (:mod:`matcad.export.pdf`)."""
 
