@@ -131,8 +131,64 @@ def write_printed_part(name: str, solid, spec, folder: Path, pose: str | None = 
 
 
 def _write_laser(plans, folder: Path) -> list[dict]:
-    """DXF + SVG per laser part's cut plan; returns every hole as cut."""
-    return [hole for plan in plans for hole in write_cut_plan(plan, folder)]
+    """DXF + SVG per laser part's cut plan; returns every hole as cut, with the taxel it belongs to and the size it
+    is drilled to (None: finished as cut)."""
+    holes = [hole for plan in plans for hole in write_cut_plan(plan, folder)]
+    extra = [{"taxel": h.taxel, "drill_to_mm": h.drill_to} for plan in plans for _ in range(plan.flat.quantity)
+             for h in plan.flat.holes]
+    return [hole | more for hole, more in zip(holes, extra)]
+
+
+def write_sheets(plans, spec, folder: Path) -> list[dict]:
+    """One nested DXF + SVG per acrylic sheet (:mod:`matcad.export.sheets`) and the 1:1 PDF of them all; returns
+    each sheet's file, parts, kerf, size (mm) and its PDF page."""
+    from matcad.export.pdf import write_scale_pdf
+    from matcad.export.sheets import sheet_plans
+    from matcad.report.fabrication import SCALE_FILE
+
+    sheets = sheet_plans(plans, spec.outputs.reference_square)
+    for plan in sheets.values():
+        write_dxf(plan, folder / f"{plan.flat.name}.dxf")
+        write_svg(plan, folder / f"{plan.flat.name}.svg")
+    pages = write_scale_pdf(list(sheets.values()), folder / SCALE_FILE) if sheets else []
+    return [{"sheet": key, "file": f"{plan.flat.name}.dxf", "parts": list(plan.parts), "thickness_mm":
+             plan.flat.thickness, "kerf_mm": plan.kerf, "width_mm": plan.extents[2] - plan.extents[0],
+             "height_mm": plan.extents[3] - plan.extents[1], "pdf_page": page}
+            for (key, plan), page in zip(sheets.items(), pages)]
+
+
+def write_print_job(spec, folder: Path, meshes: dict) -> dict | None:
+    """The printer's 3MF (:mod:`matcad.export.threemf`) from the printed STLs just written (their print poses),
+    each with its print profile; an FDM mold base with the pause for its captive nuts; one file per bed load.
+    Returns the printer and each file's objects and pauses; None without printed parts."""
+    import trimesh
+
+    from matcad.export.threemf import PrintPart, plates, write_3mf
+    from matcad.parts.print_profile import profile
+    from matcad.report.fabrication import PRINT_FILE
+
+    printer = spec.machine.printer
+    parts = []
+    for stl, checks in meshes.items():
+        if not checks["printed"]:
+            continue
+        name = Path(stl).stem
+        mesh = trimesh.load_mesh(folder / stl, file_type="stl")
+        pause = None
+        if name == "end_cap_mold_base" and printer == "fdm":
+            from matcad.parts.mold_layout import layout
+
+            lay = layout(spec)
+            c = lay.clamp
+            pause = (round(c.pocket_top_z + lay.base_height, 6), f"insert {len(lay.bolts)} {c.bolt} nuts into the "
+                     "mold base's hex pockets")
+        parts.append(PrintPart(name, mesh.vertices, mesh.faces, profile(printer, name), pause))
+    if not parts:
+        return None
+    loads = plates(parts, printer)
+    stems = ([PRINT_FILE.format(printer=printer)] if len(loads) == 1 else
+             [PRINT_FILE.format(printer=f"{printer}_{k}") for k in range(1, len(loads) + 1)])
+    return {"printer": printer, "files": [write_3mf(load, printer, folder / stem) for load, stem in zip(loads, stems)]}
 
 
 def _write_solids(spec, folder: Path) -> dict[str, dict]:
@@ -207,11 +263,13 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
         flats = laser_parts(spec)
         plans = [cut_plan(flat, spec.outputs.reference_square) for flat in flats]
         holes = _write_laser(plans, tmp)
+        sheets = write_sheets(plans, spec, tmp)
         meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
+        job = write_print_job(spec, tmp, meshes) if meshes else None
         figures = render_figures(spec, prediction, tmp, meshes, plans) + [band_chart(bands, tmp / BANDS_PNG)]
         mold = layout(spec) if spec.outputs.end_cap_mold else None
-        report = make_report(spec, prediction, findings, holes, meshes, tmp, flats=flats, mold=mold) | {
-            "figures": figures, "bands": bands}
+        report = make_report(spec, prediction, findings, holes, meshes, tmp, flats=flats, mold=mold, job=job) | {
+            "figures": figures, "bands": bands, "sheets": sheets, "print_job": job}
         if len(board) > 1:
             report["taxels"] = board_report(spec, board, predictions)
         write_report(report, tmp)

@@ -12,7 +12,7 @@ import ezdxf
 import pytest
 
 from matcad import spec as spec_mod
-from matcad.parts.features import needle_axis_mm, pin_hole_diameter_mm
+from matcad.parts.features import needle_axis_mm, pin_hole_diameter_mm, sheet_kerf_mm
 from matcad.parts.guide import BODY_CLEARANCE_MM
 from matcad.parts.mold_layout import layout, mold_slots, pours_per_board
 from matcad.rules import board as board_rules
@@ -160,7 +160,7 @@ def laser_build(tmp_path_factory, spec):
 def test_four_necks_read_back_from_the_dxf_at_their_positions(laser_build):
     spec, out = laser_build
     circles = _inner_circles(out / "neck_plate.dxf")
-    kerf = spec.machine.laser_kerf
+    kerf = sheet_kerf_mm(spec, "plate")  # the template's own kerf for the plate sheet
     cx, cy = _read_centre(out / "neck_plate.dxf")
     for t in taxels(spec):  # pilots, drawn (finished - kerf)
         drawn = _at(circles, cx + t.x, cy + t.y)
@@ -184,7 +184,7 @@ def test_guides_have_each_caps_hole_at_its_position(laser_build, role):
     cx, cy = _read_centre(path)
     for t in taxels(spec):
         want = cap_flange_diameter_mm(t) if role == "locator" else t.end_cap.outer_diameter + BODY_CLEARANCE_MM
-        assert _at(circles, cx + t.x, cy + t.y) == pytest.approx(want - spec.machine.laser_kerf, abs=1e-6)
+        assert _at(circles, cx + t.x, cy + t.y) == pytest.approx(want - sheet_kerf_mm(spec, "guide"), abs=1e-6)
 
 
 def test_report_lists_every_taxel_and_its_needle(laser_build):

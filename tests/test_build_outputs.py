@@ -2,6 +2,7 @@
 
 import hashlib
 import json
+import math
 import re
 import xml.etree.ElementTree as ET
 
@@ -196,11 +197,24 @@ def test_mold_lid_exported_pins_up_with_its_outer_face_on_the_bed(built):
     mesh = trimesh.load_mesh(out / "end_cap_mold_lid.stl")
     # the lid plate (lid_thickness) is at the bottom, the core pins (cavity length) stand above it
     assert mesh.bounds[1, 2] == pytest.approx(spec.mold.lid_thickness + spec.cavity.length, abs=1e-6)
-    vents = len(lay.vents) + len(lay.pin_vents)
+    vents = len(lay.vents)  # the ring vents over the base faces; no vent runs through a core pin
     holes = (len(lay.fill_ports) * spec.mold.fill_port ** 2 + vents * spec.mold.vent ** 2
              + len(lay.bolts) * bolt_clearance_mm(spec.mold.bolt, "normal") ** 2) * np.pi / 4
+    labels = sum(_glyph_area(t) for t in end_cap_mold.lid_labels(spec))  # a board's taxel names recessed in it
     bed = _horizontal_groups(mesh)[(-1, 0.0)]
-    assert bed == pytest.approx(lay.block_x * lay.block_y - holes, rel=2e-3)
+    assert bed == pytest.approx(lay.block_x * lay.block_y - holes - labels, rel=2e-3)
+    assert bool(labels) == (len(taxels(spec)) > 1)
+
+
+def _glyph_area(engraving) -> float:
+    """Area of an engraving's glyphs, holes (the inside of a 4 or an o) left out (mm²)."""
+    from matcad.parts.flat import engraving_outlines, even_odd_faces
+
+    def area(loop):
+        return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(loop, loop[1:] + loop[:1]))) / 2
+
+    return sum(area(outer) - sum(area(h) for h in inner)
+               for outer, inner in even_odd_faces(engraving_outlines(engraving)))
 
 
 def test_seal_squeeze_read_back_from_the_cast_cap(built):
@@ -231,3 +245,312 @@ def test_kit_archive_holds_every_file_byte_for_byte(built):
         assert names == {p.name for p in out.iterdir()} - {KIT_ARCHIVE, MANIFEST}
         for name in names:
             assert archive.read(name) == (out / name).read_bytes(), name
+
+
+LAYER_ORDER = ["ENGRAVE", "CUT_INNER", "CUT_OUTER", "REFERENCE"]
+
+
+def test_one_nested_file_per_sheet_cut_inner_before_outer(built):
+    """Each acrylic sheet's DXF and SVG hold every part cut from it (its quantity), side by side without overlap,
+    each hole inside its part, at that sheet's own kerf; entities in cutting order: engraving, inner cuts, outlines."""
+    spec, out, _ = built
+    report = json.loads((out / "report.json").read_text())
+    by_sheet = {}
+    for flat in laser_parts(spec):
+        by_sheet.setdefault(flat.sheet, []).append(flat)
+    assert sorted(s["sheet"] for s in report["sheets"]) == sorted(by_sheet)
+    for s in report["sheets"]:
+        flats = by_sheet[s["sheet"]]
+        assert s["file"] == f"sheet_{s['sheet']}.dxf" and sorted(s["parts"]) == sorted(f.name for f in flats)
+        assert {f.kerf for f in flats} == {s["kerf_mm"]}
+        msp = ezdxf.readfile(out / s["file"]).modelspace()
+        layers = [e.dxf.layer for e in msp]
+        assert layers == sorted(layers, key=LAYER_ORDER.index), "cut order: engrave, inner, outer"
+        outlines = [e for e in msp if e.dxf.layer == "CUT_OUTER"]
+        boxes = []
+        for e in outlines:
+            pts = np.array([p[:2] for p in e.get_points("xy")])
+            boxes.append((*pts.min(axis=0), *pts.max(axis=0)))
+        assert len(boxes) == sum(f.quantity for f in flats)
+        sizes = sorted((round(b[2] - b[0], 6), round(b[3] - b[1], 6)) for b in boxes)
+        assert sizes == sorted((round(f.width + f.kerf, 6), round(f.depth + f.kerf, 6)) for f in flats
+                               for _ in range(f.quantity))
+        for i, a in enumerate(boxes):  # no two parts overlap: separated along x or y
+            for b in boxes[i + 1:]:
+                assert a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1], (a, b)
+        circles = msp.query("CIRCLE[layer=='CUT_INNER']")
+        assert sorted(round(2 * c.dxf.radius, 6) for c in circles) == sorted(
+            round(h.diameter - f.kerf, 6) for f in flats for h in f.holes for _ in range(f.quantity))
+        for c in circles:
+            x, y, r = c.dxf.center.x, c.dxf.center.y, c.dxf.radius
+            assert any(b[0] < x - r and x + r < b[2] and b[1] < y - r and y + r < b[3] for b in boxes)
+        engraved = sum(len(f.engrave) for f in flats for _ in range(f.quantity))
+        assert bool(msp.query("LWPOLYLINE[layer=='ENGRAVE']")) == (engraved > 0)
+        root = ET.parse(out / s["file"].replace(".dxf", ".svg")).getroot()
+        groups = [g.get("id") for g in root.iter("{http://www.w3.org/2000/svg}g") if g.get("id") in LAYER_ORDER]
+        assert groups == sorted(groups, key=LAYER_ORDER.index) and "CUT_OUTER" in groups
+
+
+def test_sheets_pdf_prints_every_sheet_at_one_to_one(built, tmp_path):
+    """sheets_1to1.pdf read back with poppler: one page per sheet at its stated paper size; rendered at 254 dpi
+    (10 px/mm, no anti-aliasing) its reference square measures 10 mm and every part outline its kerf-compensated
+    size."""
+    import shutil
+    import subprocess
+
+    from PIL import Image
+    from scipy import ndimage
+
+    if not shutil.which("pdftoppm"):
+        pytest.skip("poppler-utils not installed (.ci/run installs it)")
+    spec, out, _ = built
+    report = json.loads((out / "report.json").read_text())
+    pdf = out / "sheets_1to1.pdf"
+    info = subprocess.run(["pdfinfo", "-l", "99", pdf], capture_output=True, text=True, check=True).stdout
+    sizes = [tuple(float(v) for v in m) for m in re.findall(r"Page\s+\d+ size:\s+([\d.]+) x ([\d.]+) pts", info)]
+    assert len(sizes) == len(report["sheets"])
+    text = subprocess.run(["pdftotext", "-layout", pdf, "-"], capture_output=True, text=True, check=True).stdout
+    assert "Print at 100 %" in text
+    flats = {f.name: f for f in laser_parts(spec)}
+    for k, (s, (w_pt, h_pt)) in enumerate(zip(report["sheets"], sizes), start=1):
+        page = s["pdf_page"]
+        assert (w_pt / 72 * 25.4, h_pt / 72 * 25.4) == pytest.approx((page["width_mm"], page["height_mm"]), abs=0.1)
+        stem = tmp_path / f"p{k}"
+        subprocess.run(["pdftoppm", "-r", "254", "-aa", "no", "-aaVector", "no", "-png", "-f", str(k), "-l", str(k),
+                        "-singlefile", pdf, stem], check=True)
+        rgb = np.asarray(Image.open(f"{stem}.png").convert("RGB")).astype(int)
+        r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+
+        def boxes(mask):
+            labels, n = ndimage.label(mask, structure=np.ones((3, 3)))
+            return [(sl[1].stop - sl[1].start, sl[0].stop - sl[0].start) for sl in ndimage.find_objects(labels)]
+
+        magenta = boxes((r > 200) & (g < 80) & (b > 200))
+        square = max(magenta, key=lambda wh: wh[0] * wh[1])
+        assert square[0] == pytest.approx(100, abs=2) and square[1] == pytest.approx(100, abs=2), square  # 10 mm
+        red = sorted(boxes((r > 200) & (g < 80) & (b < 80)), key=lambda wh: -wh[0] * wh[1])
+        want = sorted(((flats[n].width + flats[n].kerf) * 10, (flats[n].depth + flats[n].kerf) * 10)
+                      for n in s["parts"] for _ in range(flats[n].quantity))
+        got = sorted(red[:len(want)])
+        assert len(got) == len(want)
+        for (gw, gh), (ww, wh) in zip(got, want):
+            assert (gw, gh) == pytest.approx((ww, wh), abs=3), (got, want)
+        print(spec.name, s["sheet"], "square px", square, "outlines px", sorted(red[:len(want)]))
+
+
+def test_print_job_3mf_read_back(built):
+    """The 3MF print job(s) read back by trimesh's 3MF reader: every printed STL once, the same volume, flat on the
+    bed (z from 0) inside the printer's bed, footprints apart; each object's slicer settings are its print
+    profile's; an FDM mold base carries its nut pause at a layer boundary above the pockets."""
+    import zipfile
+
+    from matcad.export.threemf import BED_MM
+    from matcad.parts.print_profile import profile
+
+    spec, out, _ = built
+    report = json.loads((out / "report.json").read_text())
+    stls = sorted(p.stem for p in out.glob("*.stl") if p.stem != "end_cap")  # the cast cap is not printed
+    job = report["print_job"]
+    if not stls:
+        assert job is None and not list(out.glob("*.3mf"))
+        return
+    printer = spec.machine.printer
+    assert job["printer"] == printer
+    seen = []
+    for f in job["files"]:
+        scene = trimesh.load(out / f["file"])
+        boxes = []
+        for node in scene.graph.nodes_geometry:
+            transform, name = scene.graph[node]
+            mesh = scene.geometry[name].copy()
+            mesh.apply_transform(transform)
+            seen.append(name)
+            assert mesh.volume == pytest.approx(trimesh.load_mesh(out / f"{name}.stl").volume, rel=1e-6)
+            lo, hi = mesh.bounds
+            assert lo[2] == pytest.approx(0.0, abs=1e-6)
+            assert lo[0] >= 0 and lo[1] >= 0 and hi[0] <= BED_MM[printer][0] and hi[1] <= BED_MM[printer][1]
+            boxes.append((lo[0], lo[1], hi[0], hi[1]))
+        for i, a in enumerate(boxes):
+            for b in boxes[i + 1:]:
+                assert a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1], (a, b)
+        with zipfile.ZipFile(out / f["file"]) as z:
+            config = ET.fromstring(z.read("Metadata/Slic3r_PE_model.config"))
+            pauses = (ET.fromstring(z.read("Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml"))
+                      if "Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml" in z.namelist() else None)
+        for obj in config.iter("object"):
+            meta = {m.get("key"): m.get("value") for m in obj.iter("metadata") if m.get("type") == "object"}
+            p = profile(printer, meta["name"])
+            assert float(meta["layer_height"]) == p.layer_mm
+            if printer == "fdm":
+                assert int(meta["perimeters"]) == p.walls
+                assert meta["fill_density"] == f"{p.infill_pct:g}%"
+        codes = [] if pauses is None else [c for c in pauses.iter("code")]
+        want = [o for o in f["pauses"]]
+        assert len(codes) == len(want)
+        for code, pause in zip(codes, want):
+            assert code.get("gcode") == "M601" and "nut" in code.get("extra")
+            p = profile(printer, pause["part"])
+            layers = (pause["after_layer_z_mm"] - p.first_layer_mm) / p.layer_mm  # a whole number of layers
+            assert layers == pytest.approx(round(layers), abs=1e-6)
+            assert float(code.get("print_z")) == pytest.approx(pause["after_layer_z_mm"] + p.layer_mm / 2)
+    assert sorted(seen) == stls
+    if spec.outputs.end_cap_mold:
+        c = end_cap_mold_layout(spec).clamp
+        assert bool(c.pause_print_z) == (printer == "fdm") and (not c.open_below) == (printer == "fdm")
+
+
+def end_cap_mold_layout(spec):
+    from matcad.parts.end_cap_mold import layout
+
+    return layout(spec)
+
+
+def _engraved_boxes(msp):
+    """Bounding boxes of the ENGRAVE layer's glyph loops, grouped into labels (loops within 0.6 mm) (mm)."""
+    loops = []
+    for e in msp.query("LWPOLYLINE[layer=='ENGRAVE']"):
+        pts = np.array([p[:2] for p in e.get_points("xy")])
+        loops.append([*pts.min(axis=0), *pts.max(axis=0)])
+    labels = []
+    for box in sorted(loops):
+        for lab in labels:
+            if box[0] <= lab[2] + 0.6 and lab[0] <= box[2] + 0.6 and box[1] <= lab[3] + 0.6 and lab[1] <= box[3] + 0.6:
+                lab[:] = [min(lab[0], box[0]), min(lab[1], box[1]), max(lab[2], box[2]), max(lab[3], box[3])]
+                break
+        else:
+            labels.append(list(box))
+    return labels
+
+
+def test_board_drilling_by_taxel_in_files_steps_and_bom(built):
+    """A board's neck pilots: each neck hole in the DXF has an engraved label beside it, nearer its own neck than
+    any other and clear of every hole; the drill step gives each taxel's pilot and finished size; the BOM one drill
+    per finished size, naming its taxels (mat-array-4: 2.1 / 2.6 / 2.7 / 2.4 mm, not one 2.1 mm for all)."""
+    from matcad.parts.neck_plate import drill_plan, neck_plate
+
+    spec, out, _ = built
+    board = taxels(spec)
+    report = json.loads((out / "report.json").read_text())
+    plan = drill_plan(spec)
+    drill = [s for s in report["fabrication"]["steps"] if s["where"] == "drill"]
+    if not plan:
+        assert not drill
+        return
+    text = drill[0]["do"]
+    for row in plan:
+        t = next(t for t in board if t.name == row["taxel"])
+        assert row["drill_mm"] == t.neck.diameter
+        if len(board) > 1:
+            assert f"{row['taxel']} {row['pilot_mm']:g} → {row['drill_mm']:g} mm" in text, text
+    sizes = {}
+    for row in plan:
+        sizes.setdefault(row["drill_mm"], []).append(row["taxel"])
+    assert sorted((d["diameter_mm"], d["taxels"]) for d in report["bom"]["drills"]) == sorted(sizes.items())
+    if len(board) < 2:
+        return
+    msp = ezdxf.readfile(out / "neck_plate.dxf").modelspace()
+    necks = [(t.name, t.x, t.y) for t in board]
+    holes = [(c.dxf.center.x, c.dxf.center.y, c.dxf.radius) for c in msp.query("CIRCLE")]
+    labels = _engraved_boxes(msp)
+    flat = neck_plate(spec)
+    for e in flat.engrave:
+        if not e.text.startswith(tuple(f"{t.name} " for t in board)):
+            continue
+        name = e.text.split()[0]
+        assert e.text == f"{name} Ø{next(t for t in board if t.name == name).neck.diameter:g}"
+        box = next(b for b in labels if b[0] <= e.x + 0.3 and b[2] >= e.x and b[1] <= e.y + e.height
+                   and b[3] >= e.y)  # the glyphs drawn at this engraving's baseline
+        cx, cy = (box[0] + box[2]) / 2, (box[1] + box[3]) / 2
+        assert min(necks, key=lambda n: math.hypot(n[1] - cx, n[2] - cy))[0] == name
+        for x, y, r in holes:  # the glyphs keep clear of every hole
+            nx, ny = min(max(x, box[0]), box[2]), min(max(y, box[1]), box[3])
+            assert math.hypot(nx - x, ny - y) > r, (e.text, (x, y, r))
+    assert sum(e.text.split()[0] in {t.name for t in board} for e in flat.engrave) == len(board)
+
+
+def test_bom_agrees_with_the_casting_guide_and_stock(built):
+    """Silicone in the BOM is the casting guide's (one source); the needle line has a count (one per taxel);
+    bolts and dowels are stock lengths no shorter than the stack needs."""
+    from matcad.parts.features import ISO_4762_LENGTHS_MM
+
+    spec, out, _ = built
+    report = json.loads((out / "report.json").read_text())
+    bom, casting = report["bom"], report["casting"]
+    if casting:
+        assert bom["silicone"]["needed_mass_g"] == pytest.approx(casting["needed_g"], abs=1e-9)
+        assert f"{casting['needed_g']:.2f} g" in (out / "report.md").read_text()
+        assert bom["mold_clamp"]["length_mm"] in ISO_4762_LENGTHS_MM
+    if "needle" in bom:
+        assert bom["needle"]["count"] == len(taxels(spec))
+    for key in ("bolts", "dowels"):
+        if key in bom:
+            assert bom[key]["length_mm"] >= bom[key]["min_length_mm"]
+            assert bom[key]["length_mm"] == int(bom[key]["length_mm"])  # a stock length, not "≥ 15.04 mm"
+
+
+def test_templates_claim_no_measurement_and_the_seal_warns(built):
+    """No template calls a sheet measured without flagging it an example: the squeeze rule reports the guide as
+    unverified (a warning with the nominal sheet's range, read back from the cast cap) and step 1 lists it among
+    the sheets still to caliper."""
+    spec, out, _ = built
+    report = json.loads((out / "report.json").read_text())
+    for section in (spec.plate, spec.guide, spec.spacer):
+        assert not section.thickness_measured or section.thickness_example
+    assert {spec.plate.laser_kerf, spec.guide.laser_kerf} != {None}  # per-sheet kerfs in the template
+    seal = [f for f in report["findings"] if f["id"] == "seal.squeeze"]
+    assert seal and all(f["level"] == "warning" for f in seal)
+    s = report["fabrication"]["seal"]
+    lo, hi = (s["unverified_low_mm"], s["unverified_high_mm"]) if s["guide_status"] == "example" else (
+        s["squeeze_low_mm"], s["squeeze_high_mm"])
+    assert (lo, hi) == pytest.approx((-0.45, 0.65), abs=1e-6)
+    value = seal[0]["value"]  # the range when the sheet is an example, its low end when nominal
+    assert (value if isinstance(value, list) else [value, hi]) == pytest.approx([lo, hi], abs=0.01)
+    first = report["fabrication"]["steps"][0]["do"]
+    assert f"{spec.guide.thickness:g} mm ({s['guide_status']})" in first
+
+
+def test_step_names_every_spacer(built):
+    spec, out, _ = built
+    if not (out / "assembly.step").exists():
+        return
+    text = (out / "assembly.step").read_text(errors="replace")
+    spacers = sorted(set(re.findall(r"'(spacer_\d+)'", text)))
+    if spec.outputs.spacers and spec.spacer.style == "laser":
+        assert spacers == [f"spacer_{i}" for i in range(1, len(spacers) + 1)] and len(spacers) >= 2
+
+
+def _runs(row) -> int:
+    """Separate stretches of True along a row of pixels, gaps of 3 px or more apart."""
+    idx = np.flatnonzero(row)
+    return 0 if not len(idx) else 1 + int(np.sum(np.diff(idx) > 3))
+
+
+def test_previews_show_bores_cavities_and_pockets(built):
+    """The pictures read back: the second view of the needle mount (a section through a needle's plane) is cut
+    in two by its bore, the cap's (a section through its axis) by its cavity, at mid-height; the mold base seen
+    from above shows a drawn rim per pocket and key inside its outline (flat shading alone gave a rectangle, a
+    disc and a block with key holes)."""
+    from PIL import Image
+    from scipy import ndimage
+
+    from matcad.render.previews import BASE_RGB, EDGE_RGB
+
+    spec, out, _ = built
+    for name, want in (("needle_mount", "split"), ("end_cap", "split"), ("end_cap_mold_base", "rims")):
+        path = out / f"preview_{name}.png"
+        if not (out / f"{name}.stl").exists():
+            assert not path.exists()
+            continue
+        rgb = np.asarray(Image.open(path).convert("RGB"), dtype=float) / 255
+        right = rgb[:, rgb.shape[1] // 2:]
+        fill = np.all(np.abs(right - BASE_RGB) < 0.12, axis=-1)
+        rows = np.flatnonzero(fill.any(axis=1))
+        if want == "split":
+            mid = fill[(rows[0] + rows[-1]) // 2]
+            assert _runs(mid) >= 2, (name, _runs(mid))
+        else:
+            edge = np.all(np.abs(right - EDGE_RGB) < 0.25, axis=-1)
+            cols = np.flatnonzero(fill.any(axis=0))
+            inner = edge[rows[0] + 4:rows[-1] - 4, cols[0] + 4:cols[-1] - 4]
+            _, n = ndimage.label(inner, structure=np.ones((3, 3)))
+            assert n >= len(end_cap_mold_layout(spec).cap_x) + 2, (name, n)

@@ -20,12 +20,16 @@ KERFS = {"plate": 0.27, "guide": 0.14, "spacer": 0.16}
 
 @pytest.fixture(scope="module")
 def coupons(tmp_path_factory):
+    import tomllib
+
+    import tomli_w
+
     root = tmp_path_factory.mktemp("coupon")
-    text = PAPER.read_text()
-    for section, kerf in KERFS.items():
-        text = text.replace(f"[{section}]\n", f"[{section}]\nlaser_kerf = {kerf}\n", 1)
+    data = tomllib.loads(PAPER.read_text())
+    for section, kerf in KERFS.items():  # the template's own per-sheet kerfs replaced by these
+        data.setdefault(section, {})["laser_kerf"] = kerf
     path = root / "spec.toml"
-    path.write_text(text)
+    path.write_text(tomli_w.dumps(data))
     code, _, err = run_cli("coupon", path, "--out", root / "c", "--json")
     assert code == 0, err
     return spec_mod.load(path), root / "c"

@@ -34,19 +34,34 @@ def _design_frame(out, report, name):
 
 
 def test_key_clearance_measured_at_the_parting_plane(kit):
-    spec, out, report, fits = kit
-    from matcad.parts.end_cap_mold import layout
+    """The lid's socket read back at the parting plane: three crush ribs touch the key line-to-line (the nearest
+    socket wall in each rib's direction is the key's radius: lid play 0, where a plain socket let the lid shift
+    ±machine.key_clearance), the socket between them the key grown by machine.key_clearance."""
+    import math
 
+    from matcad.parts.end_cap_mold import RIB_ANGLES_DEG, layout
+
+    spec, out, report, fits = kit
     base, lid = (_design_frame(out, report, f"end_cap_mold_{p}.stl") for p in ("base", "lid"))
     x, y = layout(spec).keys[0]
     z = 1e-3
     key = nearest_circle(section_circles(base, z), x, y)
-    socket = nearest_circle(section_circles(lid, z), x, y)
-    measured = 2 * (socket[2] - key[2])
+    section = lid.section(plane_origin=[0.0, 0.0, z], plane_normal=[0.0, 0.0, 1.0])
+    loops = [np.asarray(loop)[:, :2] for loop in section.discrete]
+    socket = min(loops, key=lambda p: np.hypot(*(p.mean(axis=0) - [x, y])))
+    d = np.hypot(socket[:, 0] - x, socket[:, 1] - y)
+    angle = np.degrees(np.arctan2(socket[:, 1] - y, socket[:, 0] - x)) % 360
     claim = fits["key"]
-    assert measured == pytest.approx(claim["clearance_mm"], abs=2e-3)
     assert 2 * key[2] == pytest.approx(claim["pin_mm"], abs=2e-3)
-    assert measured == pytest.approx(2 * spec.machine.key_clearance, abs=2e-3)
+    assert d.max() == pytest.approx(claim["socket_mm"] / 2, abs=2e-3)
+    assert claim["socket_mm"] == pytest.approx(claim["pin_mm"] + 2 * spec.machine.key_clearance, abs=1e-9)
+    for a in RIB_ANGLES_DEG:  # each rib's face is the key's own surface
+        near = np.abs((angle - a + 180) % 360 - 180) < 5
+        assert near.any() and d[near].min() == pytest.approx(key[2], abs=2e-3), (a, d[near].min(), key[2])
+    play = 2 * (d[np.abs((angle[:, None] - np.array(RIB_ANGLES_DEG) + 180) % 360 - 180).min(axis=1) < 5].min()
+                - key[2])
+    assert play == pytest.approx(claim["clearance_mm"], abs=4e-3) and claim["clearance_mm"] == 0.0
+    assert math.isfinite(play)
 
 
 def test_flange_in_locator_measured_from_dxf_and_cap(kit):

@@ -57,8 +57,22 @@ def _grid_points(component, step):
     return np.column_stack([p[inside], np.full(inside.sum(), z)])
 
 
+def _rim_points(component, step):
+    """Points every ``step`` mm along the boundary of a ceiling component (edges owned by one face) (mm)."""
+    edges = component.edges_sorted
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    rim = unique[counts == 1]
+    pts = []
+    for a, b in component.vertices[rim]:
+        n = max(2, int(np.ceil(np.linalg.norm(b - a) / step)) + 1)
+        pts.append(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a))
+    return np.vstack(pts)
+
+
 def measured_reaches(spec, out, report):
-    """Farthest distance (mm) from a ceiling point to an opening, per ceiling (per cap: base face, pin end)."""
+    """Farthest distance (mm) from a ceiling point to an escape, per ceiling (per cap: base face, pin end). The
+    base face escapes through the lid's openings above it; the core pin's end face has none (a channel through
+    the pin would cast a thread inside the cavity): its escape is its rim, where the pin's side rises."""
     from matcad.parts.end_cap_mold import layout
 
     lid = _design_frame(out, report, "end_cap_mold_lid.stl")
@@ -74,9 +88,14 @@ def measured_reaches(spec, out, report):
             rays = pts + [0, 0, 1e-3]
             blocked = lid.ray.intersects_any(rays, np.tile([0.0, 0.0, 1.0], (len(rays), 1)))
             opened = pts[~blocked]
-            assert len(opened), f"a ceiling at z = {pts[0, 2]:.2f} with no opening above it"
-            gap, _ = cKDTree(opened[:, :2]).query(pts[blocked][:, :2]) if blocked.any() else (np.zeros(1), None)
-            reaches.append((round(float(pts[0, 2]), 3), float(gap.max())))
+            z = round(float(pts[0, 2]), 3)
+            if z < -1e-6:  # the pin's end face: solid pin above every point of it, escape at its rim
+                assert not len(opened), f"{len(opened)} points of the pin end face see an opening through the pin"
+                gap, _ = cKDTree(_rim_points(component, SAMPLE_MM / 4)[:, :2]).query(pts[:, :2])
+            else:
+                assert len(opened), f"a ceiling at z = {z:.2f} with no opening above it"
+                gap, _ = cKDTree(opened[:, :2]).query(pts[blocked][:, :2]) if blocked.any() else (np.zeros(1), None)
+            reaches.append((z, float(gap.max())))
     return reaches
 
 
@@ -104,3 +123,54 @@ def test_pour_guide_in_the_report(built):
         assert "SLA cure inhibition" in md and "PLA" not in md
     else:
         assert "PLA" in md and "inhibition" not in md
+
+
+def test_nothing_is_cast_inside_any_cavity(built):
+    """The cavity (the acoustic volume) read back from the lid STL: a 0.2 mm grid filling each core pin's footprint
+    over its length lies inside the lid's solid, so no silicone can be cast there (a vent through the pin cast a
+    Ø1 × 7.8 mm thread, 3.7 mm³, before); the rule reports the same 0 mm³."""
+    from matcad.parts.end_cap_mold import layout
+    from matcad.parts.mold_layout import pin_tip_radius_mm
+
+    spec, out, report = built
+    lid = _design_frame(out, report, "end_cap_mold_lid.stl")
+    step, r = 0.2, pin_tip_radius_mm(spec) - 0.05  # the drafted pin is narrowest at its tip
+    g = np.arange(-r, r + 1e-9, step)
+    xs, ys, zs = np.meshgrid(g, g, np.arange(-spec.cavity.length + 0.05, -0.05, step))
+    keep = np.hypot(xs, ys).ravel() <= r
+    grid = np.column_stack([xs.ravel(), ys.ravel(), zs.ravel()])[keep]
+    for x in layout(spec).cap_x:
+        outside = ~lid.contains(grid + [x, 0.0, 0.0])
+        silicone = outside.sum() * step ** 3
+        print(spec.name, f"cap at x = {x:.2f}: {len(grid)} points in the cavity, {silicone:.3f} mm³ castable")
+        assert silicone == 0.0
+    rule = next(f for f in report["findings"] if f["id"] == "mold.cavity_appendage")
+    assert rule["level"] == "info" and rule["value"] == 0.0
+
+
+def test_the_cavity_check_sees_a_vent_through_the_core_pin(monkeypatch):
+    """Deliberate fault: the old vent along each core pin's axis (Ø mold.vent from the lid's top down to the pin's
+    end) put back into the layout the lid is cut from. The lid loses that channel's volume, and the
+    cavity-appendage rule turns it into an error measuring the thread it would cast inside the cavity
+    (π/4 · 1² · 4.76 = 3.74 mm³ for the paper's taxel)."""
+    from matcad.parts import end_cap_mold
+    from matcad.parts.mold_layout import MoldLayout, Opening
+    from matcad.rules import check
+    from tests.conftest import PAPER
+
+    spec = spec_mod.load(PAPER)
+    clean = end_cap_mold.mold_lid(spec).volume
+    assert [f.level for f in check(spec) if f.id == "mold.cavity_appendage"] == ["info"]
+    honest = MoldLayout.openings.fget
+
+    def with_pin_vent(self):
+        return honest(self) + tuple(Opening(x, 0.0, self.vent, -spec.cavity.length, self.lid_thickness, "vent")
+                                    for x in self.cap_x)
+
+    monkeypatch.setattr(MoldLayout, "openings", property(with_pin_vent))
+    thread = math.pi / 4 * spec.mold.vent ** 2 * spec.cavity.length
+    lost = clean - end_cap_mold.mold_lid(spec).volume
+    assert lost == pytest.approx(math.pi / 4 * spec.mold.vent ** 2 * (spec.cavity.length + spec.mold.lid_thickness),
+                                 rel=1e-3)
+    found = [f for f in check(spec) if f.id == "mold.cavity_appendage"]
+    assert [f.level for f in found] == ["error"] and found[0].value == pytest.approx(thread, rel=1e-3)

@@ -176,3 +176,39 @@ def test_librecad_renders_every_dxf_at_one_to_one(builds, tmp_path):
             assert height == pytest.approx(y1 - y0, abs=0.3), flat.name
             checked += 1
     assert checked >= 10  # every laser part of every template, and the coupon
+
+
+def test_prusa_slicer_slices_every_print_job_with_its_pause(builds, tmp_path):
+    """PrusaSlicer opens each FDM 3MF job as written (no options: the job's own per-object settings) and slices it;
+    the G-code pauses (M601) once per pause the report lists, after the part's layer at the stated height and
+    before its next layer (print_fdm.3mf of mat-paper: after z = 4.40 mm, at the job's z = 4.50 mm layer)."""
+    import json
+
+    from matcad.parts.print_profile import profile
+
+    need("prusa-slicer")
+    jobs = 0
+    for spec, folder in builds:
+        if spec is None or not (folder / "report.json").exists():
+            continue
+        job = json.loads((folder / "report.json").read_text())["print_job"]
+        if not job or job["printer"] != "fdm":
+            continue
+        for f in job["files"]:
+            gcode = tmp_path / f"{spec.name}_{f['file']}.gcode"
+            proc = subprocess.run(["prusa-slicer", "--export-gcode", "--output", str(gcode), str(folder / f["file"])],
+                                  capture_output=True, text=True, timeout=900)
+            assert proc.returncode == 0, (f["file"], proc.stdout[-500:], proc.stderr[-500:])
+            lines = gcode.read_text().splitlines()
+            stops = [i for i, line in enumerate(lines) if line.strip() == "M601"]
+            assert len(stops) == len(f["pauses"]), (f["file"], len(stops))
+            for i, pause in zip(stops, f["pauses"]):
+                z = float(next(line[3:] for line in reversed(lines[:i]) if line.startswith(";Z:")))
+                layer = profile("fdm", pause["part"]).layer_mm
+                assert pause["after_layer_z_mm"] <= z + 1e-6 < pause["after_layer_z_mm"] + layer, (z, pause)
+            jobs += 1
+    if not any(spec is not None and spec.machine.printer == "fdm" and (spec.outputs.end_cap_mold
+                                                                       or spec.outputs.needle_mount)
+               for spec, _ in builds):
+        pytest.skip("no template prints on FDM")
+    assert jobs

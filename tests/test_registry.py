@@ -145,7 +145,12 @@ def test_a_printed_only_part_loads_the_kernel_without_other_edits(extra_part, tm
     report = json.loads((result.out_dir / "report.json").read_text())
     assert report["meshes"]["test_block.stl"]["bed_face"] == "flat underside"
     printing = [s for s in report["fabrication"]["steps"] if s["where"].startswith("printer")]
-    assert printing and printing[0]["files"] == ["test_block.stl"]
+    assert printing and printing[0]["files"] == ["print_fdm.3mf", "test_block.stl"]
+    import zipfile  # the print job carries the new part too, with the default profile
+
+    with zipfile.ZipFile(result.out_dir / "print_fdm.3mf") as job:
+        assert 'name="test_block"' in job.read("3D/3dmodel.model").decode()
+        assert 'key="perimeters" value="3"' in job.read("Metadata/Slic3r_PE_model.config").decode()
 
 
 @pytest.fixture(scope="module")

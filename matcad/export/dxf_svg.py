@@ -1,8 +1,9 @@
 """DXF and SVG writers for laser cut plans. Units mm everywhere; one layer / colour per operation.
 
 DXF: $INSUNITS = 4 (mm), native CIRCLE, closed LWPOLYLINE outlines with bulge arcs (no splines), layers
-CUT_INNER, CUT_OUTER, ENGRAVE (text as closed glyph outlines, never font text), REFERENCE with distinct ACI
-colours; inner cuts are written first so a laser that follows file order cuts holes before freeing the part.
+ENGRAVE (text as closed glyph outlines, never font text), CUT_INNER, CUT_OUTER, REFERENCE with distinct ACI
+colours, written in that order so a laser that follows file order engraves and cuts every hole (of every part on a
+nested sheet) before it frees any part.
 SVG: width/height in mm with a matching viewBox (1 user unit = 1 mm), one stroke colour per operation — for
 Glowforge-class lasers that read SVG, not DXF.
 """
@@ -16,10 +17,10 @@ from xml.sax.saxutils import escape
 from matcad.parts.flat import CutPlan, engraving_outlines
 
 LAYERS = {
-    # name: (DXF ACI colour, SVG stroke, meaning)
-    "CUT_INNER": (5, "#0000ff", "cut through, inner features (holes) first"),
+    # name: (DXF ACI colour, SVG stroke, meaning), in cutting order
+    "ENGRAVE": (3, "#00a000", "engrave/score first, do not cut through"),
+    "CUT_INNER": (5, "#0000ff", "cut through, inner features (holes) before any outline"),
     "CUT_OUTER": (1, "#ff0000", "cut through, part outlines last"),
-    "ENGRAVE": (3, "#00a000", "engrave/score, do not cut through"),
     "REFERENCE": (6, "#ff00ff", "10 mm reference square to check scale on import; do not cut"),
 }
 QUARTER_BULGE = math.tan(math.pi / 8)  # bulge of a 90° arc
@@ -57,11 +58,11 @@ def _write_dxf(plan: CutPlan, path: Path) -> None:
     for name, (aci, _, meaning) in LAYERS.items():
         doc.layers.add(name, color=aci).description = meaning
     msp = doc.modelspace()
-    for c in plan.circles:
-        msp.add_circle((c.x, c.y), c.diameter / 2, dxfattribs={"layer": "CUT_INNER"})
     for t in plan.texts:
         for outline in engraving_outlines(t):
             msp.add_lwpolyline(outline, format="xy", close=True, dxfattribs={"layer": "ENGRAVE"})
+    for c in plan.circles:
+        msp.add_circle((c.x, c.y), c.diameter / 2, dxfattribs={"layer": "CUT_INNER"})
     for x0, y0, x1, y1, r in plan.outlines:
         msp.add_lwpolyline(rounded_rect_points(x0, y0, x1, y1, r), format="xyb", close=True,
                            dxfattribs={"layer": "CUT_OUTER"})
@@ -97,9 +98,6 @@ def write_svg(plan: CutPlan, path: Path) -> None:
            f"<title>{escape(plan.flat.name)} ({plan.flat.thickness:g} mm sheet, kerf {plan.kerf:g} mm "
            "compensated)</title>"]
     group = 'fill="none" stroke-width="0.1"'
-    out.append(f'<g id="CUT_INNER" stroke="{stroke["CUT_INNER"]}" {group}>')
-    out += [f'<circle cx="{c.x:.6f}" cy="{-c.y:.6f}" r="{c.diameter / 2:.6f}"/>' for c in plan.circles]
-    out.append("</g>")
     if plan.texts:
         out.append(f'<g id="ENGRAVE" fill="{stroke["ENGRAVE"]}" stroke="none">')
         for t in plan.texts:
@@ -107,6 +105,9 @@ def write_svg(plan: CutPlan, path: Path) -> None:
                          for outline in engraving_outlines(t))
             out.append(f'<path d="{d}" fill-rule="evenodd"><title>{escape(t.text)}</title></path>')
         out.append("</g>")
+    out.append(f'<g id="CUT_INNER" stroke="{stroke["CUT_INNER"]}" {group}>')
+    out += [f'<circle cx="{c.x:.6f}" cy="{-c.y:.6f}" r="{c.diameter / 2:.6f}"/>' for c in plan.circles]
+    out.append("</g>")
     out.append(f'<g id="CUT_OUTER" stroke="{stroke["CUT_OUTER"]}" {group}>')
     out += [f'<path d="{_svg_rounded_rect(*o)}"/>' for o in plan.outlines]
     out.append("</g>")

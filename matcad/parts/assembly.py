@@ -57,9 +57,10 @@ def assembled_parts(spec) -> dict[str, object]:
         parts["needle_mount"] = needle_mount(spec)
         parts |= {f"needle_{t.name}": taxel_needle(t) for t in board}
     if spec.spacer.style == "laser":
-        one = flat_solid(spacer(spec), -spec.spacer.height)
+        one = spacer(spec)
         for i, (x, y) in enumerate(plate_bolt_positions_mm(spec), 1):
-            parts[f"spacer_{i}"] = Pos(x, y, 0) * one
+            # each spacer its own solid: moved copies of one solid share one STEP product, named after the last
+            parts[f"spacer_{i}"] = Pos(x, y, 0) * flat_solid(one, -spec.spacer.height)
     return parts
 
 

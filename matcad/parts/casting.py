@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from matcad.materials import grade
 from matcad.parts.features import cap_volume_mm3
 from matcad.parts.mold_layout import layout
+from matcad.parts.print_profile import PRINT_FILE
 
 if TYPE_CHECKING:
     from matcad.spec import Spec
@@ -80,7 +81,7 @@ class CastingGuide:
 
 def casting_guide(spec: Spec) -> CastingGuide:
     """The pour for ``spec``: batch = max(cast volume × waste factor × density, :data:`MIN_BATCH_G`) (g)."""
-    from matcad.spec import taxel_spec
+    from matcad.spec import taxel_spec, taxels
 
     g = grade(spec.silicone.grade)
     mold = MOLD_MATERIALS[spec.machine.printer]
@@ -95,30 +96,43 @@ def casting_guide(spec: Spec) -> CastingGuide:
               "the batch" if needed < MIN_BATCH_G else f"the caps need {needed:.2f} g with x{spec.silicone.waste_factor:g} "
               "for cup, sprues and vents")
     vents = len(lay.plan.inner) + len(lay.plan.outer)
+    c = lay.clamp
+    nuts = (f"the {len(lay.bolts)} captive {c.bolt} nuts in the base (pressed into the traps under it after "
+            "printing)" if c.open_below else f"the {len(lay.bolts)} {c.bolt} nuts the base print captured at its pause")
+    board = len(taxels(spec)) > 1
     steps = (
-        f"Print the mold ({mold.label}): end_cap_mold_base.stl and end_cap_mold_lid.stl, each as exported "
-        f"(flat face down, no supports). Clear every vent with a {spec.mold.vent:g} mm drill or pin.",
+        f"Print the mold ({mold.label}): end_cap_mold_base and end_cap_mold_lid as exported "
+        f"({PRINT_FILE.format(printer=spec.machine.printer)}, or its _1, _2, ... files when the parts take more "
+        "than one bed, holds them oriented with their settings; or the STLs, flat face down, no supports). Clear every vent with a "
+        f"{spec.mold.vent:g} mm drill or pin.",
         *(("SLA: post-cure the printed mold fully, or barrier-coat it, and cast a test drop (cure inhibition, "
            "above).",) if mold.inhibition else ()),
         f"Release: {RELEASE_AGENT}.",
-        f"Close the mold: lid on the base (the keys centre it), {len(lay.bolts)} x {spec.mold.bolt} bolts with nuts, "
-        "finger-tight and even; set it level, fill ports up.",
+        "Close the mold: lid on the base, the keys in their ribbed sockets"
+        + (" (the taxel names on the lid and the base side by side)" if board else "")
+        + f"; {len(lay.bolts)} x {c.bolt} x {c.length_mm or 0:g} mm bolts through the lid into {nuts}, finger-tight "
+        "and even until the lid sits on the base; the mold stands flat on its base: set it level, fill ports up.",
         f"Weigh {batch:.1f} g of {g.label} ({g.mix_ratio}), mix 3 min scraping sides and bottom, degas in vacuum "
         f"if you can; pot life {g.pot_life_min:g} min at 23 °C.",
         f"Fill each cap through its {spec.mold.fill_port:g} mm fill port with a syringe, slowly, one cap at a time: "
-        "first the core-pin vent must show silicone (the closed end over the membrane is full), then every one of "
-        f"the {vents} base-face vents; top the port up as the level settles.",
+        "the silicone runs down the body wall to the bottom of the pocket (the membrane) and rises round the core "
+        "pin, pushing the air ahead of it up and out through the vents; air under the pin's end escapes round its "
+        f"rim and up its side. The cap is full when silicone stands in every one of its {vents} vents; top the "
+        "port up as the level settles.",
         f"Cure {g.cure_h_room:g} h at room temperature (23 °C), or warm at most {mold.max_cure_c:g} °C: "
         f"{mold.note}.",
-        "Demold: remove the bolts, lift the lid straight up (the core pins slide out of the cavities), then push "
-        "each cap out of the base by its flange.",
+        "Demold: remove the bolts, lift the lid straight up (the core pins slide out of the cavities, the sprues out "
+        "of the lid), then push each cap out of the base by its flange"
+        + ("; keep each cap with the taxel name recessed beside its pocket until it is seated in its locator hole"
+           if board else "") + ".",
     )
+    sprues = vents + 1
     trim = (
-        "fill-port and base-face vent sprues: cut flush with the cap's base face (the face that seals on the "
-        "neck plate) using a fresh scalpel blade laid flat on the face; a nub there breaks the seal",
-        "core-pin vent thread: it stands on the cavity's closed end (inside the cavity, over the membrane); pull it "
-        "out with tweezers through the cavity opening or snip it flush with micro scissors: a stub changes the "
-        "cavity volume and the membrane's stiffness",
+        f"{sprues} sprues per cap (the fill port's and {vents} vents') stand on the cap's base face, the face that "
+        "seals on the neck plate: lay the cap base face up on the bench, rest a fresh scalpel blade (No. 10 or 11) "
+        "flat on the face and slice each sprue off in one stroke at its root; then press the face on a glass "
+        "plate: it must sit flat with no nub (a nub holds the flange off the plate and the cavity leaks)",
+        "nothing to trim inside the cavity: the core pin has no vent, so the membrane's inside is clean",
     )
     return CastingGuide(grade=g.label, mold_material=mold.label, caps=caps, cast_volume_ml=cast_ml,
                         needed_g=needed, batch_g=batch, batch_reason=reason, mix_ratio=g.mix_ratio,

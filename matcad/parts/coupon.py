@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Sequence
 
 from matcad.parts.features import bolt_clearance_mm, sheet_kerf_mm, sheet_thickness_mm
 from matcad.parts.flat import Engraving, Flat, Hole, engraving_outlines
+from matcad.parts.print_profile import FDM_MAX_OVERHANG_DEG
 from matcad.parts.registry import Kind, PrintPose, parts
 
 if TYPE_CHECKING:
@@ -75,7 +76,8 @@ def laser_coupon(spec: Spec, sheet: str = "plate") -> Flat:
     labels = tuple(Engraving(h.x - 0.9 * LABEL_MM, h.y - h.diameter / 2 - 0.5 - LABEL_MM, LABEL_MM,
                              f"{h.diameter:.2f}") for h in holes)
     thickness, measured = sheet_thickness_mm(spec, sheet)
-    return Flat(name=f"coupon_{sheet}", thickness=thickness, thickness_measured=measured,
+    return Flat(name=f"coupon_{sheet}", thickness=thickness, thickness_measured=measured, sheet=sheet,
+                thickness_example=getattr(spec, sheet).thickness_example,
                 kerf=sheet_kerf_mm(spec, sheet), width=width, depth=depth, holes=tuple(holes), engrave=labels)
 
 
@@ -150,11 +152,10 @@ Y_SWEEP_MM = (0.0, 0.87, 1.74, 2.6, 3.47)
 THETA_WINDOW_DEG = (30.0, 75.0)
 """Needle angles θ the paper tested (Sec. II), deg."""
 THETA_STEPS = 5
-FDM_THETA_MIN_DEG = 60.0
+FDM_THETA_MIN_DEG = 90.0 - FDM_MAX_OVERHANG_DEG
 """Lowest needle angle θ (deg) whose bore FDM prints without support, and so the lowest θ of the FDM trial set and
-the ``print.bore_overhang`` rule's limit: PrusaSlicer with automatic supports (its default FDM profile,
-tests/test_real_clients.py) puts support under this mount's bore at θ = 45° (171 mm³) and 52.5° (110 mm³), none
-at 60° and above (measured)."""
+the ``print.bore_overhang`` rule's limit: 60°, a bore ceiling overhanging
+:data:`matcad.parts.print_profile.FDM_MAX_OVERHANG_DEG` = 30° from vertical."""
 NOTCH_MM = 1.0
 
 

@@ -52,4 +52,5 @@ def board_caps(spec):
 
 PARTS = (Part("end_cap", Kind.CAST, flag="end_cap_mold", make=board_caps, order=50, colour="#f0a050",
               pose=PrintPose(0.0, "base (the sealing face), cavity opening down: cast, not printed", printed=False),
-              view=("from below: the cavity's open end", -90.0, -90.0), label="silicone end cap"),)
+              view=("section through its axis: cavity, membrane, flange", -90.0, -90.0), label="silicone end cap",
+              section="axis"),)

@@ -3,16 +3,23 @@
 Mold frame: the parting plane is z = 0 and is the cap's base (the face that sits on the neck plate). Pour
 orientation is as modelled, z up:
 - **base** (z < 0): a block holding each cap's outer shape upside down. The cap widens toward the parting
-  plane (body, then flange), so it lifts straight out without undercuts.
+  plane (body, then flange), so it lifts straight out without undercuts. Two captive hex nuts take the clamp
+  bolts (:func:`matcad.parts.mold_layout.clamp_nut`), so the closed mold stands flat.
 - **lid** (z > 0): a plate carrying the core pins that form the cavities (drafted toward their tips so they
-  release), with sockets over the base's truncated-cone registration keys (clearance per side from the
-  printer's fit class), a fill port per cap over the body annulus, vents, and clamp bolt holes.
+  release), with sockets over the base's truncated-cone registration keys, a fill port per cap over the body
+  annulus, vents over the base face, and clamp bolt holes. Each socket carries three crush ribs line-to-line with
+  its key (:data:`RIB_WIDTH_MM`), so the lid centres on the keys with no lateral play; between the ribs the
+  socket keeps the printer's key clearance.
 Each cavity has two ceilings in pour orientation (see :mod:`matcad.parts.mold_layout`): the base face under
 the lid, vented by rings of holes planned so no point is farther than ``mold.vent_reach`` from an opening, and
-the core pin's end face over the sensing membrane, vented along the pin's axis.
+the core pin's end face over the sensing membrane, which vents round its rim and up the pin's side: no vent runs
+through the pin, so nothing is cast inside the cavity. On a board each pocket and each fill port is labelled
+with its taxel's name, recessed in the base's parting face and in the lid's top face.
 """
 
 from __future__ import annotations
+
+import math
 
 from matcad.parts.end_cap import cap_envelope, core_pin, end_cap
 from matcad.parts.features import bolt_clearance_mm
@@ -21,6 +28,11 @@ from matcad.parts.registry import Kind, Part, PrintPose
 
 KEY_TOP_RATIO = 0.6
 """Key top diameter / base diameter: a truncated cone that self-centres as the lid closes."""
+RIB_WIDTH_MM = {"fdm": 0.8, "sla": 0.5}
+"""Width of a socket's crush ribs: two FDM extrusion lines, or a thin SLA web. Line-to-line with the key, a rib
+printed fat is shaved or flexed as the bolts pull the lid down (the crush-rib practice of printed press fits)."""
+RIB_ANGLES_DEG = (90.0, 210.0, 330.0)
+"""Three ribs 120° apart: each lateral direction pushes the key into at least one of them."""
 
 
 def _key(spec, grow: float, x: float, y: float):
@@ -29,6 +41,84 @@ def _key(spec, grow: float, x: float, y: float):
     m = spec.mold
     r = m.key_diameter / 2
     return frustum_up(r + grow, r * KEY_TOP_RATIO + grow, m.key_height + grow, x, y, 0.0)
+
+
+def _ribbed_socket(spec, x: float, y: float):
+    """The lid's socket over the key at (x, y): the key grown by ``machine.key_clearance``, less three crush
+    ribs that fill the clearance line-to-line with the key in :data:`RIB_WIDTH_MM`-wide sectors (mm)."""
+    from build123d import Box, Pos, Rot
+
+    grown = _key(spec, spec.machine.key_clearance, x, y)
+    gap = grown - _key(spec, 0.0, x, y)
+    reach = spec.mold.key_diameter / 2 + spec.machine.key_clearance + 1.0
+    width = RIB_WIDTH_MM[spec.machine.printer]
+    sectors = [Pos(x, y, 0) * Rot(0, 0, a) * Pos(reach / 2, 0, 0)
+               * Box(reach, width, 2 * (spec.mold.key_height + spec.machine.key_clearance))
+               for a in RIB_ANGLES_DEG]
+    return grown - gap.intersect(sectors[0].fuse(*sectors[1:]))
+
+
+def taxel_labels(spec, lay: MoldLayout, keepout) -> tuple:
+    """The taxel name over each cap position of a board's mold, placed on the block's face clear of ``keepout``
+    circles (x, y, radius); () for a single taxel's mold, whose caps are all the same (mm)."""
+    from matcad.parts.labels import PRINTED_LABEL_HEIGHTS_MM, place_labels
+    from matcad.spec import taxels
+
+    if len(taxels(spec)) < 2:
+        return ()
+    return place_labels([(t.name, x, 0.0) for x, t in zip(lay.cap_x, lay.slots)], keepout, lay.block_x,
+                        lay.block_y, heights=PRINTED_LABEL_HEIGHTS_MM)
+
+
+def _flanges(spec, lay: MoldLayout) -> list[tuple[float, float, float]]:
+    from matcad.spec import cap_flange_diameter_mm
+
+    return [(x, 0.0, cap_flange_diameter_mm(s) / 2) for x, s in _slot_specs(spec, lay)]
+
+
+def _features(spec, lay: MoldLayout) -> list[tuple[float, float, float]]:
+    """Keys (with their socket clearance) and clamp bolts as keep-out circles (x, y, radius) of the faces (mm)."""
+    key = spec.mold.key_diameter / 2 + spec.machine.key_clearance
+    bolt = max(bolt_clearance_mm(spec.mold.bolt, "normal"), lay.clamp.across_flats_mm / math.cos(math.pi / 6)) / 2
+    return [(x, y, key) for x, y in lay.keys] + [(x, y, bolt) for x, y in lay.bolts]
+
+
+def base_labels(spec) -> tuple:
+    """Taxel names recessed in the base's parting face beside each pocket (mm)."""
+    lay = layout(spec)
+    return taxel_labels(spec, lay, _flanges(spec, lay) + _features(spec, lay))
+
+
+def lid_labels(spec) -> tuple:
+    """Taxel names recessed in the lid's top face beside each fill port (mm)."""
+    lay = layout(spec)
+    return taxel_labels(spec, lay, _flanges(spec, lay) + _features(spec, lay))
+
+
+def _hexagon(x: float, y: float, z: float, circumradius: float):
+    from build123d import Wire
+
+    return Wire.make_polygon([(x + circumradius * math.cos(math.radians(60 * k)),
+                               y + circumradius * math.sin(math.radians(60 * k)), z) for k in range(6)], close=True)
+
+
+def _nut_pocket(spec, lay: MoldLayout, x: float, y: float):
+    """A clamp nut's hex pocket in the base (closed below on FDM, a trap open to the base's underside on SLA),
+    its funnel roof (:func:`matcad.parts.mold_layout.nut_funnel_mm`) and the bolt's clearance hole from it up to
+    the parting plane (mm)."""
+    from build123d import Face, Solid, Vector
+
+    from matcad.parts.mold_layout import nut_funnel_mm
+    from matcad.parts.solid import cylinder_up
+
+    c = lay.clamp
+    r = c.across_flats_mm / 2 / math.cos(math.pi / 6)
+    hole = bolt_clearance_mm(spec.mold.bolt, "normal") / 2
+    z0 = -lay.base_height if c.open_below else c.pocket_bottom_z
+    pocket = Solid.extrude(Face(_hexagon(x, y, z0, r)), Vector(0, 0, c.pocket_top_z - z0))
+    funnel = Solid.make_loft([_hexagon(x, y, c.pocket_top_z, r),
+                              _hexagon(x, y, c.pocket_top_z + nut_funnel_mm(c.bolt, spec.machine.printer), hole)])
+    return [pocket, funnel, cylinder_up(hole, -c.pocket_top_z, x, y, c.pocket_top_z)]
 
 
 def _slot_specs(spec, lay: MoldLayout) -> list[tuple[float, object]]:
@@ -45,38 +135,38 @@ def _upside_down(shape, x: float):
 
 
 def mold_base(spec):
-    """Base block: top face at z = 0, cap negatives upside down, keys on top, bolt holes (mm)."""
+    """Base block: top face at z = 0, cap negatives upside down, keys on top, captive clamp nuts under bolt holes,
+    a board's taxel names beside the pockets (mm)."""
     from build123d import Box
 
-    from matcad.parts.solid import TOP, cylinder_up
+    from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
+    from matcad.parts.solid import TOP, engraved
 
     lay = layout(spec)
-    bolt_r = bolt_clearance_mm(spec.mold.bolt, "normal") / 2
     block = Box(lay.block_x, lay.block_y, lay.base_height, align=TOP)
     block = block.fuse(*(_key(spec, 0.0, x, y) for x, y in lay.keys))
     return block.cut(*[_upside_down(cap_envelope(s), x) for x, s in _slot_specs(spec, lay)],
-                     *[cylinder_up(bolt_r, lay.base_height, x, y, -lay.base_height) for x, y in lay.bolts])
+                     *[f for x, y in lay.bolts for f in _nut_pocket(spec, lay, x, y)],
+                     *engraved(base_labels(spec), 0.0, PRINTED_LABEL_DEPTH_MM))
 
 
 def mold_lid(spec):
-    """Lid: bottom face at z = 0, core pins (each vented along its axis) hanging into the caps, key sockets, fill
-    ports, vents, bolts (mm)."""
+    """Lid: bottom face at z = 0, solid core pins hanging into the caps, ribbed key sockets, fill ports, vents,
+    bolt holes, a board's taxel names beside the fill ports on its top face (mm)."""
     from build123d import Box
 
-    from matcad.parts.solid import BOTTOM, cylinder_up
+    from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
+    from matcad.parts.solid import BOTTOM, cylinder_up, engraved
 
     lay = layout(spec)
     m = spec.mold
     lid = Box(lay.block_x, lay.block_y, m.lid_thickness, align=BOTTOM)
-    slots = _slot_specs(spec, lay)
-    lid = lid.fuse(*(_upside_down(core_pin(s), x) for x, s in slots))
-    holes = ([(x, y, m.fill_port / 2) for x, y in lay.fill_ports]
-             + [(x, y, m.vent / 2) for x, y in lay.vents]
-             + [(x, y, bolt_clearance_mm(m.bolt, "normal") / 2) for x, y in lay.bolts])
-    return lid.cut(*[_key(spec, spec.machine.key_clearance, x, y) for x, y in lay.keys],
-                   *[cylinder_up(r, m.lid_thickness, x, y, 0.0) for x, y, r in holes],
-                   *[cylinder_up(m.vent / 2, s.cavity.length + m.lid_thickness, x, y, -s.cavity.length)
-                     for (x, y), (_, s) in zip(lay.pin_vents, slots)])
+    lid = lid.fuse(*(_upside_down(core_pin(s), x) for x, s in _slot_specs(spec, lay)))
+    bolt = bolt_clearance_mm(m.bolt, "normal") / 2
+    return lid.cut(*[_ribbed_socket(spec, x, y) for x, y in lay.keys],
+                   *[cylinder_up(o.diameter / 2, o.z_top - o.z_bottom, o.x, o.y, o.z_bottom) for o in lay.openings],
+                   *[cylinder_up(bolt, m.lid_thickness, x, y, 0.0) for x, y in lay.bolts],
+                   *engraved(lid_labels(spec), m.lid_thickness, PRINTED_LABEL_DEPTH_MM))
 
 
 def cast_caps(spec):
@@ -86,7 +176,7 @@ def cast_caps(spec):
 
 PARTS = (Part("end_cap_mold_base", Kind.PRINTED, flag="end_cap_mold", make=mold_base, order=60, colour="#e0c090",
               pose=PrintPose(0.0, "flat underside; cap cavities and keys face up"),
-              view=("from above: cap cavities, fill ports, vents", 90.0, -90.0)),
+              view=("from above: cap pockets, keys, nut pockets", 90.0, -90.0)),
          Part("end_cap_mold_lid", Kind.PRINTED, flag="end_cap_mold", make=mold_lid, order=70, colour="#e0c090",
               pose=PrintPose(180.0, "outer (top) face; core pins point up, the parting face prints last"),
-              view=("from above (as printed, pins up): core pins, vents, key sockets", 90.0, -90.0)))
+              view=("from above (as printed, pins up): core pins, vents, ribbed key sockets", 90.0, -90.0)))

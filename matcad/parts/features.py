@@ -44,10 +44,24 @@ def sheet_kerf_mm(spec, sheet: str) -> float:
 
 
 def sheet_thickness_mm(spec, sheet: str) -> tuple[float, bool]:
-    """(thickness mm, measured) of ``sheet``."""
+    """(thickness mm, measured) of ``sheet``: an example value counts as measured (:func:`sheet_status`)."""
     return {"plate": (spec.neck.length, spec.plate.thickness_measured),
             "guide": (spec.guide.thickness, spec.guide.thickness_measured),
             "spacer": (spec.spacer.height, spec.spacer.thickness_measured)}[sheet]
+
+
+SHEET_STATUSES = ("measured", "example", "nominal")
+"""What a sheet's thickness is: calipered by the user; a template's example of a calipered value (predictions
+use it as measured, the rules report it unverified); or the nominal stock size (ISO 7823-1 tolerance)."""
+
+
+def sheet_status(spec, sheet: str) -> str:
+    """``sheet``'s thickness status, one of :data:`SHEET_STATUSES`: ``<section>.thickness_measured`` and
+    ``<section>.thickness_example``."""
+    section = getattr(spec, sheet)
+    if not section.thickness_measured:
+        return "nominal"
+    return "example" if section.thickness_example else "measured"
 
 
 NEEDLE_GAUGE_OD_MM = {14: 2.108, 15: 1.829, 16: 1.651, 17: 1.473, 18: 1.270, 19: 1.067, 20: 0.908, 21: 0.819,
@@ -68,6 +82,21 @@ def pin_hole_diameter_mm(pin_diameter_mm: float, process: str, fit: str) -> floa
 def bolt_clearance_mm(bolt: str, fit: str) -> float:
     """ISO 273 clearance hole diameter (mm)."""
     return ISO_273_CLEARANCE_MM[bolt][fit]
+
+
+ISO_4762_LENGTHS_MM = (3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0,
+                       60.0)
+"""Preferred stock lengths of socket head cap screws, ISO 4762 (mm): what a shop or kit box holds."""
+ISO_8734_LENGTHS_MM = (3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 18.0, 20.0, 22.0, 24.0, 26.0, 28.0, 30.0,
+                       32.0, 35.0, 40.0, 45.0, 50.0)
+"""Stock lengths of hardened dowel pins, ISO 8734 (mm)."""
+NEEDLE_LENGTHS_MM = (6.35, 12.7, 25.4, 38.1)
+"""Stock lengths of blunt dispensing needles: 1/4, 1/2, 1 and 1 1/2 in (mm)."""
+
+
+def stock_length_mm(needed_mm: float, series) -> float | None:
+    """The shortest stock length of ``series`` at least ``needed_mm`` long; None when none is (mm)."""
+    return next((length for length in series if length >= needed_mm - 1e-9), None)
 
 
 def bolt_nominal_mm(bolt: str) -> float:

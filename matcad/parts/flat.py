@@ -14,13 +14,21 @@ REFERENCE_SQUARE_MM = 10.0
 
 @dataclass(frozen=True)
 class Hole:
-    """A round hole: centre (x, y), finished diameter, what it is for and what it must fit (mm)."""
+    """A round hole: centre (x, y), diameter as cut (after kerf compensation), what it is for and what it must fit;
+    the taxel it belongs to on a board, and the size it is drilled to after cutting (a neck pilot) (mm)."""
 
     x: float
     y: float
     diameter: float
     purpose: str  # neck | neck_pilot | dowel | bolt | cap
     fit: str = ""
+    taxel: str = ""
+    drill_to: float | None = None
+
+    @property
+    def finished_mm(self) -> float:
+        """The hole's finished diameter: drilled to, or as cut (mm)."""
+        return self.diameter if self.drill_to is None else self.drill_to
 
 
 @dataclass(frozen=True)
@@ -98,7 +106,7 @@ class Flat:
 
     name: str
     thickness: float
-    thickness_measured: bool
+    thickness_measured: bool  # calipered, or a template's example of a calipered value (thickness_example)
     kerf: float  # full kerf of this part's sheet (see features.sheet_kerf_mm)
     width: float
     depth: float
@@ -106,10 +114,19 @@ class Flat:
     engrave: tuple[Engraving, ...] = ()
     quantity: int = 1
     corner_radius: float = 0.5
+    thickness_example: bool = False  # the measured thickness is a template's example, not the user's sheet
+    sheet: str = ""  # the acrylic sheet it is cut from (a key of features.SHEETS)
 
     @property
     def area_mm2(self) -> float:
         return self.width * self.depth
+
+    @property
+    def thickness_status(self) -> str:
+        """'measured', 'example' or 'nominal' (:data:`matcad.parts.features.SHEET_STATUSES`)."""
+        if not self.thickness_measured:
+            return "nominal"
+        return "example" if self.thickness_example else "measured"
 
 
 @dataclass(frozen=True)
@@ -133,6 +150,7 @@ class CutPlan:
     texts: tuple[Engraving, ...] = ()
     reference_square: tuple[float, float, float] | None = None  # x0, y0, side
     extents: tuple[float, float, float, float] = field(default=(0, 0, 0, 0))
+    parts: tuple[str, ...] = ()  # a nested sheet's parts (matcad.export.sheets); () for one part's plan
 
 
 class DrawnSizeError(ValueError):

@@ -8,10 +8,17 @@ cap has two:
 - the base face: the annulus from the cavity edge (D/2) to the flange edge, against the lid's underside;
 - the core pin's end face (the cavity's closed end, over the sensing membrane), at z = −L.
 
-Openings: a vent along each core pin's axis, through pin and lid (its end face reaches it within the tip radius
-minus the vent radius); over the base face, the fill port and two rings of vents, one over the body wall and one
-over the flange, as many as it takes for every point of the annulus to lie within ``mold.vent_reach`` of an
-opening's edge (:func:`plan_vents`).
+A bubble leaves a ceiling through an opening above it, or over the ceiling's edge where the surface beyond rises
+(a wall steeper than the ceiling limit) toward a vented ceiling. The core pin's end face has no opening: its rim
+meets the pin's side, which rises to the base face, so every point of it lies within the tip radius D_tip/2 of
+an escape, and the base face is vented. No vent runs through the pin: one would cast a silicone thread standing
+on the membrane inside the cavity (the acoustic volume), to be pulled out of a blind hole. Over the base face
+the fill port and two rings of vents, one over the body wall and one over the flange, as many as it takes for
+every point of the annulus to lie within ``mold.vent_reach`` of an opening's edge (:func:`plan_vents`); their
+sprues stand on the sealing face and are trimmed flush (the casting guide says how).
+
+The clamp bolts screw into captive nuts in the base (:func:`clamp_nut`), so the closed mold stands flat on its
+base: on FDM the print pauses to drop the nuts into closed pockets, on SLA they press into traps open below.
 """
 
 from __future__ import annotations
@@ -38,8 +45,40 @@ class VentPlan:
     inner: tuple[tuple[float, float], ...]  # over the body wall, the fill port's ring (fill port not included)
     outer: tuple[tuple[float, float], ...]  # over the flange
     reach_base_mm: float  # farthest point of the base-face ceiling from an opening's edge
-    reach_tip_mm: float  # farthest point of the core-pin end face from the pin vent's edge
+    reach_tip_mm: float  # farthest point of the core-pin end face from its rim, where the pin's side rises
     feasible: bool  # every ceiling within mold.vent_reach with vents that fit
+
+
+@dataclass(frozen=True)
+class ClampNut:
+    """How a mold clamp bolt holds: from the lid's top through the lid and base into a captive hex nut in the base
+    (mold frame, mm). ``length_mm`` is the stock bolt length (None when the base is too thin for the nut), its end
+    flush with the nut's underside; the pocket spans ``pocket_bottom_z`` … ``pocket_top_z``, ``across_flats_mm``
+    wide, open below on SLA (a trap the nut presses into) and closed on FDM, where the print pauses at
+    ``pause_print_z`` (print frame, bed at 0) to drop the nut in."""
+
+    bolt: str
+    length_mm: float | None
+    nut_height_mm: float
+    pocket_bottom_z: float
+    pocket_top_z: float
+    across_flats_mm: float
+    open_below: bool
+    pause_print_z: float | None
+
+
+@dataclass(frozen=True)
+class Opening:
+    """A channel through the lid that silicone can rise into: centre (x, y), diameter, from ``z_bottom`` up to
+    ``z_top`` (mold frame), and what it is (``fill`` or ``vent``) (mm). The lid is cut from these, and the
+    cavity-volume check (:func:`appendages`) reads the same list."""
+
+    x: float
+    y: float
+    diameter: float
+    z_bottom: float
+    z_top: float
+    kind: str
 
 
 @dataclass(frozen=True)
@@ -54,9 +93,18 @@ class MoldLayout:
     bolts: tuple[tuple[float, float], ...]
     fill_ports: tuple[tuple[float, float], ...]
     vents: tuple[tuple[float, float], ...]  # ring vents over the base face
-    pin_vents: tuple[tuple[float, float], ...]  # one along each core pin's axis
     base_height: float
     plans: tuple[VentPlan, ...]  # per slot
+    clamp: ClampNut
+    fill_port: float = 2.0
+    vent: float = 1.0
+    lid_thickness: float = 3.0
+
+    @property
+    def openings(self) -> tuple[Opening, ...]:
+        """Every fill port and vent as a channel from the parting plane through the lid (mm)."""
+        return (tuple(Opening(x, y, self.fill_port, 0.0, self.lid_thickness, "fill") for x, y in self.fill_ports)
+                + tuple(Opening(x, y, self.vent, 0.0, self.lid_thickness, "vent") for x, y in self.vents))
 
     @property
     def plan(self) -> VentPlan:
@@ -117,7 +165,7 @@ def _plan(cavity_d: float, outer_d: float, flange_d: float, tip_r: float, fill_p
           vent_reach: float) -> VentPlan:
     r_in, r_out = (cavity_d + outer_d) / 4, (outer_d + flange_d) / 4
     fill = [(r_in, 0.0, fill_port / 2)]
-    reach_tip = max(0.0, tip_r - vent / 2)
+    reach_tip = tip_r  # the end face's centre to its rim, where the pin's side rises to the base face
     best = None
     for n_in in range(1, MAX_VENTS_PER_RING + 1):
         if not _fits(r_in, n_in, max(vent, fill_port)):
@@ -211,6 +259,94 @@ def layout(spec) -> MoldLayout:
 
     fill = tuple(at(x, fill_radius_mm(s), 0.0) for x, s in zip(cap_x, specs))
     vents = tuple(at(x, r, a) for x, p in zip(cap_x, plans) for r, a in p.inner + p.outer)
+    base_height = max(cap_height_mm(s) for s in specs) + m.floor
     return MoldLayout(cap_x, slots, block_x, block_y, keys=((xe, ye), (-xe, -ye)), bolts=((xe, -ye), (-xe, ye)),
-                      fill_ports=fill, vents=vents, pin_vents=tuple((x, 0.0) for x in cap_x),
-                      base_height=max(cap_height_mm(s) for s in specs) + m.floor, plans=plans)
+                      fill_ports=fill, vents=vents, base_height=base_height, plans=plans,
+                      clamp=clamp_nut(m.bolt, spec.machine.printer, base_height, m.lid_thickness),
+                      fill_port=m.fill_port, vent=m.vent, lid_thickness=m.lid_thickness)
+
+
+def _overlap_mm2(d: float, r1: float, r2: float) -> float:
+    """Area shared by two discs of radii r1, r2 whose centres are d apart (mm²)."""
+    if d >= r1 + r2:
+        return 0.0
+    if d <= abs(r1 - r2):
+        return math.pi * min(r1, r2) ** 2
+    a1 = r1 * r1 * math.acos((d * d + r1 * r1 - r2 * r2) / (2 * d * r1))
+    a2 = r2 * r2 * math.acos((d * d + r2 * r2 - r1 * r1) / (2 * d * r2))
+    return a1 + a2 - 0.5 * math.sqrt((-d + r1 + r2) * (d + r1 - r2) * (d - r1 + r2) * (d + r1 + r2))
+
+
+def appendages(spec, lay: MoldLayout | None = None) -> list[dict]:
+    """What each cap position casts beyond the cap itself (mm³): the silicone the openings over it can hold
+    (sprues on its sealing face, above the parting plane, trimmed off) and the part of it that lies inside the
+    cavity — the acoustic volume — where a channel runs down into the core pin (a pin vent would cast a thread
+    standing on the membrane). One row per slot: taxel, sprues (count), sprue volume, volume inside the cavity,
+    taken at the pin's root diameter over the channel's depth below the parting plane (an upper bound for a
+    drafted pin)."""
+    from matcad.spec import taxel_spec
+
+    lay = lay or layout(spec)
+    rows = []
+    for x, taxel in zip(lay.cap_x, lay.slots):
+        cap = taxel_spec(spec, taxel)
+        flange_r, pin_r = cap_flange_diameter_mm(cap) / 2, cap.cavity.diameter / 2
+        own = [o for o in lay.openings if math.hypot(o.x - x, o.y) < flange_r + o.diameter / 2]
+        sprue = sum(math.pi * o.diameter ** 2 / 4 * max(o.z_top, 0.0) for o in own)
+        inside = sum(_overlap_mm2(math.hypot(o.x - x, o.y), o.diameter / 2, pin_r)
+                     * min(max(-o.z_bottom, 0.0), cap.cavity.length) for o in own)
+        rows.append({"taxel": taxel.name, "x_mm": x, "sprues": len(own), "sprue_mm3": sprue,
+                     "inside_cavity_mm3": inside})
+    return rows
+
+
+NUT_ACROSS_FLATS_MM = {"M2": 4.0, "M2.5": 5.0, "M3": 5.5}
+NUT_HEIGHT_MM = {"M2": 1.6, "M2.5": 2.0, "M3": 2.4}
+"""ISO 4032 hex nut: width across flats s and height m (mm)."""
+NUT_POCKET_CLEARANCE_MM = {"fdm": 0.3, "sla": 0.15}
+"""Nut pocket across flats over the nut's: a printed hole comes out undersize, FDM more than SLA (mm)."""
+NUT_HEADROOM_MM = 0.2
+"""Pocket height over the nut's: the layer that closes an FDM pocket must not touch the nut (mm)."""
+NUT_ROOF_MM = 1.0
+"""Base material kept between the top of a nut pocket's funnel roof and the parting plane (mm)."""
+
+
+def nut_funnel_mm(bolt: str, printer: str) -> float:
+    """Height of the roof over a clamp nut's hex pocket: a hexagonal funnel from the pocket to a hexagon inscribed in
+    the bolt's clearance hole (a corner standing out of the hole would leave a ledge the slicer supports), its
+    corners overhanging :data:`matcad.parts.print_profile.FDM_MAX_OVERHANG_DEG` from vertical, the steepest
+    PrusaSlicer's default FDM profile prints without support (measured) (mm)."""
+    from matcad.parts.print_profile import FDM_MAX_OVERHANG_DEG
+
+    pocket = (NUT_ACROSS_FLATS_MM[bolt] + NUT_POCKET_CLEARANCE_MM[printer]) / 2 / math.cos(math.pi / 6)
+    hole = bolt_clearance_mm(bolt, "normal") / 2  # the top hexagon inscribed in the hole: no ledge at its corners
+    return (pocket - hole) / math.tan(math.radians(FDM_MAX_OVERHANG_DEG))
+NUT_FLOOR_MM = {"fdm": 1.0, "sla": 0.0}
+"""Under the nut: FDM closes the pocket below (five 0.2 mm layers), SLA leaves the trap open to the bed (mm)."""
+
+
+def clamp_nut(bolt: str, printer: str, base_height: float, lid_thickness: float) -> ClampNut:
+    """Where a mold clamp bolt's captive nut sits (mold frame, mm): the longest stock bolt
+    (:data:`matcad.parts.features.ISO_4762_LENGTHS_MM`) whose end, flush with the nut's underside, stays
+    :data:`NUT_FLOOR_MM` above the base's underside while the pocket keeps :data:`NUT_ROOF_MM` under the parting
+    plane. On FDM the pocket's top is raised to a layer boundary of the base's print profile and the print pauses
+    before the layer that closes it."""
+    from matcad.parts.features import ISO_4762_LENGTHS_MM
+    from matcad.parts.print_profile import profile
+
+    m, s = NUT_HEIGHT_MM[bolt], NUT_ACROSS_FLATS_MM[bolt] + NUT_POCKET_CLEARANCE_MM[printer]
+    roof = nut_funnel_mm(bolt, printer) + NUT_ROOF_MM
+    fits = [length for length in ISO_4762_LENGTHS_MM
+            if lid_thickness - length >= -base_height + NUT_FLOOR_MM[printer]
+            and lid_thickness - length + m + NUT_HEADROOM_MM <= -roof]
+    length = max(fits) if fits else None
+    bottom = lid_thickness - (length if length is not None else lid_thickness + base_height)
+    top = bottom + m + NUT_HEADROOM_MM
+    pause = None
+    if printer == "fdm" and length is not None:
+        base = profile(printer, "end_cap_mold_base")
+        top_print = base.layer_top_mm(top + base_height)
+        top = top_print - base_height
+        pause = round(top_print + base.layer_mm / 2, 6)
+    return ClampNut(bolt, length, m, round(bottom if printer == "fdm" else -base_height, 6), round(top, 6), s,
+                    printer == "sla", pause)

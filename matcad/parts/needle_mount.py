@@ -44,11 +44,12 @@ def needle_bore(taxel, bore_diameter: float, reach: float):
 
 def needle_mount(spec):
     """The mount solid in the assembly frame (mm): block, fixing ears, standoffs (if printed), bolt pilots,
-    dowel holes, one needle bore per taxel (at its θ and y, aimed at its own neck). No manifold: each needle
-    takes its own air line."""
+    dowel holes, one needle bore per taxel (at its θ and y, aimed at its own neck), and on a board each bore's taxel
+    name recessed beside its mouth on the top face. No manifold: each needle takes its own air line."""
     from build123d import Box, Pos
 
-    from matcad.parts.solid import BOTTOM, TOP, cylinder_up
+    from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
+    from matcad.parts.solid import BOTTOM, TOP, cylinder_up, engraved
     from matcad.spec import taxels
 
     gap, thick = spec.spacer.height, spec.mount.thickness
@@ -74,8 +75,37 @@ def needle_mount(spec):
              + bores
              + [cylinder_up(bolt_clearance_mm(FIXING_BOLT, "normal") / 2, EAR_THICKNESS_MM, x, y, top - thick)
                 for x, y in ear_holes_mm(spec)])
-    return body.cut(*holes)
+    return body.cut(*holes, *engraved(mount_labels(spec), top, PRINTED_LABEL_DEPTH_MM))
+
+
+def bore_mouth_mm(spec, taxel) -> tuple[float, float, float]:
+    """Where ``taxel``'s needle bore opens in the mount's top face: (x, y, radius of a circle holding the bore's
+    elliptical mouth, r / sin θ) (mm)."""
+    (px, py, _), _ = needle_axis_mm(taxel)
+    theta = math.radians(taxel.needle.theta_deg)
+    r = pin_hole_diameter_mm(taxel.needle.outer_diameter, spec.machine.printer, taxel.needle.fit) / 2
+    return px - spec.spacer.height / max(math.tan(theta), 1e-3), py, r / max(math.sin(theta), 1e-3)
+
+
+def mount_labels(spec) -> tuple:
+    """A board's taxel names recessed in the mount's top face, each beside its needle bore's mouth, clear of the
+    other mouths, the bolt pilots (or standoffs) and the dowel holes; () for a single taxel (mm)."""
+    from matcad.parts.labels import PRINTED_LABEL_HEIGHTS_MM, place_labels
+    from matcad.spec import taxels
+
+    board = taxels(spec)
+    if len(board) < 2:
+        return ()
+    mouths = [bore_mouth_mm(spec, t) for t in board]
+    post = (spec.spacer.size if spec.spacer.style == "standoff" else SELF_TAP_PILOT_MM[spec.fasteners.bolt]) / 2
+    dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
+                                 spec.fasteners.dowel_fit_printed) / 2
+    keepout = (mouths + [(x, y, post) for x, y in plate_bolt_positions_mm(spec)]
+               + [(x, y, dowel) for x, y in plate_dowel_positions_mm(spec)])
+    return place_labels([(t.name, x, y) for t, (x, y, _) in zip(board, mouths)], keepout, spec.plate.width,
+                        spec.plate.depth, heights=PRINTED_LABEL_HEIGHTS_MM)
 
 PARTS = (Part("needle_mount", Kind.PRINTED, flag="needle_mount", make=needle_mount, order=80, colour="#b4b4b4",
               pose=PrintPose(0.0, "flat underside; standoffs and the needle bore's mouth face up"),
-              view=("from the side: the needle bore at θ", 0.0, -90.0), label="needle mount (printed)"),)
+              view=("section through a needle's plane: its bore at θ", 0.0, -90.0), label="needle mount (printed)",
+              section="bore"),)

@@ -49,6 +49,9 @@ class PrintPose:
         return [[1.0, 0.0, 0.0, 0.0], [0.0, c, -s, 0.0], [0.0, s, c, -z_min_rotated], [0.0, 0.0, 0.0, 1.0]]
 
 
+SECTIONS = ("", "axis", "bore")
+"""A preview's second view: an orthographic view (''), or a section through y = 0 ('axis') or through an inclined
+bore's plane ('bore')."""
 DEFAULT_VIEW = ("from above", 90.0, -90.0)
 """(caption, elevation, azimuth in degrees) of a 3-D part's second preview when its entry names no view."""
 NON_PART_FLAGS = {
@@ -71,7 +74,8 @@ class Part:
     are exported); ``view`` is their preview's second view (caption, elevation, azimuth in degrees;
     :data:`DEFAULT_VIEW` when None). Laser parts name their ``sheet`` (a key of
     :data:`matcad.parts.features.SHEETS`). ``label`` names the part on the section (default: its name spelt
-    out)."""
+    out). ``section`` draws the preview's second view as a cut instead: 'axis' (through y = 0, every cap's axis)
+    or 'bore' (through an inclined bore's plane), so what lies inside shows."""
 
     name: str
     kind: Kind
@@ -84,6 +88,7 @@ class Part:
     sheet: str | None = None
     when: Callable[[Spec], bool] | None = None
     label: str = ""
+    section: str = ""
 
     def __post_init__(self):
         from matcad.spec import Outputs
@@ -102,6 +107,8 @@ class Part:
             problems.append("pose must be given for a printed or cast part and only for one")
         if (self.kind is Kind.LASER) != (self.sheet is not None):
             problems.append("sheet must be given for a laser part and only for one")
+        if self.section not in SECTIONS:
+            problems.append(f"section {self.section!r} invalid, must be one of {SECTIONS}")
         if problems:
             raise ValueError(f"part {self.name!r}: " + "; ".join(problems))
 

@@ -9,7 +9,7 @@ def spacer(spec) -> Flat:
     """Square laser-cut spacer, spacer.size wide, sheet thickness = spacer.height, one bolt hole; one per bolt."""
     bolt = bolt_clearance_mm(spec.fasteners.bolt, spec.fasteners.bolt_fit)
     return Flat(name="spacer", thickness=spec.spacer.height, thickness_measured=spec.spacer.thickness_measured,
-                kerf=sheet_kerf_mm(spec, "spacer"),
+                thickness_example=spec.spacer.thickness_example, sheet="spacer", kerf=sheet_kerf_mm(spec, "spacer"),
                 width=spec.spacer.size, depth=spec.spacer.size,
                 holes=(Hole(0.0, 0.0, bolt, "bolt", spec.fasteners.bolt_fit),),
                 quantity=len(plate_bolt_positions_mm(spec)), corner_radius=0.5)

@@ -29,12 +29,13 @@ def mount_depth_mm(spec) -> float:
     return spec.spacer.height + spec.mount.thickness
 
 
-def squeeze_range_mm(spec) -> tuple[float, float, float]:
+def squeeze_range_mm(spec, nominal: bool = False) -> tuple[float, float, float]:
     """Flange squeeze the clamp can produce over the guide sheet's tolerance: (low, high, tolerance) in mm.
 
     The flange is cast guide.thickness + squeeze thick; the clamp bottoms out on the locator, cut from the same
     sheet, so the real squeeze is the flange minus the real sheet (nominal ±
-    :func:`matcad.acoustics.uncertainty.sheet_tolerance_mm`)."""
-    tol = sheet_tolerance_mm(spec.guide.thickness, spec.guide.thickness_measured)
+    :func:`matcad.acoustics.uncertainty.sheet_tolerance_mm`). A measured sheet (or a template's example of one)
+    takes the calipering tolerance unless ``nominal``: what the sheet on the bench may really be until calipered."""
+    tol = sheet_tolerance_mm(spec.guide.thickness, spec.guide.thickness_measured and not nominal)
     s = spec.end_cap.flange_squeeze
     return s - tol, s + tol, tol

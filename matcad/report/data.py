@@ -14,8 +14,9 @@ from typing import TYPE_CHECKING
 
 from matcad import __version__
 from matcad.acoustics.geometry import drafted_cavity_volume_mm3, drafted_tip_diameter_mm
-from matcad.parts.features import (sheet_kerf_mm, bolt_nominal_mm, cap_volume_mm3, plate_bolt_positions_mm,
-                                   plate_dowel_positions_mm)
+from matcad.parts.features import (SHEET_STATUSES, bolt_nominal_mm, cap_volume_mm3, plate_bolt_positions_mm,
+                                   plate_dowel_positions_mm, sheet_kerf_mm)
+from matcad.parts.print_profile import PRINT_FILE
 from matcad.parts.stack import bolt_span_mm
 from matcad.report.fabrication import fabrication
 from matcad.report.files import manifest
@@ -27,8 +28,6 @@ if TYPE_CHECKING:
 
 HUB_CLEARANCE_MM = 3.0
 """Needle left below the mount's underside so the hub clears it."""
-NUT_HEIGHT_PER_D = 0.8
-"""ISO 4032 hex nut height ≈ 0.8 d."""
 THREAD_ENGAGEMENT_PER_D = 2.0
 """Self-tapping screws into printed plastic want ~2 x diameter of engagement."""
 
@@ -53,32 +52,33 @@ def as_built(spec) -> dict:
 
 
 def bill_of_materials(spec, flats: list[Flat], mold: MoldLayout | None) -> dict:
-    """Sheets, silicone, pins, bolts and needle needed for one taxel (plus the mold's batch); ``flats`` are the
-    laser parts the build cut, ``mold`` the mold's layout when it builds one (else None)."""
-    sheets = defaultdict(lambda: {"parts": [], "area_mm2": 0.0, "measured": False})
+    """Sheets, silicone, drills, pins, bolts and needles for the kit (the silicone as the casting guide pours it);
+    ``flats`` are the laser parts the build cut, ``mold`` the mold's layout when it builds one (else None). Fasteners
+    come as the stock length to buy (ISO 4762 screws, ISO 8734 dowels) with the length the stack needs."""
+    from matcad.parts.features import ISO_4762_LENGTHS_MM, ISO_8734_LENGTHS_MM, stock_length_mm
+
+    sheets = defaultdict(lambda: {"parts": [], "area_mm2": 0.0, "measured": False, "status": "measured"})
     for flat in flats:
         s = sheets[flat.thickness]
         s["parts"].append(f"{flat.quantity} x {flat.name}")
         s["area_mm2"] += flat.area_mm2 * flat.quantity
         s["measured"] = s["measured"] or flat.thickness_measured
-    from matcad.parts.casting import MIN_BATCH_G
-
-    cap = cap_volume_mm3(spec)
-    needed_g = cap * spec.mold.count * spec.silicone.waste_factor / 1000 * spec.silicone.density_g_cm3
-    batch_g = max(needed_g, MIN_BATCH_G)
+        s["status"] = max(s["status"], flat.thickness_status, key=SHEET_STATUSES.index)
     stack = bolt_span_mm(spec)
     bolt_d = bolt_nominal_mm(spec.fasteners.bolt)
     engage = min(THREAD_ENGAGEMENT_PER_D * bolt_d, spec.mount.thickness)
+    bolt_len = stock_length_mm(stack + engage, ISO_4762_LENGTHS_MM)
+    dowel_len = stock_length_mm(stack + engage, ISO_8734_LENGTHS_MM)
     return {
         "sheets": [{"thickness_mm": t, **v} for t, v in sorted(sheets.items())],
-        "silicone": {"cap_volume_mm3": cap, "cap_mass_g": cap / 1000 * spec.silicone.density_g_cm3,
-                     "caps_per_pour": spec.mold.count, "needed_mass_g": needed_g, "batch_mass_g": batch_g,
-                     "batch_ml": batch_g / spec.silicone.density_g_cm3,
-                     "density_g_cm3": spec.silicone.density_g_cm3},
+        "silicone": silicone_bom(spec),
+        "drills": drill_bom(spec),
         "dowels": {"count": len(plate_dowel_positions_mm(spec)), "diameter_mm": spec.fasteners.dowel_diameter,
-                   "min_length_mm": stack + engage},
+                   "min_length_mm": stack + engage, "length_mm": dowel_len, "standard": "ISO 8734"},
         "bolts": {"count": len(plate_bolt_positions_mm(spec)), "size": spec.fasteners.bolt,
-                  "min_length_mm": stack + engage, "note": "self-tapping into the printed mount"},
+                  "min_length_mm": stack + engage, "length_mm": bolt_len, "standard": "ISO 4762",
+                  "into_mount_mm": None if bolt_len is None else bolt_len - stack,
+                  "note": f"self-tapping into the printed mount ({spec.mount.thickness:g} mm)"},
         "spacers": ({"count": len(plate_bolt_positions_mm(spec)), "style": "laser",
                      "note": f"{spec.spacer.size:g} mm squares cut from {spec.spacer.height:g} mm sheet"}
                     if spec.spacer.style == "laser" else
@@ -89,17 +89,48 @@ def bill_of_materials(spec, flats: list[Flat], mold: MoldLayout | None) -> dict:
     }
 
 
+def silicone_bom(spec) -> dict:
+    """The silicone to buy and mix, the same numbers the casting guide pours (g, ml, mm³): per distinct cap its
+    taxels, volume and mass, then one pour of the mold."""
+    from matcad.parts.casting import casting_guide
+    from matcad.parts.mold_layout import cap_groups
+    from matcad.spec import taxel_spec, taxels
+
+    guide = casting_guide(spec)
+    rho = spec.silicone.density_g_cm3
+    caps = []
+    for group in cap_groups(taxels(spec)):
+        v = cap_volume_mm3(taxel_spec(spec, group[0]))
+        caps.append({"taxels": [t.name for t in group], "cap_volume_mm3": v, "cap_mass_g": v / 1000 * rho})
+    return {"caps": caps, "cap_volume_mm3": caps[0]["cap_volume_mm3"], "cap_mass_g": caps[0]["cap_mass_g"],
+            "caps_per_pour": guide.caps, "cast_volume_ml": guide.cast_volume_ml, "needed_mass_g": guide.needed_g,
+            "batch_mass_g": guide.batch_g, "batch_ml": guide.batch_g / rho, "density_g_cm3": rho}
+
+
+def drill_bom(spec) -> list[dict]:
+    """One twist drill per finished neck size, with the taxels it drills (mm); empty when the necks are cut to
+    size. Metric jobber drills (DIN 338) come in 0.1 mm steps: a size off that grid says so."""
+    from matcad.parts.neck_plate import drill_plan
+
+    sizes: dict[float, list[str]] = {}
+    for row in drill_plan(spec):
+        sizes.setdefault(round(row["drill_mm"], 4), []).append(row["taxel"])
+    return [{"diameter_mm": d, "taxels": names, "standard": abs(d * 10 - round(d * 10)) < 1e-6}
+            for d, names in sorted(sizes.items())]
+
+
 def casting(spec, mold: MoldLayout | None) -> dict | None:
     """The pour guide and the venting of the mold laid out as ``mold`` (mm, g, min, h, °C); None without a mold."""
     if mold is None:
         return None
     from matcad.parts.casting import casting_guide
+    from matcad.parts.mold_layout import appendages
 
     plan = mold.plan
     out = casting_guide(spec).to_dict() | {"venting": {
         "vent_reach_mm": spec.mold.vent_reach, "base_face_reach_mm": plan.reach_base_mm,
         "pin_end_reach_mm": plan.reach_tip_mm, "base_face_vents_per_cap": len(plan.inner) + len(plan.outer),
-        "pin_vents_per_cap": 1, "vent_diameter_mm": spec.mold.vent}}
+        "pin_vents_per_cap": 0, "vent_diameter_mm": spec.mold.vent}, "appendages": appendages(spec, mold)}
     from matcad.spec import is_array, taxels
 
     if is_array(spec):  # which caps each mold holds, and how many pours (or molds) one board takes
@@ -122,9 +153,13 @@ def needle_bom(spec) -> dict:
     board = (f" A board takes {count} needles, one bore per taxel; the mount has no manifold: feed each needle "
              "from its own regulated air line (or a splitter with a valve per line) so every jet can be set "
              "alone" if count > 1 else "")
+    from matcad.parts.features import NEEDLE_LENGTHS_MM, stock_length_mm
+
     return {"count": count, "outer_diameter_mm": spec.needle.outer_diameter, "theta_deg": spec.needle.theta_deg,
             "y_mm": spec.needle.y, "gauge": gauge, "gauge_od_mm": od, "hub": "Luer-lock hub, blunt (dispensing) tip",
-            "min_length_mm": through + HUB_CLEARANCE_MM, "protrusion_mm": needle_protrusion_mm(spec),
+            "min_length_mm": through + HUB_CLEARANCE_MM,
+            "length_mm": stock_length_mm(through + HUB_CLEARANCE_MM, NEEDLE_LENGTHS_MM),
+            "protrusion_mm": needle_protrusion_mm(spec),
             "note": f"nearest standard: {gauge} G ({od:.3f} mm, ISO 9626); measure yours and enter "
                     "needle.outer_diameter. Push it up the bore until its tip stands the stated protrusion out of "
                     "the mount's top face (along the needle; a caliper depth rod), then fix the hub" + board}
@@ -138,10 +173,15 @@ def kit_hardware(spec, mold: MoldLayout | None) -> dict:
 
     out = {}
     if mold is not None:
-        d = bolt_nominal_mm(spec.mold.bolt)
-        out["mold_clamp"] = {"count": len(mold.bolts), "size": spec.mold.bolt,
-                             "min_length_mm": mold.base_height + spec.mold.lid_thickness + NUT_HEIGHT_PER_D * d + 1.0,
-                             "nuts": len(mold.bolts), "washers": 2 * len(mold.bolts)}
+        c = mold.clamp
+        out["mold_clamp"] = {"count": len(mold.bolts), "size": spec.mold.bolt, "length_mm": c.length_mm,
+                             "standard": "ISO 4762", "nuts": len(mold.bolts), "nut_standard": "ISO 4032",
+                             "washers": len(mold.bolts),
+                             "note": ("captive: press each nut into its hex trap under the base after printing"
+                                      if c.open_below else "captive: the base print "
+                                      f"({PRINT_FILE.format(printer='fdm')}) pauses when its "
+                                      f"layers reach z = {c.pocket_top_z + mold.base_height:.2f} mm: drop each nut "
+                                      "into its pocket, resume")}
         out["release_agent"] = RELEASE_AGENT
     if spec.outputs.needle_mount:
         out["mount_fixing"] = {"count": len(ear_holes_mm(spec)), "size": FIXING_BOLT,
@@ -151,9 +191,10 @@ def kit_hardware(spec, mold: MoldLayout | None) -> dict:
 
 
 def make_report(spec, prediction, findings, holes, meshes, folder: Path, *, flats: list[Flat],
-                mold: MoldLayout | None) -> dict:
+                mold: MoldLayout | None, job: dict | None = None) -> dict:
     """The report's data for ``spec`` built into ``folder``: ``holes`` as cut and ``meshes`` (STL read-back
-    checks) from the writers, ``flats`` the laser parts cut, ``mold`` the mold's layout (None without a mold)."""
+    checks) from the writers, ``flats`` the laser parts cut, ``mold`` the mold's layout (None without a mold),
+    ``job`` the print job written (:func:`matcad.build.write_print_job`, None without one)."""
     return {
         "matcad_version": __version__,
         "name": spec.name,
@@ -164,7 +205,7 @@ def make_report(spec, prediction, findings, holes, meshes, folder: Path, *, flat
         "verdict": "fail" if any(f.level == "error" for f in findings) else "pass",
         "bom": bill_of_materials(spec, flats, mold),
         "casting": casting(spec, mold),
-        "fabrication": fabrication(spec, flats),
+        "fabrication": fabrication(spec, flats, job),
         "meshes": meshes,
         "files": manifest(folder),
     }

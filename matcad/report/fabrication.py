@@ -10,6 +10,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
+from matcad.parts.features import sheet_status
+from matcad.parts.print_profile import PRINT_FILE
 from matcad.parts.registry import Kind, wanted
 from matcad.parts.stack import squeeze_range_mm
 
@@ -33,18 +35,26 @@ def sheets_to_caliper(flats: list[Flat]) -> list[dict]:
         if flat.thickness in seen:  # parts listed plate, guides, spacer: a shared sheet keeps its first use
             continue
         seen.add(flat.thickness)
-        rows.append({"sheet_mm": flat.thickness, "part": flat.name, "measured": flat.thickness_measured,
-                     "tolerance_mm": sheet_tolerance_mm(flat.thickness, flat.thickness_measured),
+        status = flat.thickness_status
+        rows.append({"sheet_mm": flat.thickness, "part": flat.name, "sheet": flat.sheet, "status": status,
+                     "measured": status == "measured",
+                     "tolerance_mm": sheet_tolerance_mm(flat.thickness, status == "measured"),
                      "before_mold": flat.name.startswith("guide"), "why": WHY_CALIPER.get(flat.name, "")})
     return rows
 
 
 def seal(spec: Spec) -> dict:
-    """Flange squeeze over the guide sheet's tolerance (mm), as the rule ``seal.squeeze`` judges it."""
+    """Flange squeeze over the guide sheet's tolerance (mm), as the rule ``seal.squeeze`` judges it; for a
+    template's example sheet also the range until the user calipers theirs (over the nominal tolerance)."""
     lo, hi, tol = squeeze_range_mm(spec)
+    n_lo, n_hi, n_tol = squeeze_range_mm(spec, nominal=True)
+    status = sheet_status(spec, "guide")
     return {"flange_squeeze_mm": spec.end_cap.flange_squeeze, "guide_sheet_mm": spec.guide.thickness,
-            "guide_measured": spec.guide.thickness_measured, "sheet_tolerance_mm": tol,
-            "squeeze_low_mm": lo, "squeeze_high_mm": hi}
+            "guide_measured": status == "measured", "guide_status": status, "sheet_tolerance_mm": tol,
+            "squeeze_low_mm": lo, "squeeze_high_mm": hi,
+            "unverified_low_mm": n_lo if status == "example" else None,
+            "unverified_high_mm": n_hi if status == "example" else None,
+            "nominal_tolerance_mm": n_tol}
 
 
 def fits(spec: Spec, flats: list[Flat]) -> list[dict]:
@@ -56,9 +66,12 @@ def fits(spec: Spec, flats: list[Flat]) -> list[dict]:
 
     rows = []
     if spec.outputs.end_cap_mold:
-        k = spec.mold.key_diameter
-        rows.append({"id": "key", "fit": "mold key in lid socket (at the parting plane)",
-                     "hole_mm": k + 2 * spec.machine.key_clearance, "pin_mm": k, "clearance_mm": 2 * spec.machine.key_clearance,
+        from matcad.parts.end_cap_mold import RIB_ANGLES_DEG
+
+        k, c = spec.mold.key_diameter, spec.machine.key_clearance
+        rows.append({"id": "key", "fit": f"mold key in lid socket (at the parting plane): {len(RIB_ANGLES_DEG)} crush "
+                     f"ribs line-to-line with the key, {c:g} mm clearance per side between them; lid play 0",
+                     "hole_mm": k, "pin_mm": k, "clearance_mm": 0.0, "socket_mm": k + 2 * c,
                      "files": ["end_cap_mold_lid.stl", "end_cap_mold_base.stl"]})
     if spec.outputs.guides:
         locator = next(flat for flat in flats if flat.name == "guide_locator")
@@ -77,20 +90,40 @@ def fits(spec: Spec, flats: list[Flat]) -> list[dict]:
     return rows
 
 
-def steps(spec: Spec, caliper: list[dict]) -> list[dict]:
+SHEET_FILE = "sheet_{sheet}.dxf"
+"""Every part cut from one acrylic sheet, nested (:mod:`matcad.export.sheets`)."""
+SCALE_FILE = "sheets_1to1.pdf"
+"""The sheets at 1:1 on paper, to check the scale before cutting (:mod:`matcad.export.pdf`)."""
+
+
+def _drill_text(rows: list[dict]) -> str:
+    if len(rows) == 1:
+        r = rows[0]
+        return f"Drill the neck pilot ({r['pilot_mm']:g} mm as cut) to {r['drill_mm']:g} mm"
+    holes = "; ".join(f"{r['taxel']} {r['pilot_mm']:g} → {r['drill_mm']:g} mm" for r in rows)
+    return (f"Drill each neck pilot to its own finished size, engraved beside it (\"t1 Ø…\"): {holes} — one drill "
+            "per size (bill of materials); check each hole with the drill's shank before the next size")
+
+
+def steps(spec: Spec, caliper: list[dict], print_files: list[str] = ()) -> list[dict]:
     """The kit made and assembled in order: each step with what to do, on which sheet or machine, which files;
-    ``caliper`` is :func:`sheets_to_caliper` of the laser parts."""
+    ``caliper`` is :func:`sheets_to_caliper` of the laser parts, ``print_files`` the 3MF print jobs written. A
+    board's steps name its taxels as the parts are engraved."""
     from matcad.parts.features import SHEETS, sheet_kerf_mm, sheet_thickness_mm
+    from matcad.parts.neck_plate import drill_plan
+    from matcad.spec import taxels
 
     o, out = spec.outputs, []
+    board = len(taxels(spec)) > 1
 
     def step(where: str, files: list[str], do: str) -> None:
         out.append({"where": where, "files": files, "do": do})
 
-    unmeasured = [c for c in caliper if not c["measured"]]
+    unmeasured = [c for c in caliper if c["status"] != "measured"]
     step("calipers", [], "Caliper every sheet (table above) in several places; enter the values (neck.length, "
-         "guide.thickness, spacer.height), set *_measured = true and rebuild"
-         + (f" — still nominal: {', '.join(str(c['sheet_mm']) + ' mm' for c in unmeasured)}" if unmeasured else ""))
+         "guide.thickness, spacer.height), set *_measured = true (and *_example = false) and rebuild"
+         + (" — still to caliper: " + ", ".join(f"{c['sheet_mm']:g} mm ({c['status']})" for c in unmeasured)
+            if unmeasured else ""))
     step("laser + printer", ["matcad coupon"], "Cut one coupon per sheet (coupon_<sheet>.dxf) and print "
          "coupon_printed.stl; set each sheet's laser_kerf from the hole that fits its pin, and the needle/dowel "
          "fits from the printed bores; rebuild")
@@ -99,34 +132,64 @@ def steps(spec: Spec, caliper: list[dict]) -> list[dict]:
         cuts.setdefault(part.sheet, []).append(f"{part.name}.dxf")
     for sheet, files in cuts.items():
         t, _ = sheet_thickness_mm(spec, sheet)
-        step(f"laser, {t:g} mm acrylic", files, f"Cut the {SHEETS[sheet]} from the {t:g} mm sheet, kerf "
-             f"{sheet_kerf_mm(spec, sheet):g} mm (already compensated in the file: cut on the line; inner "
-             "cuts first, engraving as score)")
-    if o.neck_plate and spec.plate.neck_pilot:
-        step("drill", ["neck_plate.dxf"], f"Drill the neck pilot to {spec.neck.diameter:g} mm (drill press, "
-             "plate clamped flat, back it with scrap)")
-    printed = [f"{part.name}.stl" for part in wanted(spec, Kind.PRINTED)]
+        step(f"laser, {t:g} mm acrylic", [SHEET_FILE.format(sheet=sheet), *files],
+             f"Check the scale first ({SCALE_FILE} printed at 100 %: its 10 mm square measures 10.0 mm), then cut "
+             f"the {SHEETS[sheet]} from the {t:g} mm sheet, all nested in {SHEET_FILE.format(sheet=sheet)}, kerf "
+             f"{sheet_kerf_mm(spec, sheet):g} mm (already compensated in the file: cut on the line; engrave first, "
+             "then the inner cuts, the outlines last)")
+    drills = drill_plan(spec)
+    if drills:
+        step("drill", ["neck_plate.dxf"], _drill_text(drills) + " (drill press, plate clamped flat, backed with "
+             "scrap)")
+    printed = [part for part in wanted(spec, Kind.PRINTED)]
     if printed:
-        step(f"printer ({spec.machine.printer})", printed, "Print each part as exported (flat face down, no "
-             "supports; the report's mesh table gives each part's bed face)")
+        jobs = list(print_files) or [PRINT_FILE.format(printer=spec.machine.printer)]
+        step(f"printer ({spec.machine.printer})", [*jobs, *(f"{part.name}.stl" for part in printed)],
+             _print_text(spec, [part.name for part in printed], jobs))
     if o.end_cap_mold:
         step("bench", ["end_cap_mold_base.stl", "end_cap_mold_lid.stl"], "Cast the caps: follow the casting guide")
     if o.needle_mount:
         step("bench", ["needle_mount.stl"], "Fix the mount by its ears (4 x M3) to the bench or robot; press the "
-             f"dowels into it; slide the needle up the bore until its tip stands out of the top face as the BOM "
-             "states; fix the hub")
+             "dowels into it; slide " + ("each needle up the bore labelled with its taxel on the mount's top face "
+                                         if board else "the needle up the bore ")
+             + "until its tip stands out of the top face as the BOM states; fix the hub")
     stack = "spacers (spacer.dxf) over the bolt holes, " if spec.spacer.style == "laser" else ""
+    seat = ("seat each cap in the locator hole engraved with its taxel, base face down on the plate"
+            if board else "seat the cap in the locator, base face down on the plate")
     step("bench", ["neck_plate.dxf", "guide_locator.dxf", "guide_clamp.dxf"], f"Stack on the mount: {stack}"
-         "the neck plate, the locator guide; seat the cap in the locator, base face down on the plate; lay the "
-         f"clamp guide over its flange; {spec.fasteners.bolt} bolts through all layers into the mount, tightened "
+         f"the neck plate, the locator guide; {seat}; lay the clamp guide over the flange"
+         f"{'s' if board else ''}; {spec.fasteners.bolt} bolts through all layers into the mount, tightened "
          "evenly until the clamp sits on the locator (that closes the flange squeeze)")
     step("bench", ["report.md"], "Blow air through the needle and record: the tone should sit in the predicted "
          "band; calibrate with `matcad calibrate`")
     return out
 
 
-def fabrication(spec: Spec, flats: list[Flat]) -> dict:
-    """The report's fabrication section for the laser parts ``flats``: sheets to caliper, the seal, the fits, the
-    ordered steps."""
+def _print_text(spec: Spec, names: list[str], jobs: list[str]) -> str:
+    """The print step: the 3MF job(s) with each part's settings, the captive nuts, the STL fallback."""
+    from matcad.parts.mold_layout import layout
+    from matcad.parts.print_profile import profile
+
+    printer = spec.machine.printer
+    parts = "; ".join(f"{n}: {p.layer_mm:g} mm layers, " + (f"{p.walls} walls, {p.infill_pct:g} % infill"
+                                                            if p.walls else "solid")
+                      for n in names for p in [profile(printer, n)])
+    text = (f"Open {' then '.join(jobs)} in the slicer ({'one bed load each' if len(jobs) > 1 else 'one bed'}): "
+            f"each part lies on its bed face, with its settings ({parts}; {profile(printer, names[0]).material})")
+    if spec.outputs.end_cap_mold:
+        lay = layout(spec)
+        c = lay.clamp
+        text += (f"; the mold base pauses when its layers reach {c.pocket_top_z + lay.base_height:.2f} mm: drop an "
+                 f"{c.bolt} nut into each of its {len(lay.bolts)} hex pockets and resume (the next layer closes "
+                 "them over the nuts)" if not c.open_below else
+                 f"; after printing press an {c.bolt} nut into each of the {len(lay.bolts)} hex traps under the mold "
+                 "base, up to the trap's top")
+    return text + ". No supports: the STLs are the same parts in the same poses"
+
+
+def fabrication(spec: Spec, flats: list[Flat], job: dict | None = None) -> dict:
+    """The report's fabrication section for the laser parts ``flats`` and the print ``job`` written (its 3MF
+    files): sheets to caliper, the seal, the fits, the ordered steps."""
     caliper = sheets_to_caliper(flats)
-    return {"caliper": caliper, "seal": seal(spec), "fits": fits(spec, flats), "steps": steps(spec, caliper)}
+    return {"caliper": caliper, "seal": seal(spec), "fits": fits(spec, flats),
+            "steps": steps(spec, caliper, [f["file"] for f in (job or {}).get("files", ())])}

@@ -42,11 +42,15 @@ def _fabrication_markdown(f: dict | None) -> list[str]:
     s = f["seal"]
     lines = ["", "## Fabrication", "", "Caliper these sheets before cutting — the guide sheet before printing the mold:",
              "", "| sheet [mm] | first part | tolerance [mm] | measured | why |", "|---:|---|---:|---|---|"]
-    lines += [f"| {c['sheet_mm']:g} | {c['part']} | ±{c['tolerance_mm']:.2f} | {'yes' if c['measured'] else '**no**'} | "
+    status = {"measured": "yes", "example": "**no** (example value)", "nominal": "**no**"}
+    lines += [f"| {c['sheet_mm']:g} | {c['part']} | ±{c['tolerance_mm']:.2f} | {status[c['status']]} | "
               f"{cell(c['why'])} |" for c in f["caliper"]]
     lines += ["", f"Seal: the flange is cast {s['guide_sheet_mm']:g} + {s['flange_squeeze_mm']:g} mm thick; over the "
               f"guide sheet's ±{s['sheet_tolerance_mm']:.2f} mm the clamp squeezes it {s['squeeze_low_mm']:+.2f} … "
-              f"{s['squeeze_high_mm']:+.2f} mm ({'measured' if s['guide_measured'] else 'nominal'} sheet)."]
+              f"{s['squeeze_high_mm']:+.2f} mm ({s['guide_status']} sheet)"
+              + (f"; **unverified**: until you caliper your own sheet it may be {s['unverified_low_mm']:+.2f} … "
+                 f"{s['unverified_high_mm']:+.2f} mm (nominal ±{s['nominal_tolerance_mm']:.2f} mm)."
+                 if s["guide_status"] == "example" else ".")]
     lines += ["", "Steps, in order:", ""]
     lines += [f"{i}. **{cell(s['where'])}** — {cell(s['do'])}" + (f" (`{'`, `'.join(s['files'])}`)" if s["files"] else "")
               for i, s in enumerate(f["steps"], 1)]
@@ -65,14 +69,55 @@ def _casting_markdown(c: dict | None) -> list[str]:
              f"{c['caps']} cap(s) of {c['grade']} in a {c['mold_material']} mold: mix **{c['batch_g']:.1f} g** "
              f"({c['mix_ratio']}) — {c['batch_reason']}. Pot life {c['pot_life_min']:g} min; cure "
              f"{c['cure_h_room']:g} h at 23 °C or warm at most {c['max_cure_c']:g} °C.", "",
-             f"Venting: every ceiling of each cavity in pour orientation reaches an opening within "
+             f"Venting: every ceiling of each cavity in pour orientation reaches an escape within "
              f"{v['vent_reach_mm']:g} mm — base face {v['base_face_reach_mm']:.2f} mm ({v['base_face_vents_per_cap']} "
-             f"vents + the fill port), core-pin end over the membrane {v['pin_end_reach_mm']:.2f} mm (a vent along "
-             "the pin).", ""]
+             f"vents + the fill port), core-pin end over the membrane {v['pin_end_reach_mm']:.2f} mm (to its rim, "
+             "where the pin's side rises to the base face: no vent through the pin). Cast beyond the cap: "
+             + ", ".join(f"{a['taxel']} {a['sprues']} sprues ≤ {a['sprue_mm3']:.1f} mm³ on the sealing face, "
+                         f"{a['inside_cavity_mm3']:.3f} mm³ inside the cavity" for a in c["appendages"]) + ".", ""]
     if c["inhibition"]:
         lines += [f"**SLA cure inhibition:** {c['inhibition']}.", ""]
     lines += [f"{i}. {step}" for i, step in enumerate(c["steps"], 1)]
     lines += ["", "Trim:", ""] + [f"- {t}" for t in c["trim"]]
+    return lines
+
+
+def _stock(length) -> str:
+    """A stock length (mm) as the BOM prints it; '?' when no stock length is long enough."""
+    return "?" if length is None else f"{length:g}"
+
+
+def _silicone_markdown(s: dict) -> list[str]:
+    caps = "; ".join(f"{', '.join(c['taxels'])}: {c['cap_volume_mm3']:.1f} mm³ ({c['cap_mass_g']:.2f} g)"
+                     for c in s["caps"]) if len(s["caps"]) > 1 else (
+        f"{s['cap_volume_mm3']:.1f} mm³ ({s['cap_mass_g']:.2f} g) per cap")
+    return [f"- silicone: {caps}; one pour of {s['caps_per_pour']} cap(s) casts {s['cast_volume_ml']:.3f} ml and "
+            f"needs {s['needed_mass_g']:.2f} g with cup, sprues and vents; mix {s['batch_mass_g']:.1f} g "
+            f"({s['batch_ml']:.1f} ml)"]
+
+
+def _drills_markdown(drills: list[dict]) -> list[str]:
+    return [f"- twist drill Ø{d['diameter_mm']:g} mm (HSS jobber, DIN 338{'' if d['standard'] else '; not a 0.1 mm step: ream'}) "
+            f"for the neck pilot{'s' if len(d['taxels']) > 1 else ''} of {', '.join(d['taxels'])}" for d in drills]
+
+
+def _files_to_make_markdown(sheets: list[dict] | None, job: dict | None) -> list[str]:
+    """The cut files (one per sheet, nested) and the print job (one 3MF, each part with its settings)."""
+    lines = []
+    if sheets:
+        lines += ["", "## Cut files, one per sheet", "",
+                  "Each sheet's parts nested in one file (engraving, then inner cuts, outlines last); "
+                  "`sheets_1to1.pdf` draws them at 1:1 to check the scale on paper first.", "",
+                  "| sheet | file | parts | kerf [mm] | size [mm] | PDF page |", "|---|---|---|---:|---|---|"]
+        lines += [f"| {s['thickness_mm']:g} mm | `{s['file']}` | {', '.join(s['parts'])} | {s['kerf_mm']:g} | "
+                  f"{s['width_mm']:.1f} × {s['height_mm']:.1f} | {s['pdf_page']['page']} |" for s in sheets]
+    if job:
+        lines += ["", f"## Print job ({job['printer']})", "",
+                  "| file | part | settings | material |", "|---|---|---|---|"]
+        lines += [f"| `{f['file']}` | {o['name']} | {cell(', '.join(f'{k} {v}' for k, v in o['settings'].items()))} | "
+                  f"{cell(o['material'])} |" for f in job["files"] for o in f["objects"]]
+        lines += [f"- pause after the layer at z = {p['after_layer_z_mm']:.2f} mm ({p['part']}): {p['message']}"
+                  for f in job["files"] for p in f["pauses"]]
     return lines
 
 
@@ -133,30 +178,31 @@ def sections(r: dict) -> str:
     lines += ["", "## Design rules", "", "| level | rule | part | message | fix |", "|---|---|---|---|---|"]
     lines += [f"| {f['level']} | {f['id']} | {_part_link(f, r)} | {cell(f['message'])} | {cell(f['fix'])} |"
               for f in r["findings"]]
-    s = bom["silicone"]
     lines += ["", "## Bill of materials", ""]
-    lines += [f"- acrylic {sh['thickness_mm']:g} mm{' (measured)' if sh['measured'] else ''}: "
+    sheet_note = {"measured": " (measured)", "example": " (example value: caliper yours)", "nominal": ""}
+    lines += [f"- acrylic {sh['thickness_mm']:g} mm{sheet_note[sh['status']]}: "
               f"{', '.join(sh['parts'])} — {sh['area_mm2'] / 100:.1f} cm²" for sh in bom["sheets"]]
-    lines += [f"- silicone: {s['cap_volume_mm3']:.1f} mm³ ({s['cap_mass_g']:.2f} g) per cap; mix "
-              f"{s['batch_mass_g']:.1f} g ({s['batch_ml']:.1f} ml) for {s['caps_per_pour']} cap(s), of which "
-              f"{s['needed_mass_g']:.2f} g fills caps, sprues and cup",
-              f"- {bom['dowels']['count']} dowel pins Ø{bom['dowels']['diameter_mm']:g} mm, ≥ "
-              f"{bom['dowels']['min_length_mm']:.1f} mm long",
+    lines += _silicone_markdown(bom["silicone"]) + _drills_markdown(bom["drills"])
+    n, d, b = bom["needle"], bom["dowels"], bom["bolts"]
+    lines += [f"- {d['count']} × dowel pin Ø{d['diameter_mm']:g} × {_stock(d['length_mm'])} mm ({d['standard']}; "
+              f"the stack needs ≥ {d['min_length_mm']:.2f} mm)",
               f"- {bom['spacers']['count']} spacers: {bom['spacers']['note']}",
-              f"- {bom['bolts']['count']} × {bom['bolts']['size']} bolts, ≥ {bom['bolts']['min_length_mm']:.1f} mm "
-              f"({bom['bolts']['note']})",
-              f"- needle Ø{bom['needle']['outer_diameter_mm']:g} mm ({bom['needle']['gauge']} G), "
-              f"{bom['needle']['hub']}, ≥ {bom['needle']['min_length_mm']:.1f} mm long, at θ = "
-              f"{bom['needle']['theta_deg']:g}°, y = {bom['needle']['y_mm']:g} mm; tip "
-              f"{bom['needle']['protrusion_mm']:.2f} mm out of the mount's top face ({bom['needle']['note']})"]
+              f"- {b['count']} × {b['size']} × {_stock(b['length_mm'])} mm socket head screws ({b['standard']}; the "
+              f"stack needs ≥ {b['min_length_mm']:.2f} mm; {b['note']}"
+              + (f", {b['into_mount_mm']:.1f} mm into it)" if b["into_mount_mm"] is not None else ")"),
+              f"- {n['count']} × needle Ø{n['outer_diameter_mm']:g} mm ({n['gauge']} G), {n['hub']}, "
+              f"{_stock(n['length_mm'])} mm long (≥ {n['min_length_mm']:.1f} mm), at θ = {n['theta_deg']:g}°, "
+              f"y = {n['y_mm']:g} mm; tip {n['protrusion_mm']:.2f} mm out of the mount's top face ({n['note']})"]
     if "mold_clamp" in bom:
         c = bom["mold_clamp"]
-        lines += [f"- mold clamp: {c['count']} × {c['size']} bolts ≥ {c['min_length_mm']:.0f} mm, {c['nuts']} nuts, "
+        lines += [f"- mold clamp: {c['count']} × {c['size']} × {_stock(c['length_mm'])} mm socket head screws "
+                  f"({c['standard']}), {c['nuts']} × {c['size']} hex nuts ({c['nut_standard']}, {c['note']}), "
                   f"{c['washers']} washers", f"- release agent: {bom['release_agent']}"]
     if "mount_fixing" in bom:
         f = bom["mount_fixing"]
         lines.append(f"- mount fixing: {f['count']} × {f['size']} screws {f['note']}")
     lines += _fabrication_markdown(r.get("fabrication"))
+    lines += _files_to_make_markdown(r.get("sheets"), r.get("print_job"))
     lines += _casting_markdown(r.get("casting"))
     lines += _taxels_markdown(board)
     lines += ["", "## Files", "", "| file | bytes | sha256 |", "|---|---:|---|"]

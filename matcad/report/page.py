@@ -13,7 +13,8 @@ import html
 from matcad.report.markdown import cell, part_anchor, sections
 
 KNOWN_KEYS = frozenset({"matcad_version", "name", "spec", "as_built", "prediction", "findings", "verdict", "bom",
-                        "meshes", "files", "figures", "casting", "fabrication", "bands", "taxels"})
+                        "meshes", "files", "figures", "casting", "fabrication", "bands", "taxels", "sheets",
+                        "print_job"})
 """Report keys rendered by :func:`matcad.report.markdown.sections` or as pictures; every other key is rendered
 generically (a list as a numbered list, a list of tables as a table, a table as key: value lines)."""
 STYLE = """

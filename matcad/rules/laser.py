@@ -39,6 +39,8 @@ def feature_and_web(spec) -> list[Finding]:
     return out
 
 
+SHEET_THICKNESS_FIELDS = {"plate": "neck.length", "guide": "guide.thickness", "spacer": "spacer.height"}
+"""The spec field that holds each sheet's thickness."""
 HOLE_FIELDS = {"neck": "neck.diameter", "neck_pilot": "plate.pilot_undersize", "dowel": "fasteners.dowel_diameter",
                "bolt": "fasteners.bolt", "cap": "end_cap.outer_diameter"}
 """The spec field that sets each hole purpose's size (what the user changes to fix a drawn size)."""
@@ -96,7 +98,15 @@ def stock_thickness(spec) -> list[Finding]:
         if flat.thickness in seen:
             continue
         seen.add(flat.thickness)
-        if flat.thickness_measured:
+        if flat.thickness_status == "example":
+            tol = sheet_tolerance_mm(flat.thickness, False)
+            field = SHEET_THICKNESS_FIELDS[flat.sheet]
+            out.append(Finding("laser.stock", "warning", flat.thickness, "measured",
+                               f"{flat.name}: unverified: {field} = {flat.thickness:g} mm is the template's example of "
+                               f"a calipered sheet, not yours; every number built on it assumes your sheet is "
+                               f"{flat.thickness:g} mm (nominal stock may be off by +-{tol:.2f} mm, ISO 7823-1)",
+                               f"caliper the sheet, enter {field}, set {flat.sheet}.thickness_example = false"))
+        elif flat.thickness_measured:
             out.append(Finding("laser.stock", "info", flat.thickness, "measured",
                                f"{flat.name}: {flat.thickness:g} mm sheet taken as measured", ""))
         elif not is_stock_sheet(flat.thickness):

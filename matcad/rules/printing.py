@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from matcad.parts.casting import MIN_BATCH_G, MOLD_MATERIALS, casting_guide
 from matcad.parts.coupon import FDM_THETA_MIN_DEG
-from matcad.parts.mold_layout import pin_tip_radius_mm, plan_vents
+from matcad.parts.mold_layout import NUT_ROOF_MM, appendages, layout, plan_vents
 from matcad.rules.finding import Finding
 
 MIN_WALL_SLA_MM = 0.8
@@ -71,15 +71,17 @@ def fill_and_vents(spec) -> list[Finding]:
         out.append(Finding("mold.vents", "warning", m.vent, 2 * spec.machine.nozzle,
                            f"{m.vent:g} mm vents may print closed with a {spec.machine.nozzle:g} mm nozzle",
                            "enlarge mold.vent or drill the vents open"))
-    pin_wall = (2 * pin_tip_radius_mm(spec) - m.vent) / 2
-    if pin_wall < _min_wall_mm(spec):
-        out.append(Finding("mold.pin_vent", "error", round(pin_wall, 4), _min_wall_mm(spec),
-                           f"the vent along the core pin leaves a {pin_wall:.2f} mm wall at the pin's end",
-                           "reduce mold.vent"))
     plan = plan_vents(spec)
     n = len(plan.inner) + len(plan.outer)
     reach = max(plan.reach_base_mm, plan.reach_tip_mm)
-    if not plan.feasible:
+    if plan.reach_tip_mm > m.vent_reach:
+        out.append(Finding("mold.vent_reach", "error", round(plan.reach_tip_mm, 3), m.vent_reach,
+                           f"the core pin's end face (over the membrane) is {2 * plan.reach_tip_mm:.2f} mm wide: its "
+                           f"centre lies {plan.reach_tip_mm:.2f} mm from the rim where a bubble can rise, more than "
+                           f"{m.vent_reach:g} mm; a vent through the pin would cast a thread inside the cavity",
+                           "raise mold.vent_reach (degas the mix and pour slowly), or narrow the cavity "
+                           "(cavity.diameter, mold.draft_deg)"))
+    elif not plan.feasible:
         out.append(Finding("mold.vent_reach", "error", round(reach, 3), m.vent_reach,
                            f"no vent layout brings every cavity ceiling within {m.vent_reach:g} mm of an opening "
                            f"(best: {reach:.2f} mm with {n} vents per cap): bubbles would stay in the cap",
@@ -87,9 +89,46 @@ def fill_and_vents(spec) -> list[Finding]:
     else:
         out.append(Finding("mold.vent_reach", "info", round(reach, 3), m.vent_reach,
                            f"per cap: {n} vents over the base face (farthest ceiling point "
-                           f"{plan.reach_base_mm:.2f} mm from an opening) and one along the core pin (its end face "
-                           f"over the membrane within {plan.reach_tip_mm:.2f} mm); fill port over the body wall", ""))
+                           f"{plan.reach_base_mm:.2f} mm from an opening); the core pin's end face over the membrane "
+                           f"vents round its rim and up the pin (every point within {plan.reach_tip_mm:.2f} mm of "
+                           "the rim), no vent through the pin; fill port over the body wall", ""))
     return out
+
+
+def cavity_appendages(spec) -> list[Finding]:
+    """Nothing may be cast inside a cap's cavity (its acoustic volume): every opening over a cap position is
+    measured against the core pin it stands over (:func:`matcad.parts.mold_layout.appendages`). Silicone inside is
+    an error (a thread on the membrane changes the volume and the pitch, and tears the membrane when pulled out);
+    the sprues on the sealing face are an info line with their count and volume, trimmed flush."""
+    if not spec.outputs.end_cap_mold:
+        return []
+    rows = appendages(spec)
+    inside = [r for r in rows if r["inside_cavity_mm3"] > 1e-9]
+    if inside:
+        worst = max(inside, key=lambda r: r["inside_cavity_mm3"])
+        return [Finding("mold.cavity_appendage", "error", round(worst["inside_cavity_mm3"], 4), 0.0,
+                        f"{worst['taxel']}'s cap would carry {worst['inside_cavity_mm3']:.2f} mm³ of silicone cast "
+                        "inside its cavity (an opening runs down into the core pin): it changes the acoustic volume "
+                        "and tears the membrane when pulled out", "vent the pin's end round its rim, not through it")]
+    worst = max(rows, key=lambda r: r["sprue_mm3"])
+    return [Finding("mold.cavity_appendage", "info", 0.0, 0.0,
+                    f"per cap: 0 mm³ cast inside the cavity; {worst['sprues']} sprues (fill port and vents, at most "
+                    f"{worst['sprue_mm3']:.1f} mm³) stand on the sealing face, trimmed flush after demolding", "")]
+
+
+def clamp_nut(spec) -> list[Finding]:
+    """The mold base must be tall enough for its captive clamp nuts: a stock bolt that reaches through the nut,
+    with material above the pocket to carry the clamp and under it on FDM."""
+    if not spec.outputs.end_cap_mold:
+        return []
+    lay = layout(spec)
+    c = lay.clamp
+    if c.length_mm is None:
+        return [Finding("mold.clamp_nut", "error", round(lay.base_height, 3), "a captive nut",
+                        f"the {lay.base_height:.2f} mm mold base cannot hold a captive {c.bolt} nut "
+                        f"({c.nut_height_mm:g} mm) with {NUT_ROOF_MM:g} mm above it for any stock bolt length",
+                        "raise mold.floor, or choose a smaller mold.bolt")]
+    return []
 
 
 def cap_wall(spec) -> list[Finding]:
@@ -135,6 +174,7 @@ def sla_inhibition(spec) -> list[Finding]:
                     "cast a test drop")]
 
 
-RULES = (printable_walls, key_clearance, fill_and_vents, cap_wall, silicone_batch, sla_inhibition, bore_overhang)
+RULES = (printable_walls, key_clearance, fill_and_vents, cap_wall, silicone_batch, sla_inhibition, bore_overhang,
+         cavity_appendages, clamp_nut)
 TAXEL_RULES = (fill_and_vents, cap_wall, bore_overhang)
 """The rules that read one taxel's own geometry: a board runs them on each taxel (:func:`matcad.rules.check`)."""

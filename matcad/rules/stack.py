@@ -70,16 +70,22 @@ def needle_window(spec) -> list[Finding]:
     return out
 
 
+CALIPER_GUIDE = ("caliper the guide sheet BEFORE printing the mold, enter guide.thickness and set "
+                 "guide.thickness_measured = true")
+
+
 def seal_squeeze(spec) -> list[Finding]:
-    """The cap's flange must stay squeezed whatever the guide sheet really is, and not be crushed."""
+    """The cap's flange must stay squeezed whatever the guide sheet really is, and not be crushed. A template's
+    example value (``guide.thickness_example``) is judged as the calipered sheet it stands for, and is reported
+    unverified: the squeeze over the nominal sheet's tolerance, as a warning, until the user enters their own."""
     lo, hi, tol = squeeze_range_mm(spec)
     g = spec.guide
     flange = cap_flange_thickness_mm(spec)
-    what = "measured" if g.thickness_measured else "nominal, ISO 7823-1 cast sheet"
+    example = g.thickness_measured and g.thickness_example
+    what = ("an example value" if example else "measured") if g.thickness_measured else "nominal, ISO 7823-1 cast sheet"
     span = f"{lo:+.2f} … {hi:+.2f} mm over the guide sheet's ±{tol:.2f} mm ({g.thickness:g} mm {what})"
     if lo <= 0:
-        fix = ("caliper the guide sheet BEFORE printing the mold, enter guide.thickness and set "
-               "guide.thickness_measured = true" if not g.thickness_measured else
+        fix = (CALIPER_GUIDE if not g.thickness_measured else
                f"raise end_cap.flange_squeeze above the {tol:g} mm measuring tolerance")
         return [Finding("seal.squeeze", "error" if spec.outputs.end_cap_mold else "warning", round(lo, 4), "> 0",
                         f"the {spec.end_cap.flange_squeeze:g} mm flange squeeze can be swallowed: squeeze {span}; "
@@ -89,6 +95,14 @@ def seal_squeeze(spec) -> list[Finding]:
         return [Finding("seal.squeeze", "warning", round(strain, 3), MAX_FLANGE_STRAIN,
                         f"the flange may be crushed by {100 * strain:.0f} % (squeeze {span})",
                         "reduce end_cap.flange_squeeze, or caliper the guide sheet")]
+    if example:
+        n_lo, n_hi, n_tol = squeeze_range_mm(spec, nominal=True)
+        return [Finding("seal.squeeze", "warning", [round(n_lo, 4), round(n_hi, 4)], "> 0",
+                        f"unverified: guide.thickness = {g.thickness:g} mm is the template's example of a calipered "
+                        f"sheet, not yours; until you caliper it the flange squeeze is {n_lo:+.2f} … {n_hi:+.2f} mm "
+                        f"over a nominal sheet's ±{n_tol:.2f} mm (ISO 7823-1): the clamp may never touch the "
+                        f"flange (calipered, {lo:+.2f} … {hi:+.2f} mm)",
+                        CALIPER_GUIDE + " and guide.thickness_example = false")]
     return [Finding("seal.squeeze", "info", [round(lo, 4), round(hi, 4)], "> 0",
                     f"flange squeeze {span}: {100 * lo / flange:.1f}-{100 * strain:.1f} % of the "
                     f"{flange:g} mm flange", "")]

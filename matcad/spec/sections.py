@@ -55,6 +55,10 @@ class Plate(Section):
     depth: float = length_mm("neck plate depth (y), neck at its centre", 24.0)
     thickness_measured: bool = param("true if neck.length is the measured sheet thickness (cast acrylic "
                                      "varies +-(0.4 + 0.1 t) mm, ISO 7823-1)", default=False, kind="bool")
+    thickness_example: bool = param("true if neck.length (with thickness_measured = true) is an example value, a "
+                                    "template's stand-in for a calipered sheet: predictions use it as measured, "
+                                    "`check` reports it unverified until you enter yours and set this false",
+                                    default=False, kind="bool")
     label: str = param("text engraved on the neck plate ('' for none)", default="", kind="text")
     neck_pilot: bool = param("cut the neck as an undersize pilot, to be drilled to neck.diameter "
                              "(avoids the laser's taper in thick sheet)", default=False, kind="bool")
@@ -76,6 +80,10 @@ class Guide(Section):
     thickness: float = length_mm("guide sheet thickness (paper: 1.5 mm acrylic)", 1.5)
     thickness_measured: bool = param("true if guide.thickness is a measured value", default=False,
                                      kind="bool")
+    thickness_example: bool = param("true if guide.thickness (with thickness_measured = true) is an example value, a "
+                                    "template's stand-in for a calipered sheet: predictions use it as measured, "
+                                    "`check` reports it unverified until you enter yours and set this false",
+                                    default=False, kind="bool")
     laser_kerf: float | None = param("full kerf in the guide sheet; default machine.laser_kerf (kerf "
                                      "grows with sheet thickness: measure each sheet with `matcad coupon`)",
                                      "mm", None, lo=0.0, hi=5.0, lo_open=False)
@@ -94,6 +102,10 @@ class Spacer(Section):
     size: float = length_mm("spacer square side / standoff diameter", 5.0)
     thickness_measured: bool = param("true if spacer.height is a measured sheet thickness", default=False,
                                      kind="bool")
+    thickness_example: bool = param("true if spacer.height (with thickness_measured = true) is an example value, a "
+                                    "template's stand-in for a calipered sheet: predictions use it as measured, "
+                                    "`check` reports it unverified until you enter yours and set this false",
+                                    default=False, kind="bool")
     laser_kerf: float | None = param("full kerf in the spacer sheet; default machine.laser_kerf (kerf "
                                      "grows with sheet thickness: measure each sheet with `matcad coupon`)",
                                      "mm", None, lo=0.0, hi=5.0, lo_open=False)
