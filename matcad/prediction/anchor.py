@@ -57,7 +57,7 @@ def _temperature_line(spec, f0_hz: float) -> list[BudgetLine]:
     if spec.air.speed_of_sound is not None:
         return []
     kelvin = spec.air.temperature_c + 273.15
-    low, high = (f0_hz * (math.sqrt((kelvin + s * TEMPERATURE_TOL_C) / kelvin) - 1) for s in (-1, 1))
+    low, high = (f0_hz * (math.sqrt(max(kelvin + s * TEMPERATURE_TOL_C, 0.0) / kelvin) - 1) for s in (-1, 1))
     return [BudgetLine("air temperature", f"{spec.air.temperature_c:g} +-{TEMPERATURE_TOL_C:g} C", low, high)]
 
 
