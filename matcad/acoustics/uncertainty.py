@@ -225,7 +225,8 @@ def total(lines: list[BudgetLine], f0_hz: float) -> tuple[float, float]:
 
 def combine(lows, highs, f0_hz):
     """:func:`total` on shifts that may be arrays of variants (Hz): (low, high) offsets from ``f0_hz``."""
-    def rss(shifts):
-        return np.sqrt(sum(np.log1p(np.asarray(x) / f0_hz) ** 2 for x in shifts))
+    def rss(shifts):  # a shift of -f0 (a band reaching 0 Hz) is ln 0 = -inf: the band's low end is then 0 Hz
+        with np.errstate(divide="ignore"):
+            return np.sqrt(sum(np.log1p(np.asarray(x) / f0_hz) ** 2 for x in shifts))
 
     return f0_hz * np.expm1(-rss(lows)), f0_hz * np.expm1(rss(highs))
