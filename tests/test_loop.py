@@ -246,5 +246,14 @@ def test_force_interval_coverage_with_hysteresis(cycles, tau_n, cycle_std_n, low
 
 
 def test_between_cycle_variance_recovered():
-    estimates = [fit(*_cycles(s, 4, 0.7)[:2], K, cycles=_cycles(s, 4, 0.7)[2]).cycle_std_n for s in range(60)]
+    """The cycles' own estimate recovers τ; the value used pools it with the prior (issue 24: 1.3 N over 0-20 N,
+    worth PRIOR_CYCLES degrees of freedom), so it lies between the two, at the weighted mean of the variances."""
+    from matcad.acoustics.eq5fit import PRIOR_CYCLES
+
+    fits = [fit(*_cycles(s, 4, 0.7)[:2], K, cycles=_cycles(s, 4, 0.7)[2]) for s in range(60)]
+    estimates = [f.cycle_std_data_n for f in fits]
     assert 0.4 < np.median(estimates) < 1.0, np.median(estimates)
+    for f in fits:
+        assert f.cycle_prior_n == pytest.approx(20.0 / 15.4)
+        pooled = (PRIOR_CYCLES * f.cycle_prior_n ** 2 + 3 * f.cycle_std_data_n ** 2) / (PRIOR_CYCLES + 3)
+        assert f.cycle_std_n == pytest.approx(np.sqrt(pooled), rel=0.02)  # τ in y mapped through the mid slope
