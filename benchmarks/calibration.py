@@ -122,6 +122,38 @@ def cost_table(max_points):
         print(f"| {n:.0e} | {spent:.3f}{status} | {peak:.1f} | {peak / n * 1e5:.1f} |")
 
 
+def cli_table(max_points):
+    """`matcad calibrate` end to end (CSV read, fit, residual plot, outputs) on files of 10^3-10^6 rows."""
+    import os
+    import subprocess
+    import tempfile
+
+    print("\n`matcad calibrate` end to end on a CSV (force_n, frequency_hz, cycle; 10 cycles; peak RSS from "
+          "/usr/bin/time -v):\n")
+    print("| rows | file [MB] | wall time [s] | peak RSS [MB] |")
+    print("|---:|---:|---:|---:|")
+    root = Path(__file__).resolve().parents[1]
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in (n for n in (10 ** 3, 10 ** 5, 10 ** 6) if n <= max_points):
+            rng = np.random.default_rng(2)
+            forces = rng.uniform(0.0, 20.0, n)
+            labels = np.arange(n) % 10
+            freqs = TRUE.frequency_hz(forces) + rng.normal(0.0, SIGMA_HZ, n)
+            path = Path(tmp) / f"cal-{n}.csv"
+            path.write_text("force_n,frequency_hz,cycle\n" + "".join(
+                f"{a:.4f},{b:.3f},c{c}\n" for a, b, c in zip(forces, freqs, labels)))
+            cmd = ["/usr/bin/time", "-v", sys.executable, "-m", "matcad", "calibrate", str(path), "--spec",
+                   str(root / "templates" / "mat-paper.toml"), "--out", str(Path(tmp) / f"out-{n}")]
+            t0 = time.perf_counter()
+            proc = subprocess.run(cmd, capture_output=True, text=True, cwd=root,
+                                  env={**os.environ, "PYTHONPATH": str(root)})
+            wall = time.perf_counter() - t0
+            rss = [ln for ln in proc.stderr.splitlines() if "Maximum resident set size" in ln]
+            peak = int(rss[0].split()[-1]) / 1024 if rss else float("nan")
+            status = "" if proc.returncode == 0 else f" (exit {proc.returncode})"
+            print(f"| {n:.0e} | {path.stat().st_size / 1e6:.1f} | {wall:.1f}{status} | {peak:.0f} |")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--trials", type=int, default=2000)
@@ -133,6 +165,8 @@ def main():
         coverage_table(args.trials)
     if not args.coverage_only:
         cost_table(args.max_points)
+        if Path("/usr/bin/time").exists():
+            cli_table(args.max_points)
 
 
 if __name__ == "__main__":
