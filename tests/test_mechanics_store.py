@@ -39,18 +39,18 @@ def test_bad_or_foreign_files_are_recomputed(case, tmp_path, monkeypatch):
     computed = solver.cap_curve(case)
     path = tmp_path / f"{store.key(case)[0]}.npz"
     path.write_bytes(b"not an npz archive")
-    assert store.load(case) is None
+    assert store.load(case, solver.CapCurve, solver.CapStep) is None
     other = cap_case(spec_mod.from_dict(tomllib.loads(FAST_MECHANICS.replace("steps = 4", "steps = 5"))))
     store.save(other, computed)
     path.write_bytes((tmp_path / f"{store.key(other)[0]}.npz").read_bytes())  # another case under this name
-    assert store.load(case) is None
+    assert store.load(case, solver.CapCurve, solver.CapStep) is None
     assert solver.cap_curve(case).steps[-1].force_n == computed.steps[-1].force_n  # recomputed, stored again
-    assert store.load(case) is not None
+    assert store.load(case, solver.CapCurve, solver.CapStep) is not None
 
 
 def test_empty_cache_dir_turns_it_off(case, tmp_path, monkeypatch):
     monkeypatch.setenv("MATCAD_CACHE_DIR", "")
-    assert store.folder() is None and store.load(case) is None
+    assert store.folder() is None and store.load(case, solver.CapCurve, solver.CapStep) is None
     store.save(case, None)  # nothing to write to: no error
 
 

@@ -129,7 +129,7 @@ def cap_curve(case) -> CapCurve:
     stored."""
     from matcad.mechanics import store
 
-    curve = store.load(case)
+    curve = store.load(case, CapCurve, CapStep)
     if curve is None:
         curve = compress(case.section, case.material, case.contact, case.displacement_mm, case.steps,
                          case.element_size_mm)

@@ -58,9 +58,10 @@ def key(case) -> tuple[str, str]:
     return hashlib.sha256(text.encode()).hexdigest()[:32], text
 
 
-def load(case):
-    """The stored :class:`~matcad.mechanics.solver.CapCurve` of ``case``, or None (no cache, no file, a file that
-    does not read back as this case's curve)."""
+def load(case, curve_type, step_type):
+    """The stored curve of ``case`` as a ``curve_type`` of ``step_type`` steps (:class:`~matcad.mechanics.solver.
+    CapCurve`, :class:`~matcad.mechanics.solver.CapStep`: the solver passes its own types), or None (no cache, no
+    file, a file that does not read back as this case's curve)."""
     where = folder()
     if where is None:
         return None
@@ -71,12 +72,10 @@ def load(case):
             if str(data["key"]) != text:
                 return None
             meta = json.loads(str(data["meta"]))
-            from matcad.mechanics.solver import CapCurve, CapStep
-
-            steps = tuple(CapStep(s["displacement_mm"], s["force_n"], s["cavity_volume_mm3"],
+            steps = tuple(step_type(s["displacement_mm"], s["force_n"], s["cavity_volume_mm3"],
                                   np.array(data[f"outline_{i}"]), s["peak_strain"], tuple(s["volume_ratio_range"]))
                           for i, s in enumerate(meta["steps"]))
-            return CapCurve(section=case.section, material=case.material, contact=case.contact,
+            return curve_type(section=case.section, material=case.material, contact=case.contact,
                             unloaded_volume_mm3=meta["unloaded_volume_mm3"],
                             unloaded_outline=np.array(data["unloaded_outline"]), corner=meta["corner"], steps=steps,
                             complete=meta["complete"], message=meta["message"], nodes=meta["nodes"],
