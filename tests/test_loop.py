@@ -107,8 +107,10 @@ def test_unreadable_recording_is_exit_2(tmp_path):
 
 
 def test_analyze_cli_json_and_files(tmp_path):
+    """A steady tone (±3 Hz of wobble) is one steady segment; a ±20 Hz wobble would be cut into several (issue
+    24's trend test: ±20 Hz is ±0.7 N at the paper's 30 Hz/N, not one steady force)."""
     path = tmp_path / "tone.wav"
-    wavfile.write(path, FS, (wobbling_tone(4700.0, snr_db=10.0) * 30000).astype(np.int16))
+    wavfile.write(path, FS, (wobbling_tone(4700.0, wobble=3.0, snr_db=10.0) * 30000).astype(np.int16))
     code, out, err = run_cli("analyze", path, "--band", "4000", "5500", "--out", tmp_path / "a", "--json")
     assert code == 0, err
     data = json.loads(out)

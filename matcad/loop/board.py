@@ -24,11 +24,14 @@ one row per frame, in time order, as soon as every taxel has decided that frame.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from matcad.errors import LoopError
+from matcad.listening import EDGE_BINS
+from matcad.loop.segments import STEP_HZ
+from matcad.loop.voicing import MIN_RUN_HARMONIC
 from matcad.loop.analysis import Analysis
 from matcad.loop.analyze import run_trackers
 from matcad.loop.sense import sense
@@ -94,12 +97,77 @@ def analyze_board(blocks, fs: float, named_bands, on_frame=None) -> list[TaxelTr
     for k, ((name, band), tracker) in enumerate(zip(named_bands, trackers)):
         others = [b for j, b in enumerate(bands) if j != k]
         try:
-            tracks.append(TaxelTrack(name, band, tracker.finish(duration, mean_power, others)))
+            heard = tracker.finish(duration, mean_power, others)
+            analysis = off_edge(name, heard)
+            tracks.append(TaxelTrack(name, band, replace(analysis, warnings=(*analysis.warnings,
+                                                                             *dropouts(name, heard)))))
         except LoopError as exc:
             tracks.append(TaxelTrack(name, band, None, str(exc)))
     if all(t.analysis is None for t in tracks):
         raise LoopError("no taxel's tone found: " + "; ".join(f"{t.name}: {t.reason}" for t in tracks))
     return tracks
+
+
+def off_edge(name: str, a: Analysis) -> Analysis:
+    """A board taxel's analysis with the frames its ridge spent at its band's edge left out (voiced ones within
+    EDGE_BINS + 1 bins of an edge, and the unvoiced run at the edge that follows them): a tone pressed out of its
+    band leaves the ridge parked on the skirt at the edge, which is no reading (issue 24: 3-frame segments pinned
+    41 Hz below the tone). Segments there are flagged (no force); a warning says the taxel left its band. Raises
+    LoopError when no voiced frame is left."""
+    df = float(a.plot_freqs_hz[1] - a.plot_freqs_hz[0])
+    lo, hi = a.band_hz
+    near = (EDGE_BINS + 1) * df
+    at_edge = (a.track_hz - lo <= near) | (hi - a.track_hz <= near)
+    left = a.voiced & at_edge
+    # the ridge parked at the edge right after a voiced edge frame: the tone went on out of the band
+    for i in range(1, len(left)):
+        if at_edge[i] and not a.voiced[i] and left[i - 1]:
+            left[i] = True
+    if not np.any(left & a.voiced):
+        return a
+    voiced = a.voiced & ~left
+    if not np.any(voiced):
+        raise LoopError(f"{name}'s tone sits at its band's edge in every voiced frame: it lies outside "
+                        f"{lo:.0f}-{hi:.0f} Hz")
+    flag = "at the band edge: the tone left the band"
+    segments = tuple(replace(s, flag=s.flag or flag) if min(s.mean_hz - lo, hi - s.mean_hz) <= near else s
+                     for s in a.segments)
+    times = a.times_s[left]
+    side = "top" if np.median(a.track_hz[left]) > 0.5 * (lo + hi) else "bottom"
+    warning = (f"{name}'s tone reached its band's {side} edge ({hi if side == 'top' else lo:.0f} Hz) in "
+               f"{int(left.sum())} frames between {times[0]:.2f} and {times[-1]:.2f} s: it left its band (pressed "
+               "beyond the band's force range, or the band is wrong); those frames are left out")
+    f = a.track_hz[voiced]
+    return replace(a, mean_hz=float(np.mean(f)), median_hz=float(np.median(f)), std_hz=float(np.std(f)),
+                   tone_fraction=float(np.mean(voiced)), voiced=voiced, segments=segments,
+                   warnings=(*a.warnings, warning))
+
+
+DROPOUT_FRAMES = (5, 65)
+"""A silence of this many frames (~0.23-3 s) inside a steady tone is reported by :func:`dropouts`."""
+
+
+def dropouts(name: str, a: Analysis) -> list[str]:
+    """Warnings for the silences of a board taxel that stops abruptly at a steady pitch and comes back at the same
+    pitch (within STEP_HZ) after DROPOUT_FRAMES frames, with MIN_RUN_HARMONIC voiced frames on both sides: what an
+    overblown jump out of its band (the jet driving another mode) does — or a stalled jet; a press would ramp the
+    pitch first. The jumped tone itself is not looked for (the trackers see only the bands)."""
+    out = []
+    v = np.flatnonzero(a.voiced)
+    for i, j in zip(v[:-1], v[1:]):
+        gap = j - i - 1
+        if not DROPOUT_FRAMES[0] <= gap <= DROPOUT_FRAMES[1]:
+            continue
+        before, after = v[v <= i][-MIN_RUN_HARMONIC:], v[v >= j][:MIN_RUN_HARMONIC]
+        if len(before) < MIN_RUN_HARMONIC or len(after) < MIN_RUN_HARMONIC or before[0] < i - 2 * MIN_RUN_HARMONIC \
+                or after[-1] > j + 2 * MIN_RUN_HARMONIC:
+            continue
+        f0, f1 = np.median(a.track_hz[before]), np.median(a.track_hz[after])
+        if abs(f1 - f0) <= STEP_HZ and np.ptp(a.track_hz[before]) <= 2 * STEP_HZ:
+            out.append(f"{name}'s tone stopped abruptly at {a.times_s[i]:.2f} s from a steady {f0:.0f} Hz and came "
+                       f"back at the same pitch at {a.times_s[j]:.2f} s: an overblown jump out of its band (the jet "
+                       "driving another mode) or a stalled jet; no force in between")
+    return out
 
 
 def parse_calibrations(values, names) -> dict[str, str]:

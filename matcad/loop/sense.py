@@ -26,6 +26,7 @@ from matcad.acoustics.eq5 import Eq5
 from matcad.acoustics.uncertainty import TEMPERATURE_TOL_C
 from matcad.errors import LoopError
 from matcad.listening import CALIBRATED_MARGIN, listening_band
+from matcad.loop.voicing import MIN_RUN_HARMONIC, longest_run
 
 
 TEMPERATURE_SD_C = TEMPERATURE_TOL_C / np.sqrt(3.0)
@@ -122,22 +123,65 @@ class Reading:
         return "\n".join(lines)
 
 
+IN_RANGE_SHARE = 0.5
+"""The overall force needs at least this share of the voiced frames inside the calibrated range (issue 24: a
+reverberant room's scattered peaks, sd 370 Hz, averaged to "4.47 N")."""
+FRAMES_PER_READING = 3.0
+"""Frames of a segment per independent reading of its frequency (the 50 % overlap and the ridge's smoothing
+correlate neighbours): on the slow-press and 2 N press recordings of benchmarks/wrong_answers.py, segment means
+scattered about the truth 1.5 times sd/sqrt(frames), i.e. one reading per ~2.3 frames; 3 is taken."""
+
+
+def _mean_scatter_n(cal: Eq5, segments, seg_f, temperature_c) -> np.ndarray:
+    """Half-width (N) of the 95 % interval that the scatter of each segment's mean frequency adds: 1.96 times
+    its sd / sqrt(frames / FRAMES_PER_READING), through dF/df (issue 24: a calibration tighter than the track
+    gave segment intervals of +-0.03 N that missed a steady force by the track's own 1 Hz)."""
+    if len(seg_f) == 0:
+        return np.zeros(0)
+    up, _, _ = force_interval(cal, seg_f + 0.5, temperature_c)
+    down, _, _ = force_interval(cal, seg_f - 0.5, temperature_c)
+    sem = np.array([s.std_hz * np.sqrt(FRAMES_PER_READING / max(s.frames, 1)) for s in segments])
+    return np.nan_to_num(1.96 * np.abs(up - down) * sem)
+
+
+def refusal(analysis) -> str:
+    """Why ``sense`` gives no force for an :class:`matcad.loop.analysis.Analysis` ('' when it does): the tracked line
+    cannot be told to be the taxel's (:attr:`~matcad.loop.analysis.Analysis.unassigned`), or no voiced stretch
+    lasts MIN_RUN_HARMONIC frames (a few frames in noise — a room's response peak, a talker's formant — are not
+    evidence of a singing taxel; ``analyze`` warns, ``sense`` refuses: issue 24)."""
+    if analysis.unassigned:
+        return analysis.unassigned
+    longest = longest_run(analysis.voiced)
+    if longest < MIN_RUN_HARMONIC:
+        return (f"no voiced stretch lasts {MIN_RUN_HARMONIC} frames (the longest: {longest}): too little evidence "
+                "of a singing taxel for a force")
+    return ""
+
+
 def sense(analysis, cal: Eq5, temperature_c: float | None = None) -> Reading:
     """Forces of an :class:`matcad.loop.analysis.Analysis` through a calibration (:meth:`Eq5.force_with_interval`):
-    per voiced frame, per segment and overall."""
-    track = np.where(analysis.voiced, analysis.track_hz, np.nan)
+    per voiced frame, per segment and overall; none at all (NaN, with the reason) when :func:`refusal` says
+    so."""
+    refused = refusal(analysis)
+    track = np.where(analysis.voiced & (not refused), analysis.track_hz, np.nan)
     frames, half, air = force_interval(cal, track, temperature_c)
-    seg_f = np.array([s.mean_hz if not s.flag else np.nan for s in analysis.segments])
+    seg_f = np.array([s.mean_hz if not (s.flag or refused) else np.nan for s in analysis.segments])
     seg_force, seg_half, _ = force_interval(cal, seg_f, temperature_c)
+    seg_half = np.hypot(seg_half, _mean_scatter_n(cal, analysis.segments, seg_f, temperature_c))
     segments = np.column_stack([seg_force, seg_force - seg_half, seg_force + seg_half]).reshape(-1, 3)
     mean_f = analysis.mean_hz
-    force, width, _ = force_interval(cal, np.array([mean_f]), temperature_c)
+    force, width, _ = force_interval(cal, np.array([np.nan if refused else mean_f]), temperature_c)
     force, width = float(force[0]), float(width[0])
-    reason = ""
-    if not np.isfinite(force):
-        f_lo, f_hi = cal.frequency_range_hz()
+    reason = refused
+    f_lo, f_hi = cal.frequency_range_hz()
+    voiced, in_range = int(np.sum(analysis.voiced)), int(np.sum(np.isfinite(frames)))
+    if not np.isfinite(force) and not refused:
         reason = (f"{mean_f:.1f} Hz lies outside the calibrated {f_lo:.1f}-{f_hi:.1f} Hz "
                   f"({cal.force_range_n[0]:g}-{cal.force_range_n[1]:g} N): no extrapolation")
+    elif not refused and in_range < IN_RANGE_SHARE * voiced:
+        force, width = np.nan, np.nan
+        reason = (f"only {in_range} of {voiced} voiced frames lie in the calibrated {f_lo:.1f}-{f_hi:.1f} Hz: "
+                  "their mean is no reading (a tone that wanders over the band is no taxel)")
     warnings = [air] if air else []
     steady = np.isfinite(segments[:, 0])
     if np.sum(steady) >= 2 and np.ptp(segments[steady, 0]) > np.max(segments[steady, 2] - segments[steady, 1]):
