@@ -134,3 +134,33 @@ def test_board_overblown_taxel_is_reported():
     rec, tracks = _board("overblown-out", 0)
     assert any("t1" in w and "overblown" in w for w in tracks[0].analysis.warnings), tracks[0].analysis.warnings
     assert not any("overblown" in w for t in tracks[1:] for w in t.analysis.warnings)
+
+
+HARMONIC_BANDS = [("t1", (2000.0, 2200.0)), ("t2", (3000.0, 3300.0)), ("t3", (4050.0, 4450.0))]
+"""t3's band holds t1's 2nd harmonic (4000-4400 Hz): allowed since issue 24, tracked around."""
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_silent_taxel_is_not_read_on_a_neighbours_harmonic(seed):
+    """Deliberate fault caught: a board tracker taking t1's 2nd harmonic (-10 dB, louder than the realistic -20)
+    in silent t3's band for t3's tone (122 voiced frames before discounting). With harmonics predicted from t1's
+    track: t3 has no force, and the singing taxels stay within 1 Hz."""
+    rec = synth_board.board_recording(HARMONIC_BANDS, (1.05,) * 3, 5.0, seconds=6.0, seed=seed, pressed=(0,),
+                                      harmonics_db=(-10.0, -20.0), silent=(2,))
+    tracks = analyze_board([rec.x], rec.fs, HARMONIC_BANDS)
+    t3 = tracks[2].analysis
+    assert t3 is None or refusal(t3), (t3.voiced.sum(), t3.warnings)
+    for k in (0, 1):
+        a = tracks[k].analysis
+        assert abs(np.mean(a.track_hz[a.voiced] - rec.truth_at(k, a.times_s[a.voiced]))) < 1.0
+
+
+def test_a_singing_taxel_is_tracked_beside_a_neighbours_harmonic():
+    """The same board with t3 singing: its own line is tracked (mean error < 1 Hz), few frames discounted."""
+    rec = synth_board.board_recording(HARMONIC_BANDS, (1.05,) * 3, 5.0, seconds=6.0, seed=0, pressed=(0,),
+                                      harmonics_db=(-10.0, -20.0))
+    tracks = analyze_board([rec.x], rec.fs, HARMONIC_BANDS)
+    for k, t in enumerate(tracks):
+        a = t.analysis
+        assert a.voiced.sum() > 0.8 * len(a.voiced)
+        assert abs(np.mean(a.track_hz[a.voiced] - rec.truth_at(k, a.times_s[a.voiced]))) < 1.0

@@ -30,6 +30,7 @@ import numpy as np
 
 from matcad.errors import LoopError
 from matcad.listening import EDGE_BINS
+from matcad.prediction.bands import HARMONICS
 from matcad.loop.segments import STEP_HZ
 from matcad.loop.voicing import MIN_RUN_HARMONIC
 from matcad.loop.analysis import Analysis
@@ -103,9 +104,62 @@ def analyze_board(blocks, fs: float, named_bands, on_frame=None) -> list[TaxelTr
                                                                              *dropouts(name, heard)))))
         except LoopError as exc:
             tracks.append(TaxelTrack(name, band, None, str(exc)))
+    tracks = discount_harmonics(tracks)
     if all(t.analysis is None for t in tracks):
         raise LoopError("no taxel's tone found: " + "; ".join(f"{t.name}: {t.reason}" for t in tracks))
     return tracks
+
+
+HARMONIC_TOL_BINS = 3
+"""A ridge within this many bins (~16 Hz at 44.1 kHz) of a predicted harmonic m·f of another taxel's tone in the
+same frame lies on that harmonic."""
+
+
+def discount_harmonics(tracks, harmonics=HARMONICS) -> list[TaxelTrack]:
+    """Each taxel's frames whose ridge lies on another taxel's harmonic — m·f (m in ``harmonics``) of that taxel's
+    tone in the same frame, within HARMONIC_TOL_BINS — left out, with a warning; segments made mostly of them are
+    flagged. The bands of a board may hold other taxels' 2f and 3f (issue 24: the allocation interleaves bands
+    between harmonics instead of forbidding them): a taxel quieter than a neighbour's harmonic, or silent, would
+    otherwise be read at the harmonic's pitch; where its own tone sits on the harmonic the frame cannot be told and
+    is left out too. A taxel left with no voiced frame gets no analysis and the reason."""
+    out = []
+    for k, t in enumerate(tracks):
+        a = t.analysis
+        if a is None:
+            out.append(t)
+            continue
+        tol = HARMONIC_TOL_BINS * float(a.plot_freqs_hz[1] - a.plot_freqs_hz[0])
+        on = np.zeros(len(a.track_hz), dtype=bool)
+        which = []
+        for j, other in enumerate(tracks):
+            b = other.analysis
+            if j == k or b is None or len(b.track_hz) != len(a.track_hz):
+                continue
+            for m in harmonics:
+                hit = a.voiced & b.voiced & (np.abs(a.track_hz - m * b.track_hz) <= tol)
+                if np.any(hit):
+                    which.append(f"{other.name}'s {m}f ({int(hit.sum())} frames)")
+                on |= hit
+        if not np.any(on):
+            out.append(t)
+            continue
+        voiced = a.voiced & ~on
+        if not np.any(voiced):
+            out.append(TaxelTrack(t.name, t.band_hz, None, f"every voiced frame lies on {', '.join(which)}: no "
+                                                            "tone of its own"))
+            continue
+        flag = "on another taxel's harmonic"
+        segments = tuple(replace(s, flag=s.flag or flag)
+                         if np.mean(on[(a.times_s >= s.start_s) & (a.times_s <= s.end_s)]) > 0.5 else s
+                         for s in a.segments)
+        f = a.track_hz[voiced]
+        warning = (f"{int(on.sum())} frames of {t.name} lie on {', '.join(which)}, predicted from that taxel's "
+                   "tone: left out (a harmonic, or the taxel's own tone where the two coincide)")
+        out.append(TaxelTrack(t.name, t.band_hz, replace(
+            a, mean_hz=float(np.mean(f)), median_hz=float(np.median(f)), std_hz=float(np.std(f)),
+            tone_fraction=float(np.mean(voiced)), voiced=voiced, segments=segments,
+            warnings=(*a.warnings, warning))))
+    return out
 
 
 def off_edge(name: str, a: Analysis) -> Analysis:

@@ -45,11 +45,12 @@ def press_forces(seconds: float, fs: float, max_force_n: float, phase: float, pe
 
 def board_recording(bands, rises, max_force_n: float, seconds: float = 8.0, seed: int = 0, fs: float = synth.FS,
                     pressed=None, harmonics_db=synth.HARMONICS_DB, level_spread_db: float = 6.0,
-                    rt60_s: float = 0.4) -> synth.BoardRecording:
+                    rt60_s: float = 0.4, silent=()) -> synth.BoardRecording:
     """Every taxel of a board singing at once in a room (pink noise, reverb, tablet microphone): ``bands`` (name,
     (low, high) Hz) are the listening bands, ``rises`` each taxel's f(max)/f(0); the ``pressed`` ones (indices;
     default every third from the second) pressed to ``max_force_n`` (N) at staggered times, the others held at 20
-    %; levels spread uniformly over ±``level_spread_db``/2 dB; harmonics at ``harmonics_db``."""
+    %; levels spread uniformly over ±``level_spread_db``/2 dB; harmonics at ``harmonics_db``; the ``silent`` ones
+    (indices) do not sing (truth NaN)."""
     rng = np.random.default_rng(seed)
     n = int(seconds * fs)
     pressed = range(1, len(bands), 3) if pressed is None else pressed
@@ -63,7 +64,8 @@ def board_recording(bands, rises, max_force_n: float, seconds: float = 8.0, seed
         freqs.append(law(f0, rise, max_force_n).frequency_hz(force))
         amps.append(0.1 * 10 ** (rng.uniform(-0.5, 0.5) * level_spread_db / 20))
     x = sum(synth.taxel(f, fs, seed + 11 * k, amplitude=a, harmonics_db=harmonics_db)
-            for k, (f, a) in enumerate(zip(freqs, amps)))
+            for k, (f, a) in enumerate(zip(freqs, amps)) if k not in silent)
+    freqs = [np.full(n, np.nan) if k in silent else f for k, f in enumerate(freqs)]
     x = synth.room(x, fs, seed, rt60=rt60_s)
     return synth.BoardRecording(x, fs, tuple(names), np.array(freqs), np.array(forces),
                                 tuple(tuple(b) for _, b in bands))
