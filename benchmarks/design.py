@@ -127,8 +127,9 @@ def capacity(forces=(5.0, 10.0), seeds=2):
 
     print("\ncapacity: taxels per microphone (rigid walls, Eq. 5 rise, calipered sheet; guard from the tracker)")
     print("| rate [kHz] | max force [N] | sheet [mm] | asked | fit | reach [Hz] | check errors | design [s] | "
-          "board: worst per-taxel |mean error| [Hz] | worst track RMS [Hz] | taxels with a tone |")
-    print("|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|")
+          "board: worst per-taxel |mean error| [Hz] | worst track RMS [Hz] | taxels with a tone | "
+          "largest neck boundary-layer drop [%] |")
+    print("|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|")
     for rate, n, band, sheet in CAPACITY:
         for force in forces:
             s = spec_mod.from_dict(tomllib.loads(BOARD_BASE.format(sheet=sheet, force=force, rate=rate)))
@@ -136,7 +137,7 @@ def capacity(forces=(5.0, 10.0), seeds=2):
             a, why = _most_that_fit(s, n, band, parse_vary(s, CAPACITY_VARY))
             took = time.perf_counter() - t0
             if a is None:
-                print(f"| {rate / 1e3:g} | {force:g} | {sheet:g} | {n} | 0 | - | - | {took:.0f} | - | - | - |")
+                print(f"| {rate / 1e3:g} | {force:g} | {sheet:g} | {n} | 0 | - | - | {took:.0f} | - | - | - | - |")
                 continue
             bad = len(errors(check(a.spec)))
             bands = taxel_bands(a.spec)
@@ -158,8 +159,12 @@ def capacity(forces=(5.0, 10.0), seeds=2):
                     count += 1
                 heard.append(count)
             reach = f"{bands[0].loaded_hz[0]:.0f}-{bands[-1].loaded_hz[1]:.0f}"
+            from matcad.acoustics.air import boundary_layer_drop
+            from matcad.spec import taxels
+
+            loss = max(boundary_layer_drop(b.f0_hz, t.neck.diameter / 2) for b, t in zip(bands, taxels(a.spec)))
             print(f"| {rate / 1e3:g} | {force:g} | {sheet:g} | {n} | {len(bands)} | {reach} | {bad} | {took:.0f} | "
-                  f"{worst_mean:.2f} | {worst_rms:.2f} | {min(heard)}/{len(bands)} |", flush=True)
+                  f"{worst_mean:.2f} | {worst_rms:.2f} | {min(heard)}/{len(bands)} | {100 * loss:.1f} |", flush=True)
             if len(bands) < n:
                 print(f"    ({n} asked: {why[:260]})")
 

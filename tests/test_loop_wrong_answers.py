@@ -142,11 +142,11 @@ HARMONIC_BANDS = [("t1", (2000.0, 2200.0)), ("t2", (3000.0, 3300.0)), ("t3", (40
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_a_silent_taxel_is_not_read_on_a_neighbours_harmonic(seed):
-    """Deliberate fault caught: a board tracker taking t1's 2nd harmonic (-10 dB, louder than the realistic -20)
+    """Deliberate fault caught: a board tracker taking t1's 2nd harmonic (-15 dB, louder than the realistic -20)
     in silent t3's band for t3's tone (122 voiced frames before discounting). With harmonics predicted from t1's
     track: t3 has no force, and the singing taxels stay within 1 Hz."""
     rec = synth_board.board_recording(HARMONIC_BANDS, (1.05,) * 3, 5.0, seconds=6.0, seed=seed, pressed=(0,),
-                                      harmonics_db=(-10.0, -20.0), silent=(2,))
+                                      harmonics_db=(-15.0, -25.0), silent=(2,))
     tracks = analyze_board([rec.x], rec.fs, HARMONIC_BANDS)
     t3 = tracks[2].analysis
     assert t3 is None or refusal(t3), (t3.voiced.sum(), t3.warnings)
@@ -158,7 +158,7 @@ def test_a_silent_taxel_is_not_read_on_a_neighbours_harmonic(seed):
 def test_a_singing_taxel_is_tracked_beside_a_neighbours_harmonic():
     """The same board with t3 singing: its own line is tracked (mean error < 1 Hz), few frames discounted."""
     rec = synth_board.board_recording(HARMONIC_BANDS, (1.05,) * 3, 5.0, seconds=6.0, seed=0, pressed=(0,),
-                                      harmonics_db=(-10.0, -20.0))
+                                      harmonics_db=(-15.0, -25.0))
     tracks = analyze_board([rec.x], rec.fs, HARMONIC_BANDS)
     for k, t in enumerate(tracks):
         a = t.analysis

@@ -58,6 +58,9 @@ class Analysis:
     plot_freqs_hz: np.ndarray = field(repr=False, default=None)
     plot_db: np.ndarray = field(repr=False, default=None)  # frequency × column, max-pooled in time
     warnings: tuple[str, ...] = ()
+    frame_level_db: np.ndarray = field(repr=False, default=None)
+    """The ridge's own level per frame (dB of power, not over the floor; the tracker's ridge, before any hop is
+    undone): lets a board tell a harmonic from a taxel's own tone (:func:`matcad.loop.board.discount_harmonics`)."""
     unassigned: str = ""
     """Why the tracked line cannot be told to be the taxel's ('' when it can): a second tone of comparable level
     (within :data:`matcad.loop.crossing.COMPARABLE_DB`) in the band from the first voiced frames on, so that no

@@ -115,13 +115,19 @@ HARMONIC_TOL_BINS = 3
 same frame lies on that harmonic."""
 
 
+HARMONIC_WEAKER_DB = 10.0
+"""...and is at least this much weaker (the ridge's own level, dB) than that taxel's tone: a harmonic is weaker than
+its fundamental (a Helmholtz resonator does not amplify it: -20 dB on the synthetic board); a line about as strong
+as another taxel's tone is the taxel's own, even where its pitch meets the harmonic."""
+
+
 def discount_harmonics(tracks, harmonics=HARMONICS) -> list[TaxelTrack]:
     """Each taxel's frames whose ridge lies on another taxel's harmonic — m·f (m in ``harmonics``) of that taxel's
-    tone in the same frame, within HARMONIC_TOL_BINS — left out, with a warning; segments made mostly of them are
-    flagged. The bands of a board may hold other taxels' 2f and 3f (issue 24: the allocation interleaves bands
+    tone in the same frame, within HARMONIC_TOL_BINS, and HARMONIC_WEAKER_DB weaker — left out, with a warning;
+    segments made mostly of them are flagged. The bands of a board may hold other taxels' 2f and 3f (issue 24: the allocation interleaves bands
     between harmonics instead of forbidding them): a taxel quieter than a neighbour's harmonic, or silent, would
-    otherwise be read at the harmonic's pitch; where its own tone sits on the harmonic the frame cannot be told and
-    is left out too. A taxel left with no voiced frame gets no analysis and the reason."""
+    otherwise be read at the harmonic's pitch; where its own, much weaker tone sits on the harmonic the frame
+    cannot be told and is left out too. A taxel left with no voiced frame gets no analysis and the reason."""
     out = []
     for k, t in enumerate(tracks):
         a = t.analysis
@@ -137,6 +143,8 @@ def discount_harmonics(tracks, harmonics=HARMONICS) -> list[TaxelTrack]:
                 continue
             for m in harmonics:
                 hit = a.voiced & b.voiced & (np.abs(a.track_hz - m * b.track_hz) <= tol)
+                if a.frame_level_db is not None and b.frame_level_db is not None:
+                    hit &= a.frame_level_db < b.frame_level_db - HARMONIC_WEAKER_DB
                 if np.any(hit):
                     which.append(f"{other.name}'s {m}f ({int(hit.sum())} frames)")
                 on |= hit
