@@ -124,10 +124,11 @@ as another taxel's tone is the taxel's own, even where its pitch meets the harmo
 def discount_harmonics(tracks, harmonics=HARMONICS) -> list[TaxelTrack]:
     """Each taxel's frames whose ridge lies on another taxel's harmonic — m·f (m in ``harmonics``) of that taxel's
     tone in the same frame, within HARMONIC_TOL_BINS, and HARMONIC_WEAKER_DB weaker — left out, with a warning;
-    segments made mostly of them are flagged. The bands of a board may hold other taxels' 2f and 3f (issue 24: the allocation interleaves bands
-    between harmonics instead of forbidding them): a taxel quieter than a neighbour's harmonic, or silent, would
-    otherwise be read at the harmonic's pitch; where its own, much weaker tone sits on the harmonic the frame
-    cannot be told and is left out too. A taxel left with no voiced frame gets no analysis and the reason."""
+    segments made mostly of them are flagged. The bands of a board may hold other taxels' 2f and 3f (issue 24: the
+    allocation interleaves bands between harmonics instead of forbidding them): a taxel quieter than a neighbour's
+    harmonic, or silent, would otherwise be read at the harmonic's pitch; where its own, much weaker tone sits on
+    the harmonic the frame cannot be told and is left out too. A taxel left with no voiced frame gets no analysis
+    and the reason."""
     out = []
     for k, t in enumerate(tracks):
         a = t.analysis
