@@ -26,6 +26,7 @@ Run: /work/venv/bin/python benchmarks/analyze.py [--quick] [--memory-only | --no
 import argparse
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -364,6 +365,37 @@ def memory_table(durations):
             path.unlink()
 
 
+def startup_table():
+    """Issue 24: `matcad analyze REC --spec BOARD` before it listens — the board's loaded bands need every distinct
+    cap's mechanics curve. Cold: an empty cap-curve cache (every FElupe run done); warm: the same command again."""
+    from scipy.io import wavfile
+
+    print("\n`matcad analyze REC --spec templates/mat-array-4.toml` (a 4 s board recording): wall time of the whole "
+          "command and of the listening bands alone, cold and warm cap-curve cache (matcad.mechanics.store):\n")
+    print("| cache | listening_bands [s] | whole command [s] | exit |")
+    print("|---|---:|---:|---:|")
+    root = Path(__file__).resolve().parents[1]
+    spec = root / "templates" / "mat-array-4.toml"
+    with tempfile.TemporaryDirectory() as tmp:
+        rec = synth.board_scenario(4.0, seed=0)
+        wavfile.write(Path(tmp) / "board.wav", int(rec.fs), np.round(rec.x / np.max(np.abs(rec.x)) * 30000)
+                      .astype(np.int16))
+        env = {**os.environ, "PYTHONPATH": str(root), "MATCAD_CACHE_DIR": str(Path(tmp) / "cache")}
+        code = ("import time, sys; t=time.perf_counter(); from matcad import spec; "
+                "from matcad.prediction.bands import listening_bands; listening_bands(spec.load(sys.argv[1])); "
+                "print(time.perf_counter()-t)")
+        for label in ("cold", "warm"):
+            bands = subprocess.run([sys.executable, "-c", code, str(spec)], capture_output=True, text=True, env=env)
+            if label == "cold":  # the command itself starts from an empty cache too
+                shutil.rmtree(Path(tmp) / "cache", ignore_errors=True)
+            t0 = time.perf_counter()
+            proc = subprocess.run([sys.executable, "-m", "matcad", "analyze", str(Path(tmp) / "board.wav"),
+                                   "--spec", str(spec), "--out", str(Path(tmp) / f"out-{label}")],
+                                  capture_output=True, text=True, env=env)
+            wall = time.perf_counter() - t0
+            print(f"| {label} | {float(bands.stdout.strip() or 'nan'):.1f} | {wall:.1f} | {proc.returncode} |")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true", help="2 seeds, 5 s cases, no 60 min file")
@@ -371,6 +403,7 @@ def main():
     parser.add_argument("--no-memory", action="store_true", help="skip the long files")
     parser.add_argument("--board-only", action="store_true", help="only the board table")
     parser.add_argument("--crossing-only", action="store_true", help="only the crossing table")
+    parser.add_argument("--startup-only", action="store_true", help="only the board start-up table")
     parser.add_argument("--speech-seeds", type=int, default=20, help="seeds of the speech cases (they vary most)")
     parser.add_argument("--noise-minutes", type=float, default=10.0,
                         help="minutes of each noise for the false-alarm table (0 skips it)")
@@ -383,6 +416,9 @@ def main():
         return
     if args.crossing_only:
         crossing_table(10, 10.0)
+        return
+    if args.startup_only:
+        startup_table()
         return
     if not args.memory_only:
         clean_tone_table()

@@ -1,6 +1,14 @@
-"""Inverse design: accuracy by `predict` and time per solve; the band allocation of a 4-taxel array.
+"""Inverse design: accuracy by `predict` and time per solve; the band allocation of a 4-taxel array; the capacity
+of one microphone (issue 24).
 
-Prints numbers, asserts nothing. Run: OMP_NUM_THREADS=1 .venv/bin/python benchmarks/design.py
+Capacity (``--capacity-only``): `design --taxels N` on a rigid-wall taxel whose load rise is the paper's Eq. 5
+(calipered sheet, max force F, neck diameter, cavity diameter and length free per taxel; the neck length is the
+plate's sheet, one stock thickness per board), at 44.1 and 96 kHz: the most taxels that fit, whether `check`
+passes, and each taxel tracked on a synthetic board recording (matcad.loop.synth_board: every taxel singing in its
+listening band with 2f/3f at -20/-30 dB, presses to F on every third, a room) — the per-taxel |mean error| and
+track RMS (Hz) over voiced frames.
+
+Prints numbers, asserts nothing. Run: OMP_NUM_THREADS=1 .venv/bin/python benchmarks/design.py [--capacity-only]
 """
 
 import dataclasses
@@ -64,6 +72,116 @@ def allocation():
           f"room left {7000 - bands[-1].loaded_hz[1]:.0f} Hz")
 
 
+BOARD_BASE = """name = "arr"
+[cavity]
+diameter = 3.18
+length = 4.76
+[neck]
+diameter = 2.1
+length = {sheet}
+[plate]
+thickness_measured = true
+[outputs]
+end_cap_mold = false
+needle_mount = false
+assembly = false
+[mechanics]
+max_force_n = {force}
+[microphone]
+sample_rate_hz = {rate}
+[calibration]
+v0_mm3 = 32.21
+a = -0.0086
+b = 0.4626
+area_convention = "d2/4"
+"""
+THREE = ["neck.diameter=0.5:7", "cavity.length", "cavity.diameter=2.1:12"]
+LENGTH = ["cavity.length=0.3:30"]
+CAPACITY = ((44100.0, 12, (1700.0, 11000.0), 1.5875, THREE), (44100.0, 24, (1700.0, 19800.0), 1.5875, LENGTH),
+            (96000.0, 16, (1200.0, 30000.0), 0.8, THREE), (96000.0, 16, (2000.0, 40000.0), 0.8, LENGTH),
+            (96000.0, 24, (1700.0, 43000.0), 0.8, LENGTH))
+"""(sample rate Hz, taxels asked, band Hz, sheet = neck length mm, --vary). The three-field route of
+matcad.design.solve stops near 10.5 / 12.1 kHz; the cavity length alone reaches higher (a shorter cavity)."""
+
+
+def _most_that_fit(s, n, band, vary):
+    """(allocation of the most taxels <= n that fit, the message when n did not)."""
+    import re
+
+    from matcad.design.allocate import allocate
+
+    why = ""
+    while n >= 2:
+        try:
+            return allocate(s, n, *band, vary), why
+        except Unreachable as exc:
+            why = why or str(exc)
+            hit = re.search(r"taxel (\d+) of", str(exc))
+            n = min(n - 1, int(hit.group(1)) - 1) if hit else n - 1
+    return None, why
+
+
+def capacity(forces=(5.0,), seeds=2):
+    import tomllib
+
+    from matcad.loop import synth_board
+    from matcad.loop.board import analyze_board
+    from matcad.prediction.bands import listening_bands, taxel_bands
+    from matcad.rules import check, errors
+
+    print("\ncapacity: taxels per microphone (rigid walls, Eq. 5 rise, calipered sheet; guard from the tracker)")
+    print("| rate [kHz] | max force [N] | sheet [mm] | vary | asked | fit | reach [Hz] | check errors | design [s] | "
+          "board: worst per-taxel |mean error| [Hz] | worst track RMS [Hz] | taxels with a tone | "
+          "largest neck boundary-layer drop [%] |")
+    print("|---:|---:|---:|---|---:|---:|---|---:|---:|---:|---:|---:|---:|")
+    for rate, n, band, sheet, vary in CAPACITY:
+        for force in forces:
+            s = spec_mod.from_dict(tomllib.loads(BOARD_BASE.format(sheet=sheet, force=force, rate=rate)))
+            t0 = time.perf_counter()
+            a, why = _most_that_fit(s, n, band, parse_vary(s, vary))
+            took = time.perf_counter() - t0
+            if a is None:
+                print(f"| {rate / 1e3:g} | {force:g} | {sheet:g} | {' '.join(vary)} | {n} | 0 | - | - | {took:.0f} "
+                      "| - | - | - | - |")
+                continue
+            bad = len(errors(check(a.spec)))
+            bands = taxel_bands(a.spec)
+            listen = listening_bands(a.spec)
+            worst_mean = worst_rms = 0.0
+            heard = []
+            for seed in range(seeds):
+                rec = synth_board.board_recording(listen, [b.rise for b in bands], force, seconds=6.0, seed=seed,
+                                                  fs=rate)
+                tracks = analyze_board([rec.x], rec.fs, listen)
+                count = 0
+                for k, t in enumerate(tracks):
+                    if t.analysis is None:
+                        continue
+                    v = t.analysis.voiced
+                    err = t.analysis.track_hz[v] - rec.truth_at(k, t.analysis.times_s[v])
+                    worst_mean = max(worst_mean, abs(float(np.mean(err))))
+                    worst_rms = max(worst_rms, float(np.sqrt(np.mean(err ** 2))))
+                    count += 1
+                heard.append(count)
+            reach = f"{bands[0].loaded_hz[0]:.0f}-{bands[-1].loaded_hz[1]:.0f}"
+            from matcad.acoustics.air import boundary_layer_drop
+            from matcad.spec import taxels
+
+            loss = max(boundary_layer_drop(b.f0_hz, t.neck.diameter / 2) for b, t in zip(bands, taxels(a.spec)))
+            print(f"| {rate / 1e3:g} | {force:g} | {sheet:g} | {' '.join(vary)} | {n} | {len(bands)} | {reach} | "
+                  f"{bad} | {took:.0f} | "
+                  f"{worst_mean:.2f} | {worst_rms:.2f} | {min(heard)}/{len(bands)} | {100 * loss:.1f} |", flush=True)
+            if len(bands) < n:
+                print(f"    ({n} asked: {why[:260]})")
+
+
 if __name__ == "__main__":
-    inverse_design()
-    allocation()
+    import argparse
+
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--capacity-only", action="store_true")
+    args = parser.parse_args()
+    if not args.capacity_only:
+        inverse_design()
+        allocation()
+    capacity()

@@ -46,7 +46,7 @@ def board(tmp_path_factory):
     n = int(FS * SECONDS)
     force = [synth.press_profile(SECONDS, FS, [(0.8, 2.0, 10.0), (2.6, 3.4, 10.0)]), np.full(n, 4.0)]
     x = sum(synth.taxel(synth.frequency_of_force(F, k), FS, 5 + i) for i, (F, k) in enumerate(zip(force, k_hz2)))
-    x = synth._room(x, FS, 3)
+    x = synth.room(x, FS, 3)
     pcm = np.round(x / np.max(np.abs(x)) * 30000).astype(np.int16)
     wavfile.write(tmp / "rec.wav", int(FS), pcm)
     points = np.linspace(0.0, 15.0, 11)

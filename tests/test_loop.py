@@ -107,8 +107,10 @@ def test_unreadable_recording_is_exit_2(tmp_path):
 
 
 def test_analyze_cli_json_and_files(tmp_path):
+    """A steady tone (±3 Hz of wobble) is one steady segment; a ±20 Hz wobble would be cut into several (issue
+    24's trend test: ±20 Hz is ±0.7 N at the paper's 30 Hz/N, not one steady force)."""
     path = tmp_path / "tone.wav"
-    wavfile.write(path, FS, (wobbling_tone(4700.0, snr_db=10.0) * 30000).astype(np.int16))
+    wavfile.write(path, FS, (wobbling_tone(4700.0, wobble=3.0, snr_db=10.0) * 30000).astype(np.int16))
     code, out, err = run_cli("analyze", path, "--band", "4000", "5500", "--out", tmp_path / "a", "--json")
     assert code == 0, err
     data = json.loads(out)
@@ -246,5 +248,14 @@ def test_force_interval_coverage_with_hysteresis(cycles, tau_n, cycle_std_n, low
 
 
 def test_between_cycle_variance_recovered():
-    estimates = [fit(*_cycles(s, 4, 0.7)[:2], K, cycles=_cycles(s, 4, 0.7)[2]).cycle_std_n for s in range(60)]
+    """The cycles' own estimate recovers τ; the value used pools it with the prior (issue 24: 1.3 N over 0-20 N,
+    worth PRIOR_CYCLES degrees of freedom), so it lies between the two, at the weighted mean of the variances."""
+    from matcad.acoustics.eq5fit import PRIOR_CYCLES
+
+    fits = [fit(*_cycles(s, 4, 0.7)[:2], K, cycles=_cycles(s, 4, 0.7)[2]) for s in range(60)]
+    estimates = [f.cycle_std_data_n for f in fits]
     assert 0.4 < np.median(estimates) < 1.0, np.median(estimates)
+    for f in fits:
+        assert f.cycle_prior_n == pytest.approx(20.0 / 15.4)
+        pooled = (PRIOR_CYCLES * f.cycle_prior_n ** 2 + 3 * f.cycle_std_data_n ** 2) / (PRIOR_CYCLES + 3)
+        assert f.cycle_std_n == pytest.approx(np.sqrt(pooled), rel=0.02)  # τ in y mapped through the mid slope

@@ -167,7 +167,7 @@ def test_cli_analyze_and_sense_an_array_spec(tmp_path):
     k_hz2 = [synth.EQ5.v0_mm3 * f**2 for f in f0]
     force = [synth.press_profile(seconds, fs, [(1.0, 2.5, 10.0), (3.2, 4.2, 10.0)]), np.full(n, 4.0)]
     x = sum(synth.taxel(synth.frequency_of_force(F, k), fs, 5 + i) for i, (F, k) in enumerate(zip(force, k_hz2)))
-    x = synth._room(x, fs, 3)
+    x = synth.room(x, fs, 3)
     wavfile.write(tmp_path / "rec.wav", int(fs), np.round(x / np.max(np.abs(x)) * 30000).astype(np.int16))
     code, out, err = run_cli("analyze", tmp_path / "rec.wav", "--spec", path, "--json", "--out", tmp_path / "a")
     assert code == 0, err

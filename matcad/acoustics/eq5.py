@@ -191,11 +191,14 @@ class Eq5:
         """The covariance of (V0, b, a) as a 3 × 3 array."""
         return np.array(self.covariance, dtype=float).reshape(3, 3)
 
-    def force_with_interval(self, frequency_hz, level: float = 0.95, temperature_c=None):
+    def force_with_interval(self, frequency_hz, level: float = 0.95, temperature_c=None,
+                            temperature_sd_c: float = 0.0):
         """(force, half-width of its ``level`` interval) (N) at each frequency (Hz) heard at ``temperature_c``
         (°C); NaN outside the calibrated force range (within :data:`RANGE_TOLERANCE` of its span). The interval
-        combines, by the delta method, the parameter covariance Σ, the residual scatter σ² and the between-cycle
-        variance τ²: Var F = gᵀ Σ g + (σ² + τ²)/(b + 2aF)², g = ∂F/∂(V0, b, a) = (1, −F, −F²) / (b + 2aF)."""
+        combines, by the delta method, the parameter covariance Σ, the residual scatter σ², the between-cycle
+        variance τ² and, when the air's temperature now is not known exactly, its standard deviation
+        ``temperature_sd_c`` (°C) against the calibration's (y = K/f² ∝ 1/T, so σ_y = y·σ_T/T):
+        Var F = gᵀ Σ g + (σ² + τ² + σ_y²)/(b + 2aF)², g = ∂F/∂(V0, b, a) = (1, −F, −F²) / (b + 2aF)."""
         f = np.asarray(frequency_hz, dtype=float) * self.temperature_factor(temperature_c)
         force = self.force_n(f)
         lo, hi = self.force_range_n
@@ -203,7 +206,10 @@ class Eq5:
         force = np.where((force >= lo - slack) & (force <= hi + slack), force, np.nan)
         slope = self.b + 2 * self.a * force  # −∂y/∂F
         grad = np.stack([np.ones_like(force), -force, -force * force]) / slope
-        scatter = self.residual_std_mm3 ** 2 + self.cycle_std_mm3 ** 2
+        kelvin = (20.0 if self.temperature_c is None else self.temperature_c) + KELVIN
+        with np.errstate(divide="ignore", invalid="ignore"):
+            air = self._k() / (f * f) * temperature_sd_c / kelvin
+        scatter = self.residual_std_mm3 ** 2 + self.cycle_std_mm3 ** 2 + air ** 2
         var = np.einsum("i...,ij,j...->...", grad, self.cov, grad) + scatter / slope ** 2
         return force, t_quantile(0.5 + level / 2, self.dof) * np.sqrt(var)
 

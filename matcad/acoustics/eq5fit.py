@@ -26,9 +26,18 @@ from matcad.errors import LoopError
 MIN_POINTS = 4
 MIN_DISTINCT_FORCES = 3
 MAX_CONDITION = 1e12
-PAPER_CYCLE_STD_N = 0.7
-"""Between-cycle standard deviation assumed when only one load cycle is given: the paper saw ~1 N (24 Hz at
-6.4 N) between two cycles; the difference of two draws has sd √2·τ, so τ ≈ 1/√2 N."""
+MAX_DOF = 10 ** 6
+"""Degrees of freedom past which Student's t is the normal law (an exact, noise-free curve gives no bound)."""
+PAPER_CYCLE_SHARE = 1.0 / 15.4
+"""Prior between-cycle (hysteresis) standard deviation, as a share of the largest calibrated force: the paper saw
+~1 N (24 Hz at 6.4 N) between a cycle to 15.4 N and the next (Sec. V, Fig. 10), so τ₀ = |F|max / 15.4 (1 N over
+the paper's range, 0.32 N over 0-5 N). A cap's between-cycle variation grows with the load it is cycled to (stress
+softening, seating), so the prior scales with the range rather than staying at 1 N."""
+PRIOR_CYCLES = 4
+"""Weight of that prior in degrees of freedom (scaled inverse-χ² prior, as if it came from PRIOR_CYCLES + 1
+cycles): the estimate used is τ² = (ν₀ τ₀² + (k − 1) τ̂²)/(ν₀ + k − 1) from k measured cycles, with ν₀ + k − 1
+degrees of freedom. Checked by simulation (benchmarks/calibration.py): one cycle covers >= 90 % up to τ = 1 N on
+the paper's range; three cycles are not twice as wide as needed."""
 OUTLIER_LEVEL = 0.05
 """Family-wise level of the outlier test (Bonferroni over the points)."""
 
@@ -37,7 +46,10 @@ OUTLIER_LEVEL = 0.05
 class Eq5Fit:
     """A fit of Eq. 5 to measured pairs: the fitted law (its covariance, residual and between-cycle scatter, force
     range and temperature in it), whether K was fitted (``k_free``), the data (N, Hz), the outliers (point index,
-    studentized residual), the load cycles and their scatter in force (N), notes and the forces left out (N)."""
+    studentized residual), the load cycles and the between-cycle scatter in force (N): the one used
+    (``cycle_std_n``), the prior (``cycle_prior_n``; ``cycle_prior_given``: by the user, else
+    :data:`PAPER_CYCLE_SHARE` of the range) and the cycles' own estimate (None with one cycle), notes and the
+    forces left out (N)."""
 
     law: Eq5
     k_free: bool
@@ -48,6 +60,9 @@ class Eq5Fit:
     cycle_std_n: float = 0.0
     notes: tuple[str, ...] = ()
     excluded_n: tuple[float, ...] = ()
+    cycle_prior_n: float = 0.0
+    cycle_prior_given: bool = False
+    cycle_std_data_n: float | None = None
 
     @property
     def standard_errors(self) -> np.ndarray:
@@ -69,6 +84,7 @@ class Eq5Fit:
                 "dof": law.dof, "points": int(len(self.forces_n)), "force_range_n": list(law.force_range_n),
                 "residual_rms_hz": float(np.sqrt(np.mean(residual ** 2))),
                 "cycles": self.cycles, "cycle_std_mm3": law.cycle_std_mm3, "cycle_std_n": self.cycle_std_n,
+                "cycle_std_prior_n": self.cycle_prior_n, "cycle_std_data_n": self.cycle_std_data_n,
                 "temperature_c": law.temperature_c, "excluded_forces_n": list(self.excluded_n),
                 "outliers": [{"point": i + 1, "studentized_residual": r} for i, r in self.outliers],
                 "notes": list(self.notes)}
@@ -83,49 +99,114 @@ class Eq5Fit:
             value = d["v0_mm3"] if name == "v0" else d[name]
             lo, hi = d[f"{name}_ci95"]
             lines.append(f"  {name:<3}= {value:.6g} +- {d[name + '_se']:.3g}  (95 %: {lo:.6g} .. {hi:.6g})")
+        data = "" if self.cycle_std_data_n is None else f", the cycles' own {self.cycle_std_data_n:.3g} N"
         lines.append(f"  residual RMS {d['residual_rms_hz']:.2f} Hz; between cycles {self.cycle_std_n:.3g} N "
-                     f"({self.cycles} cycle(s)); at {self.law.temperature_c:g} degC")
+                     f"({self.cycles} cycle(s){data}); at {self.law.temperature_c:g} degC")
         lines += [f"  note: {note}" for note in self.notes]
         return "\n".join(lines)
 
 
-def weighted_least_squares(force, y, w, scale, cycles, tau2_fixed=None):
-    """Weighted least squares in (V0, b, a) with a random offset per load cycle: returns
-    (theta, covariance, σ² within cycles, τ² between cycles, residuals in y (weighted), leverages)."""
+@dataclass(frozen=True)
+class LeastSquares:
+    """What :func:`weighted_least_squares` found, in the scaled parameters (V0, b·s, a·s²) of its design matrix:
+    the estimate and its covariance, the within-cycle variance σ² (``dof_within`` degrees of freedom), the
+    between-cycle variance τ² used and its degrees of freedom (inf: given, not estimated), the cycles' own estimate
+    of τ² (None with one cycle), and each point's externally studentized within-cycle residual."""
+
+    coef: np.ndarray
+    cov: np.ndarray
+    sigma2: float
+    dof_within: int
+    tau2: float
+    dof_tau: float
+    tau2_data: float | None
+    student: np.ndarray
+
+
+def _per_cycle(index, k: int, values) -> np.ndarray:
+    """Sums of ``values`` (n, or n × m) over the points of each of ``k`` cycles: (k,) or (k, m); O(n)."""
+    values = np.asarray(values, dtype=float)
+    if values.ndim == 1:
+        return np.bincount(index, values, minlength=k)
+    return np.stack([np.bincount(index, values[:, j], minlength=k) for j in range(values.shape[1])], axis=1)
+
+
+def weighted_least_squares(force, y, w, scale, index, k: int, tau2_prior: float = 0.0,
+                           prior_dof: float = PRIOR_CYCLES) -> LeastSquares:
+    """Eq. 5 in (V0, b, a) by weighted least squares with a random offset per load cycle (a random intercept):
+    y_ij = x_ijᵀθ + u_i + e_ij, u_i ~ N(0, τ²), e_ij ~ N(0, σ²/w_ij²); ``index`` gives each point's cycle
+    (0 … ``k`` − 1). O(n) time and memory: no n × n matrix is ever formed.
+
+    - σ² and the outlier test come from the within-cycle (fixed-effects) fit, each cycle its own intercept
+      (n − 2 − k degrees of freedom); its externally studentized residuals use the exact leave-one-out variance
+      ((n−p)s² − e_i²/(1−h_i))/(n−p−1), which cannot go negative.
+    - τ²: with k >= 2 cycles, the spread of the cycles' weighted mean residuals beyond what σ² explains (method of
+      moments, k − 1 degrees of freedom), pooled with the prior ``tau2_prior`` worth ``prior_dof`` degrees of
+      freedom (:data:`PRIOR_CYCLES`; ``prior_dof`` inf: τ² taken as known). One cycle: the prior alone.
+    - θ by generalised least squares with V = σ²I + τ²ZZᵀ through the Woodbury identity, per-cycle sums only;
+      with one cycle that is the weighted fit, and the offset of the calibration's own cycle sits in V0:
+      Cov θ = σ²(XᵀWX)⁻¹ + τ² e₁e₁ᵀ.
+    ``force`` N, ``y`` mm³ (K/f² or 1/f²), ``w`` the square roots of the weights, ``scale`` N (F/scale in X)."""
     n = len(force)
     x = np.column_stack([np.ones(n), -force / scale, -(force / scale) ** 2])
     xw, yw = x * w[:, None], y * w
-    coef, *_ = np.linalg.lstsq(xw, yw, rcond=None)
-    resid = yw - xw @ coef
-    labels, index = np.unique(cycles, return_inverse=True)
-    k = len(labels)
-    dof = n - 3
-    if k >= 2 and tau2_fixed is None:
-        # method of moments: within-cycle scatter from residuals about their cycle means; between-cycle from
-        # the spread of those means beyond what the within scatter explains
-        means = np.bincount(index, resid) / np.bincount(index)
-        within = resid - means[index]
-        s2 = float(within @ within) / max(n - 3 - (k - 1), 1)
-        counts = np.bincount(index)
-        tau2 = max(0.0, float(np.sum(counts * means ** 2) / max(k - 1, 1) - s2) * k / n)
+    w2 = _per_cycle(index, k, w * w)  # Σ w² per cycle
+    sums_x, sums_y = _per_cycle(index, k, xw * w[:, None]), _per_cycle(index, k, yw * w)
+    # within-cycle (fixed effects): each cycle's weighted mean removed; the intercept column vanishes
+    xd = xw - w[:, None] * (sums_x / w2[:, None])[index]
+    yd = yw - w * (sums_y / w2)[index]
+    slopes, *_ = np.linalg.lstsq(xd[:, 1:], yd, rcond=None)
+    e = yd - xd[:, 1:] @ slopes
+    dof_w = n - 2 - k
+    if dof_w < 1:
+        raise LoopError(f"too few points for {k} load cycles: {n} points leave {dof_w} degrees of freedom within "
+                        "the cycles (needs >= 1: each cycle its own offset, plus b and a)")
+    rss = float(e @ e)
+    sigma2 = rss / dof_w
+    gram = xd[:, 1:].T @ xd[:, 1:]
+    hat = w * w / w2[index] + np.einsum("ij,jk,ik->i", xd[:, 1:], np.linalg.pinv(gram), xd[:, 1:])
+    room = np.clip(1.0 - hat, 0.0, None)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        deleted = np.where(room > 1e-12, e * e / room, 0.0)
+        s2_others = np.maximum(rss - deleted, 0.0) / max(dof_w - 1, 1)  # exact leave-one-out: never < 0
+        student = np.where((room > 1e-12) & (s2_others > 0), e / np.sqrt(s2_others * room), 0.0)
+    tau2_data = None
+    if k >= 2:
+        # the cycles' weighted mean residuals about the common fit scatter as τ² + σ²/Σw²
+        pooled, *_ = np.linalg.lstsq(xw, yw, rcond=None)
+        means = _per_cycle(index, k, w * (yw - xw @ pooled)) / w2
+        tau2_data = max(0.0, float(np.var(means, ddof=1) - np.mean(sigma2 / w2)))
+    if not np.isfinite(prior_dof):
+        tau2, dof_tau = tau2_prior, math.inf
+    elif tau2_data is None:
+        tau2, dof_tau = tau2_prior, float(prior_dof)
     else:
-        s2 = float(resid @ resid) / dof
-        tau2 = 0.0 if tau2_fixed is None else tau2_fixed
-    z = (index[:, None] == np.arange(k)[None, :]).astype(float) * w[:, None]
-    v = s2 * np.eye(n) + (tau2 * z @ z.T if (k >= 2 and tau2_fixed is None) else 0.0)
-    vi = np.linalg.inv(v)
-    cov = np.linalg.inv(xw.T @ vi @ xw)
-    coef = cov @ xw.T @ vi @ yw
-    resid = yw - xw @ coef
-    hat = np.einsum("ij,jk,ik->i", xw, np.linalg.inv(xw.T @ xw), xw)
-    return coef, cov, s2, tau2, resid, hat
+        dof_tau = prior_dof + k - 1
+        tau2 = (prior_dof * tau2_prior + (k - 1) * tau2_data) / dof_tau
+    s2 = max(sigma2, np.finfo(float).tiny)
+    if k == 1:
+        # one cycle: weighted least squares; the cycle's offset u moves V0 alone (X e₁ = 1)
+        gram_full = xw.T @ xw
+        coef = np.linalg.solve(gram_full, xw.T @ yw)
+        cov = s2 * np.linalg.inv(gram_full)
+        cov[0, 0] += tau2
+    else:
+        # Woodbury, split stably: XᵀV⁻¹X = (within + Σ_c q_c S_c S_cᵀ / W_c) / σ², q_c = σ²/(σ² + τ² W_c)
+        q = s2 / (s2 + tau2 * w2)
+        between = (sums_x * (q / w2)[:, None]).T
+        a_mat = xd.T @ xd + between @ sums_x
+        rhs = xd.T @ yd + between @ sums_y
+        coef = np.linalg.solve(a_mat, rhs)
+        cov = s2 * np.linalg.inv(a_mat)
+    return LeastSquares(coef, cov, sigma2, dof_w, float(tau2), dof_tau, tau2_data, student)
 
 
 def fit(forces_n, frequencies_hz, k_mm3_hz2: float, v0_fixed_mm3: float | None = None, cycles=None,
         temperature_c: float | None = None, cycle_std_n: float | None = None) -> Eq5Fit:
     """Fit Eq. 5; ``v0_fixed_mm3`` switches to the K-free fit. ``cycles`` labels each point's load cycle: with
     two or more, the between-cycle (hysteresis) variance is estimated and carried into every force interval;
-    with one, ``cycle_std_n`` (N; default :data:`PAPER_CYCLE_STD_N`) is assumed. When the fit turns inside the
+    with one, ``cycle_std_n`` (N; default :data:`PAPER_CYCLE_SHARE` of the largest force) is assumed, and
+    with several the cycles' estimate is pooled with that prior (:data:`PRIOR_CYCLES`). When the fit turns inside the
     range (f stops rising: the paper's taxel past ~25 N), the top forces are left out until Eq. 5 holds over
     the rest, and the fit says where it stops. Raises LoopError when the data cannot tell."""
     force = np.asarray(forces_n, dtype=float)
@@ -160,10 +241,19 @@ def fit(forces_n, frequencies_hz, k_mm3_hz2: float, v0_fixed_mm3: float | None =
     for row, r in outliers:
         notes.append(f"point {row} (F = {force[row - 1]:g} N, f = {freq[row - 1]:g} Hz) is an outlier: "
                      f"studentized residual {r:+.1f}")
-    if len(np.unique(cycles[keep])) < 2:
-        notes.append(f"one load cycle: between-cycle (hysteresis) variation not measured; "
-                     f"{result.cycle_std_n:.2g} N assumed (the paper saw ~1 N between two cycles): give several "
-                     "cycles (a 'cycle' column) to estimate it")
+    if result.cycle_prior_given and result.cycles == 1:
+        notes.append(f"one load cycle: between-cycle (hysteresis) sd {result.cycle_prior_n:.3g} N as given "
+                     "(--cycle-std-n); it counts twice in every force interval: in V0 (this cycle's offset) and in "
+                     "the reading's own cycle")
+    elif result.cycles == 1:
+        notes.append(f"one load cycle: between-cycle (hysteresis) variation not measured; {result.cycle_std_n:.2g} N "
+                     f"assumed (the paper's ~1 N over 15.4 N, scaled to this {result.law.force_range_n[1]:g} N "
+                     "range); it counts twice in every force interval: give several cycles (a 'cycle' column) to "
+                     "measure it")
+    else:
+        notes.append(f"{result.cycles} load cycles: between-cycle sd {result.cycle_std_data_n:.2g} N from the "
+                     f"cycles, pooled with the prior {result.cycle_prior_n:.2g} N (worth {PRIOR_CYCLES} degrees of "
+                     f"freedom) to {result.cycle_std_n:.2g} N")
     return replace(result, law=replace(result.law, temperature_c=temperature_c), notes=tuple(notes),
                    excluded_n=tuple(force[~keep]))
 
@@ -193,31 +283,33 @@ def _fit_once(force, freq, k_mm3_hz2, v0_fixed_mm3, cycles, cycle_std_n) -> Eq5F
     y = k_mm3_hz2 / freq ** 2 if v0_fixed_mm3 is None else 1.0 / freq ** 2
     # the measurement noise is in f, so y = K/f² scatters as f⁻³: weight by (f/f̄)⁶ (σ then refers to f̄)
     w = np.sqrt((freq / freq.mean()) ** 6)
-    one_cycle = len(np.unique(cycles)) < 2
-    coef, cov_scaled, sigma2, tau2, resid, hat = weighted_least_squares(force, y, w, scale, cycles)
+    labels, index = np.unique(cycles, return_inverse=True)
+    k_cycles = len(labels)
     unscale = np.diag([1.0, 1.0 / scale, 1.0 / scale ** 2])
-    theta = unscale @ coef
-    if one_cycle:
-        # τ assumed in force: in y it is τ_F·|dy/dF| at mid-range
-        tau_n = PAPER_CYCLE_STD_N if cycle_std_n is None else cycle_std_n
-        mid = 0.5 * (force.min() + force.max())
-        tau2 = (tau_n * abs(theta[1] + 2 * theta[2] * mid)) ** 2
-    cov = unscale @ cov_scaled @ unscale
-    dof = n - 3
-    if not one_cycle and tau2 > 0:
-        # Welch–Satterthwaite: σ² has n − 3 − (k − 1) degrees of freedom, τ² only k − 1 (k cycles); the
-        # intervals use the effective dof of σ² + τ², so that τ from 2-3 cycles widens them as it should
-        k_cycles = len(np.unique(cycles))
-        dof_w, dof_b = max(n - 3 - (k_cycles - 1), 1), k_cycles - 1
-        dof = max(1, int((sigma2 + tau2) ** 2 / (sigma2 ** 2 / dof_w + tau2 ** 2 / dof_b)))
+    lo, hi = float(force.min()), float(force.max())
+    # the prior τ in force becomes one in y through |dy/dF| = |b + 2aF| at mid-range (a first, plain fit)
+    first, *_ = np.linalg.lstsq(x_scaled * w[:, None], y * w, rcond=None)
+    first = unscale @ first
+    dy_df = abs(first[1] + 2 * first[2] * 0.5 * (lo + hi))
+    given = cycle_std_n is not None
+    tau_prior_n = cycle_std_n if given else PAPER_CYCLE_SHARE * max(abs(lo), abs(hi))
+    # one cycle: the prior is all there is, taken as known (a stated assumption); several: pooled with theirs
+    ls = weighted_least_squares(force, y, w, scale, index, k_cycles, (tau_prior_n * dy_df) ** 2,
+                                math.inf if k_cycles == 1 else PRIOR_CYCLES)
+    theta, cov, sigma2, tau2 = unscale @ ls.coef, unscale @ ls.cov @ unscale, ls.sigma2, ls.tau2
+    # Welch–Satterthwaite: a new reading's scatter in y is σ² (dof within) plus τ²(1 + 1/k) — its own cycle's
+    # offset and the calibration cycles' mean offset that sits in V0 — with the degrees of freedom of τ²
+    share_tau = tau2 * (1.0 + 1.0 / k_cycles)
+    spread = sigma2 ** 2 / ls.dof_within + share_tau ** 2 / ls.dof_tau
+    dof = max(1, int(min((sigma2 + share_tau) ** 2 / spread, MAX_DOF))) if spread > 0 else MAX_DOF
+    tau2_data = ls.tau2_data
     if v0_fixed_mm3 is not None:
         # theta = (V0, b, a)/K with K = V0_fixed/theta0. Reading force from 1/f² needs theta alone (K cancels),
         # so holding K at its fitted value and scaling, (v0, b, a) = K·theta and cov = K²·cov(theta), is exact.
         k = v0_fixed_mm3 / theta[0]
         theta, cov, sigma2, tau2, k_mm3_hz2 = k * theta, k * k * cov, sigma2 * k * k, tau2 * k * k, k
-        resid = resid * k
+        tau2_data = None if tau2_data is None else tau2_data * k * k
     v0, b, a = (float(v) for v in theta)
-    lo, hi = float(force.min()), float(force.max())
     if a != 0:
         turn = -b / (2 * a)
         if lo <= turn <= hi:
@@ -229,15 +321,12 @@ def _fit_once(force, freq, k_mm3_hz2, v0_fixed_mm3, cycles, cycle_std_n) -> Eq5F
     if not abs(change) > max(t_quantile(0.975, dof) * math.sqrt(max(float(g @ cov @ g), 0.0)), 1e-12 * abs(v0)):
         raise LoopError(f"the frequencies do not change with force over {lo:g}-{hi:g} N beyond their scatter: "
                         "no load response to calibrate (check that the cap is loaded and the tone tracked)")
-    # externally studentized residuals: each point judged by the scatter of the others
-    var = sigma2 + (0.0 if one_cycle else tau2)
-    h = np.clip(1 - hat, 1e-9, None)
-    var_others = np.maximum((dof * var - resid ** 2 / h) / max(dof - 1, 1), 1e-300)
-    student = resid / np.sqrt(var_others * h)
-    limit = t_quantile(1 - OUTLIER_LEVEL / (2 * n), max(dof - 1, 1))
-    outliers = tuple((int(i), float(student[i])) for i in np.flatnonzero(np.abs(student) > limit))
-    slope_mid = abs(b + 2 * a * 0.5 * (lo + hi))
+    # externally studentized within-cycle residuals: each point judged by the scatter of the others
+    limit = t_quantile(1 - OUTLIER_LEVEL / (2 * n), max(ls.dof_within - 1, 1))
+    outliers = tuple((int(i), float(ls.student[i])) for i in np.flatnonzero(np.abs(ls.student) > limit))
+    slope_mid = max(abs(b + 2 * a * 0.5 * (lo + hi)), 1e-300)
     law = Eq5(v0, a, b, float(k_mm3_hz2), covariance=tuple(float(x) for x in cov.ravel()),
               residual_std_mm3=math.sqrt(sigma2), dof=dof, force_range_n=(lo, hi), cycle_std_mm3=math.sqrt(tau2))
-    return Eq5Fit(law, v0_fixed_mm3 is not None, force, freq, outliers=outliers, cycles=int(len(np.unique(cycles))),
-                  cycle_std_n=math.sqrt(tau2) / max(slope_mid, 1e-300))
+    return Eq5Fit(law, v0_fixed_mm3 is not None, force, freq, outliers=outliers, cycles=k_cycles,
+                  cycle_std_n=math.sqrt(tau2) / slope_mid, cycle_prior_n=tau_prior_n, cycle_prior_given=given,
+                  cycle_std_data_n=None if tau2_data is None else math.sqrt(tau2_data) / slope_mid)

@@ -3,10 +3,13 @@
 Bands are placed upward from LO. For taxel k the allocation starts at ``start`` (LO, or the previous loaded band's
 top plus the guard, :func:`matcad.prediction.bands.guard_hz`); its f0 is the lowest target whose solved geometry
 (:func:`matcad.design.solve.solve`) has a loaded band (:func:`matcad.prediction.bands.taxel_band`: predicted band,
-rise to ``mechanics.max_force_n``) starting at or above ``start``, found by bisection on the target. A band that another taxel's 2f or 3f would land in is moved above that
-harmonic (plus the guard). Every band must end at or below HI; otherwise the message says how far the N bands
-reach. The taxels go on a grid (columns = ceil(√N)) of [[taxel]] entries with the pitch of the largest cap flange
-plus the laser's smallest web, on a plate grown by the grid's extent. Frequencies Hz, lengths mm.
+rise to ``mechanics.max_force_n``) starting at or above ``start``, found by bisection on the target. Bands sit side
+by side, the guard apart, whether or not another taxel's 2f or 3f lands in them: the board tracker discounts a
+predicted harmonic (:func:`matcad.loop.board.discount_harmonics`; issue 24 — the band used to be moved above the
+harmonic, which sent the 4th band of 2.5-12 kHz to 11.7 kHz). Every band must end at or below HI; otherwise the
+message says how far the N bands reach. The taxels go on a grid (columns = ceil(√N)) of [[taxel]] entries with the
+pitch of the largest cap flange plus the laser's smallest web, on a plate grown by the grid's extent. Frequencies
+Hz, lengths mm.
 """
 
 from __future__ import annotations
@@ -58,14 +61,6 @@ class Allocation:
                          f"{b.unloaded_hz[0]:.0f}-{b.unloaded_hz[1]:.0f} Hz, loaded {b.loaded_hz[0]:.0f}-"
                          f"{b.loaded_hz[1]:.0f} Hz; {fields}")
         return "\n".join(lines)
-
-
-def _harmonic_top(placed, band, guard: float) -> float | None:
-    """The top (Hz) of the highest harmonic of an earlier band that ``band`` meets within the guard, or None."""
-    from matcad.prediction.bands import conflicts
-
-    hits = [c for c in conflicts([*placed, band], guard) if c.other == band.name]
-    return max(c.band_hz[1] for c in hits) if hits else None
 
 
 def _one(base, name: str, start: float, stop: float, vary, ratio: float):
@@ -172,10 +167,7 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
             if band.loaded_hz[0] < start:  # the load lowered f somewhere below max force: start that much higher
                 start = 2 * start - band.loaded_hz[0]
                 continue
-            top = _harmonic_top(placed, band, guard)
-            if top is None:
-                break
-            start = top + guard
+            break
         if band.loaded_hz[1] > hi_hz:
             raise Unreachable(_fit_text(None, k, n, lo_hz, hi_hz, [*placed, band])[0])
         placed.append(band)
@@ -194,7 +186,7 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
 def _fit_text(exc, k: int, n: int, lo: float, hi: float, placed) -> tuple:
     """Why the n bands do not fit in [lo, hi]: where the bands so far reach, and the exception's own reason."""
     bands = "; ".join(f"{b.name} {b.loaded_hz[0]:.0f}-{b.loaded_hz[1]:.0f} Hz" for b in placed) or "none"
-    text = (f"--band {lo:g} {hi:g}: {n} disjoint bands do not fit (guard and 2f/3f rule); taxel {k} of {n} "
+    text = (f"--band {lo:g} {hi:g}: {n} disjoint bands do not fit (guard); taxel {k} of {n} "
             f"{'ends above ' + format(hi, 'g') + ' Hz' if exc is None else 'cannot be solved: ' + str(exc)}. "
             f"Bands so far: {bands}. Widen the band, lower mechanics.max_force_n, or narrow each taxel's band "
             "(plate.thickness_measured, a [reference] taxel)")

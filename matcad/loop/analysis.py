@@ -59,6 +59,13 @@ class Analysis:
     plot_freqs_hz: np.ndarray = field(repr=False, default=None)
     plot_db: np.ndarray = field(repr=False, default=None)  # frequency × column, max-pooled in time
     warnings: tuple[str, ...] = ()
+    frame_level_db: np.ndarray = field(repr=False, default=None)
+    """The ridge's own level per frame (dB of power, not over the floor; the tracker's ridge, before any hop is
+    undone): lets a board tell a harmonic from a taxel's own tone (:func:`matcad.loop.board.discount_harmonics`)."""
+    unassigned: str = ""
+    """Why the tracked line cannot be told to be the taxel's ('' when it can): a second tone of comparable level
+    (within :data:`matcad.loop.crossing.COMPARABLE_DB`) in the band from the first voiced frames on, so that no
+    stretch of the taxel alone anchors its identity (issue 24). ``sense`` gives no force then."""
 
     def to_dict(self) -> dict:
         return {"mean_hz": self.mean_hz, "median_hz": self.median_hz, "std_hz": self.std_hz,
@@ -68,7 +75,7 @@ class Analysis:
                 "voiced_frames": int(np.sum(self.voiced)), "segments": [s.to_dict() for s in self.segments],
                 "other_sources": [{"frequency_hz": s.frequency_hz, "relative_db": s.relative_db,
                                    "fraction": s.fraction} for s in self.sources],
-                "warnings": list(self.warnings)}
+                "warnings": list(self.warnings), "unassigned": self.unassigned}
 
     def to_text(self, source: str) -> str:
         """What ``analyze`` prints for the recording named ``source``: the statistics, the segments, the
@@ -165,6 +172,7 @@ def conclude(frames: Frames, bins: BandBins, duration_s: float, loudest: str = "
         warnings.append(f"no voiced stretch lasts {MIN_RUN_HARMONIC} frames ({seconds:.2f} s; the longest: "
                         f"{longest}): these may be a room's response peaks or another transient rather than a "
                         "singing taxel")
+    unassigned = _unassigned(sources, other_excess[voiced], other_level[voiced])
     prom = np.where(np.isfinite(other_level[voiced]), -other_level[voiced], excess[voiced])
     plot_times, plot_db = plot
     return Analysis(mean_hz=float(np.mean(track[voiced])), median_hz=float(np.median(track[voiced])),
@@ -173,7 +181,21 @@ def conclude(frames: Frames, bins: BandBins, duration_s: float, loudest: str = "
                     band_hz=(lo, hi), sample_rate_hz=bins.fs, duration_s=duration_s, times_s=times,
                     track_hz=track, frame_snr_db=excess, voiced=voiced, segments=tuple(segments),
                     sources=tuple(sources), plot_times_s=plot_times, plot_freqs_hz=band_freqs, plot_db=plot_db,
-                    warnings=tuple(warnings))
+                    warnings=tuple(warnings), unassigned=unassigned)
+
+
+def _unassigned(sources, other_excess, other_level) -> str:
+    """:attr:`Analysis.unassigned` from the second sources and, per voiced frame, the strongest other line's excess
+    over its floor and level relative to the ridge (dB): a comparable second source present in most of the first
+    MIN_RUN_HARMONIC voiced frames."""
+    close = [s for s in sources if abs(s.relative_db) <= crossing.COMPARABLE_DB]
+    first = slice(0, MIN_RUN_HARMONIC)
+    comparable = (other_excess[first] >= WEAK_DB) & (other_level[first] >= -crossing.COMPARABLE_DB)
+    if not close or np.mean(comparable) <= 0.5:
+        return ""
+    return (f"two tones of comparable level in the band from the start (the other near {close[0].frequency_hz:.0f} "
+            f"Hz, {close[0].relative_db:+.1f} dB): nothing tells which one is the taxel, so no force is given; "
+            "listen in the taxel's own band (a board spec, or --band around its tone only)")
 
 
 def second_sources(other_bin, other_excess, other_level, band_freqs) -> list[Source]:

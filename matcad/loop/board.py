@@ -24,11 +24,15 @@ one row per frame, in time order, as soon as every taxel has decided that frame.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from matcad.errors import LoopError
+from matcad.listening import EDGE_BINS
+from matcad.prediction.bands import HARMONICS
+from matcad.loop.segments import STEP_HZ
+from matcad.loop.voicing import MIN_RUN_HARMONIC
 from matcad.loop.analysis import Analysis
 from matcad.loop.analyze import run_trackers
 from matcad.loop.sense import sense
@@ -94,12 +98,139 @@ def analyze_board(blocks, fs: float, named_bands, on_frame=None) -> list[TaxelTr
     for k, ((name, band), tracker) in enumerate(zip(named_bands, trackers)):
         others = [b for j, b in enumerate(bands) if j != k]
         try:
-            tracks.append(TaxelTrack(name, band, tracker.finish(duration, mean_power, others)))
+            heard = tracker.finish(duration, mean_power, others)
+            analysis = off_edge(name, heard)
+            tracks.append(TaxelTrack(name, band, replace(analysis, warnings=(*analysis.warnings,
+                                                                             *dropouts(name, heard)))))
         except LoopError as exc:
             tracks.append(TaxelTrack(name, band, None, str(exc)))
+    tracks = discount_harmonics(tracks)
     if all(t.analysis is None for t in tracks):
         raise LoopError("no taxel's tone found: " + "; ".join(f"{t.name}: {t.reason}" for t in tracks))
     return tracks
+
+
+HARMONIC_TOL_BINS = 3
+"""A ridge within this many bins (~16 Hz at 44.1 kHz) of a predicted harmonic m·f of another taxel's tone in the
+same frame lies on that harmonic."""
+
+
+HARMONIC_WEAKER_DB = 10.0
+"""...and is at least this much weaker (the ridge's own level, dB) than that taxel's tone: a harmonic is weaker than
+its fundamental (a Helmholtz resonator does not amplify it: -20 dB on the synthetic board); a line about as strong
+as another taxel's tone is the taxel's own, even where its pitch meets the harmonic."""
+
+
+def discount_harmonics(tracks, harmonics=HARMONICS) -> list[TaxelTrack]:
+    """Each taxel's frames whose ridge lies on another taxel's harmonic — m·f (m in ``harmonics``) of that taxel's
+    tone in the same frame, within HARMONIC_TOL_BINS, and HARMONIC_WEAKER_DB weaker — left out, with a warning;
+    segments made mostly of them are flagged. The bands of a board may hold other taxels' 2f and 3f (issue 24: the
+    allocation interleaves bands between harmonics instead of forbidding them): a taxel quieter than a neighbour's
+    harmonic, or silent, would otherwise be read at the harmonic's pitch; where its own, much weaker tone sits on
+    the harmonic the frame cannot be told and is left out too. A taxel left with no voiced frame gets no analysis
+    and the reason."""
+    out = []
+    for k, t in enumerate(tracks):
+        a = t.analysis
+        if a is None:
+            out.append(t)
+            continue
+        tol = HARMONIC_TOL_BINS * float(a.plot_freqs_hz[1] - a.plot_freqs_hz[0])
+        on = np.zeros(len(a.track_hz), dtype=bool)
+        which = []
+        for j, other in enumerate(tracks):
+            b = other.analysis
+            if j == k or b is None or len(b.track_hz) != len(a.track_hz):
+                continue
+            for m in harmonics:
+                hit = a.voiced & b.voiced & (np.abs(a.track_hz - m * b.track_hz) <= tol)
+                if a.frame_level_db is not None and b.frame_level_db is not None:
+                    hit &= a.frame_level_db < b.frame_level_db - HARMONIC_WEAKER_DB
+                if np.any(hit):
+                    which.append(f"{other.name}'s {m}f ({int(hit.sum())} frames)")
+                on |= hit
+        if not np.any(on):
+            out.append(t)
+            continue
+        voiced = a.voiced & ~on
+        if not np.any(voiced):
+            out.append(TaxelTrack(t.name, t.band_hz, None, f"every voiced frame lies on {', '.join(which)}: no "
+                                                            "tone of its own"))
+            continue
+        flag = "on another taxel's harmonic"
+        segments = tuple(replace(s, flag=s.flag or flag)
+                         if np.mean(on[(a.times_s >= s.start_s) & (a.times_s <= s.end_s)]) > 0.5 else s
+                         for s in a.segments)
+        f = a.track_hz[voiced]
+        warning = (f"{int(on.sum())} frames of {t.name} lie on {', '.join(which)}, predicted from that taxel's "
+                   "tone: left out (a harmonic, or the taxel's own tone where the two coincide)")
+        out.append(TaxelTrack(t.name, t.band_hz, replace(
+            a, mean_hz=float(np.mean(f)), median_hz=float(np.median(f)), std_hz=float(np.std(f)),
+            tone_fraction=float(np.mean(voiced)), voiced=voiced, segments=segments,
+            warnings=(*a.warnings, warning))))
+    return out
+
+
+def off_edge(name: str, a: Analysis) -> Analysis:
+    """A board taxel's analysis with the frames its ridge spent at its band's edge left out (voiced ones within
+    EDGE_BINS + 1 bins of an edge, and the unvoiced run at the edge that follows them): a tone pressed out of its
+    band leaves the ridge parked on the skirt at the edge, which is no reading (issue 24: 3-frame segments pinned
+    41 Hz below the tone). Segments there are flagged (no force); a warning says the taxel left its band. Raises
+    LoopError when no voiced frame is left."""
+    df = float(a.plot_freqs_hz[1] - a.plot_freqs_hz[0])
+    lo, hi = a.band_hz
+    near = (EDGE_BINS + 1) * df
+    at_edge = (a.track_hz - lo <= near) | (hi - a.track_hz <= near)
+    left = a.voiced & at_edge
+    # the ridge parked at the edge right after a voiced edge frame: the tone went on out of the band
+    for i in range(1, len(left)):
+        if at_edge[i] and not a.voiced[i] and left[i - 1]:
+            left[i] = True
+    if not np.any(left & a.voiced):
+        return a
+    voiced = a.voiced & ~left
+    if not np.any(voiced):
+        raise LoopError(f"{name}'s tone sits at its band's edge in every voiced frame: it lies outside "
+                        f"{lo:.0f}-{hi:.0f} Hz")
+    flag = "at the band edge: the tone left the band"
+    segments = tuple(replace(s, flag=s.flag or flag) if min(s.mean_hz - lo, hi - s.mean_hz) <= near else s
+                     for s in a.segments)
+    times = a.times_s[left]
+    side = "top" if np.median(a.track_hz[left]) > 0.5 * (lo + hi) else "bottom"
+    warning = (f"{name}'s tone reached its band's {side} edge ({hi if side == 'top' else lo:.0f} Hz) in "
+               f"{int(left.sum())} frames between {times[0]:.2f} and {times[-1]:.2f} s: it left its band (pressed "
+               "beyond the band's force range, or the band is wrong); those frames are left out")
+    f = a.track_hz[voiced]
+    return replace(a, mean_hz=float(np.mean(f)), median_hz=float(np.median(f)), std_hz=float(np.std(f)),
+                   tone_fraction=float(np.mean(voiced)), voiced=voiced, segments=segments,
+                   warnings=(*a.warnings, warning))
+
+
+DROPOUT_FRAMES = (5, 65)
+"""A silence of this many frames (~0.23-3 s) inside a steady tone is reported by :func:`dropouts`."""
+
+
+def dropouts(name: str, a: Analysis) -> list[str]:
+    """Warnings for the silences of a board taxel that stops abruptly at a steady pitch and comes back at the same
+    pitch (within STEP_HZ) after DROPOUT_FRAMES frames, with MIN_RUN_HARMONIC voiced frames on both sides: what an
+    overblown jump out of its band (the jet driving another mode) does — or a stalled jet; a press would ramp the
+    pitch first. The jumped tone itself is not looked for (the trackers see only the bands)."""
+    out = []
+    v = np.flatnonzero(a.voiced)
+    for i, j in zip(v[:-1], v[1:]):
+        gap = j - i - 1
+        if not DROPOUT_FRAMES[0] <= gap <= DROPOUT_FRAMES[1]:
+            continue
+        before, after = v[v <= i][-MIN_RUN_HARMONIC:], v[v >= j][:MIN_RUN_HARMONIC]
+        if len(before) < MIN_RUN_HARMONIC or len(after) < MIN_RUN_HARMONIC or before[0] < i - 2 * MIN_RUN_HARMONIC \
+                or after[-1] > j + 2 * MIN_RUN_HARMONIC:
+            continue
+        f0, f1 = np.median(a.track_hz[before]), np.median(a.track_hz[after])
+        if abs(f1 - f0) <= STEP_HZ and np.ptp(a.track_hz[before]) <= 2 * STEP_HZ:
+            out.append(f"{name}'s tone stopped abruptly at {a.times_s[i]:.2f} s from a steady {f0:.0f} Hz and came "
+                       f"back at the same pitch at {a.times_s[j]:.2f} s: an overblown jump out of its band (the jet "
+                       "driving another mode) or a stalled jet; no force in between")
+    return out
 
 
 def parse_calibrations(values, names) -> dict[str, str]:

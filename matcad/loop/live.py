@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from matcad.loop.board import LiveFrames
+from matcad.loop.sense import force_interval
 
 
 def taxel_line(cal, temperature_c, time_s: float, freq: float) -> str:
@@ -18,7 +19,7 @@ def taxel_line(cal, temperature_c, time_s: float, freq: float) -> str:
     (:class:`matcad.acoustics.eq5.Eq5`) at ``temperature_c`` (°C)."""
     if freq != freq:
         return f"{time_s:9.3f} s  no tone"
-    force, half = cal.force_with_interval([freq], temperature_c=temperature_c)
+    force, half, _ = force_interval(cal, [freq], temperature_c)
     text = f"F = {force[0]:.3f} +- {half[0]:.3f} N" if np.isfinite(force[0]) else "outside the calibrated range"
     return f"{time_s:9.3f} s  {freq:9.2f} Hz  {text}"
 
@@ -40,7 +41,7 @@ def board_line(names, cals, temperature_c, time_s: float, values) -> str:
             return f"{taxel} no tone"
         text = f"{taxel} {freq:.2f} Hz"
         if taxel in cals:
-            force, half = cals[taxel].force_with_interval([freq], temperature_c=temperature_c)
+            force, half, _ = force_interval(cals[taxel], [freq], temperature_c)
             text += (f" F={force[0]:.3f}+-{half[0]:.3f} N" if np.isfinite(force[0])
                      else " outside the calibrated range")
         return text

@@ -6,7 +6,11 @@ and the between-cycle (hysteresis) variance τ² the calibration estimated from 
 Var F = gᵀ Σ g + (σ² + τ²)/(b + 2aF)², with g = ∂F/∂(V0, b, a) = (1, −F, −F²) / (b + 2aF).
 
 Temperature: f = c/(2π)·sqrt(A/(l V)) with c ∝ sqrt(T) (T in kelvin, ideal gas; matcad.acoustics.air), so a
-frequency heard at T is the one the calibration would have heard at T_cal times sqrt(T_cal/T).
+frequency heard at T is the one the calibration would have heard at T_cal times sqrt(T_cal/T). When the air's
+temperature now is not given, it may differ from the calibration's by a lab's day-to-day swing
+(:data:`matcad.acoustics.uncertainty.TEMPERATURE_TOL_C`, ±3 °C, taken as uniform: sd 3/√3 °C); that term is
+carried into every interval (:func:`force_interval`) and a warning says what it costs (issue 24: without it, 74 %
+of 95 % intervals held the true force at ±3 °C).
 
 Only voiced frames get a force; frequencies whose force falls outside the calibrated range give NaN with a
 reason, never an extrapolation; flagged segments (mode jumps) get none. Forces N, frequencies Hz, °C.
@@ -19,8 +23,34 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from matcad.acoustics.eq5 import Eq5
+from matcad.acoustics.uncertainty import TEMPERATURE_TOL_C
 from matcad.errors import LoopError
 from matcad.listening import CALIBRATED_MARGIN, listening_band
+from matcad.loop.voicing import MIN_RUN_HARMONIC, longest_run
+
+
+TEMPERATURE_SD_C = TEMPERATURE_TOL_C / np.sqrt(3.0)
+"""Standard deviation (°C) of the air's temperature now against the calibration's when it is not given: uniform
+over ±TEMPERATURE_TOL_C."""
+
+
+def force_interval(cal: Eq5, frequency_hz, temperature_c: float | None):
+    """(forces, half-widths of their 95 % intervals, warning or '') (N) of frequencies heard (Hz): through
+    :meth:`Eq5.force_with_interval` at ``temperature_c`` (°C) when given, else with the unknown temperature's
+    :data:`TEMPERATURE_SD_C` in every interval and a warning naming its cost at mid-range."""
+    if temperature_c is not None:
+        force, half = cal.force_with_interval(frequency_hz, temperature_c=temperature_c)
+        return force, half, ""
+    force, half = cal.force_with_interval(frequency_hz, temperature_sd_c=TEMPERATURE_SD_C)
+    mid = 0.5 * sum(cal.force_range_n)
+    f_mid = cal.frequency_hz(mid)
+    _, known = cal.force_with_interval([f_mid])
+    _, unknown = cal.force_with_interval([f_mid], temperature_sd_c=TEMPERATURE_SD_C)
+    at = "" if cal.temperature_c is None else f" {cal.temperature_c:g} degC"
+    warning = (f"air temperature not given (--temperature-c): up to +-{TEMPERATURE_TOL_C:g} degC from the "
+               f"calibration's{at} assumed, which widens each 95 % interval from +-{known[0]:.2f} to "
+               f"+-{unknown[0]:.2f} N at {mid:g} N")
+    return force, half, warning
 
 
 def sensing_law(cal) -> Eq5:
@@ -93,23 +123,66 @@ class Reading:
         return "\n".join(lines)
 
 
+IN_RANGE_SHARE = 0.5
+"""The overall force needs at least this share of the voiced frames inside the calibrated range (issue 24: a
+reverberant room's scattered peaks, sd 370 Hz, averaged to "4.47 N")."""
+FRAMES_PER_READING = 3.0
+"""Frames of a segment per independent reading of its frequency (the 50 % overlap and the ridge's smoothing
+correlate neighbours): on the slow-press and 2 N press recordings of benchmarks/wrong_answers.py, segment means
+scattered about the truth 1.5 times sd/sqrt(frames), i.e. one reading per ~2.3 frames; 3 is taken."""
+
+
+def _mean_scatter_n(cal: Eq5, segments, seg_f, temperature_c) -> np.ndarray:
+    """Half-width (N) of the 95 % interval that the scatter of each segment's mean frequency adds: 1.96 times
+    its sd / sqrt(frames / FRAMES_PER_READING), through dF/df (issue 24: a calibration tighter than the track
+    gave segment intervals of +-0.03 N that missed a steady force by the track's own 1 Hz)."""
+    if len(seg_f) == 0:
+        return np.zeros(0)
+    up, _, _ = force_interval(cal, seg_f + 0.5, temperature_c)
+    down, _, _ = force_interval(cal, seg_f - 0.5, temperature_c)
+    sem = np.array([s.std_hz * np.sqrt(FRAMES_PER_READING / max(s.frames, 1)) for s in segments])
+    return np.nan_to_num(1.96 * np.abs(up - down) * sem)
+
+
+def refusal(analysis) -> str:
+    """Why ``sense`` gives no force for an :class:`matcad.loop.analysis.Analysis` ('' when it does): the tracked line
+    cannot be told to be the taxel's (:attr:`~matcad.loop.analysis.Analysis.unassigned`), or no voiced stretch
+    lasts MIN_RUN_HARMONIC frames (a few frames in noise — a room's response peak, a talker's formant — are not
+    evidence of a singing taxel; ``analyze`` warns, ``sense`` refuses: issue 24)."""
+    if analysis.unassigned:
+        return analysis.unassigned
+    longest = longest_run(analysis.voiced)
+    if longest < MIN_RUN_HARMONIC:
+        return (f"no voiced stretch lasts {MIN_RUN_HARMONIC} frames (the longest: {longest}): too little evidence "
+                "of a singing taxel for a force")
+    return ""
+
+
 def sense(analysis, cal: Eq5, temperature_c: float | None = None) -> Reading:
     """Forces of an :class:`matcad.loop.analysis.Analysis` through a calibration (:meth:`Eq5.force_with_interval`):
-    per voiced frame, per segment and overall."""
-    track = np.where(analysis.voiced, analysis.track_hz, np.nan)
-    frames, half = cal.force_with_interval(track, temperature_c=temperature_c)
-    seg_f = np.array([s.mean_hz if not s.flag else np.nan for s in analysis.segments])
-    seg_force, seg_half = cal.force_with_interval(seg_f, temperature_c=temperature_c)
+    per voiced frame, per segment and overall; none at all (NaN, with the reason) when :func:`refusal` says
+    so."""
+    refused = refusal(analysis)
+    track = np.where(analysis.voiced & (not refused), analysis.track_hz, np.nan)
+    frames, half, air = force_interval(cal, track, temperature_c)
+    seg_f = np.array([s.mean_hz if not (s.flag or refused) else np.nan for s in analysis.segments])
+    seg_force, seg_half, _ = force_interval(cal, seg_f, temperature_c)
+    seg_half = np.hypot(seg_half, _mean_scatter_n(cal, analysis.segments, seg_f, temperature_c))
     segments = np.column_stack([seg_force, seg_force - seg_half, seg_force + seg_half]).reshape(-1, 3)
     mean_f = analysis.mean_hz
-    force, width = cal.force_with_interval(np.array([mean_f]), temperature_c=temperature_c)
+    force, width, _ = force_interval(cal, np.array([np.nan if refused else mean_f]), temperature_c)
     force, width = float(force[0]), float(width[0])
-    reason = ""
-    if not np.isfinite(force):
-        f_lo, f_hi = cal.frequency_range_hz()
+    reason = refused
+    f_lo, f_hi = cal.frequency_range_hz()
+    voiced, in_range = int(np.sum(analysis.voiced)), int(np.sum(np.isfinite(frames)))
+    if not np.isfinite(force) and not refused:
         reason = (f"{mean_f:.1f} Hz lies outside the calibrated {f_lo:.1f}-{f_hi:.1f} Hz "
                   f"({cal.force_range_n[0]:g}-{cal.force_range_n[1]:g} N): no extrapolation")
-    warnings = []
+    elif not refused and in_range < IN_RANGE_SHARE * voiced:
+        force, width = np.nan, np.nan
+        reason = (f"only {in_range} of {voiced} voiced frames lie in the calibrated {f_lo:.1f}-{f_hi:.1f} Hz: "
+                  "their mean is no reading (a tone that wanders over the band is no taxel)")
+    warnings = [air] if air else []
     steady = np.isfinite(segments[:, 0])
     if np.sum(steady) >= 2 and np.ptp(segments[steady, 0]) > np.max(segments[steady, 2] - segments[steady, 1]):
         warnings.append(f"the load changed during the recording ({np.sum(steady)} steady segments from "

@@ -61,9 +61,18 @@ def press_profile(seconds: float, fs: float, steps, ramp_s: float = 0.15, base_n
     return force
 
 
+HARMONICS_DB = (-20.0, -30.0)
+"""Levels of the 2nd and 3rd harmonic against the fundamental (dB) of a realistic taxel: a Helmholtz resonator has no
+resonance at its harmonics, so the edge tone's harmonic drive is not amplified and vessel flutes sound almost
+overtone-free ("Vessel flute", Acoustics: the resonator amplifies one frequency only); -20/-30 dB is a generous
+reading of that (benchmarks/analyze.py also runs -10 dB)."""
+
+
 def taxel(freq_hz: np.ndarray, fs: float, seed: int, amplitude: float = 0.1, linewidth_hz: float = 1.0,
-          q: float = 40.0, skirt: float = 0.3, gate=None) -> np.ndarray:
-    """The self-sustained oscillator at per-sample ``freq_hz``: phase-diffusing line plus resonant jet noise.
+          q: float = 40.0, skirt: float = 0.3, gate=None, harmonics_db=()) -> np.ndarray:
+    """The self-sustained oscillator at per-sample ``freq_hz``: phase-diffusing line plus resonant jet noise, and
+    phase-locked harmonics 2f, 3f, … at ``harmonics_db`` (dB against the line; those above 0.45 fs are left out,
+    as a microphone's anti-alias filter does).
 
     ``gate`` (0..1 per sample) switches the sound on and off with 20 ms fades.
     """
@@ -72,7 +81,11 @@ def taxel(freq_hz: np.ndarray, fs: float, seed: int, amplitude: float = 0.1, lin
     # phase diffusion D = π·linewidth gives a Lorentzian of FWHM linewidth_hz (Lax 1967)
     dphi = 2 * np.pi * freq_hz / fs + np.sqrt(2 * np.pi * linewidth_hz / fs) * rng.standard_normal(n)
     amp = amplitude * (1 + 0.05 * _lowpass(rng.standard_normal(n), fs, 5.0))
-    line = amp * np.sin(np.cumsum(dphi))
+    phase = np.cumsum(dphi)
+    line = amp * np.sin(phase)
+    for k, level in enumerate(harmonics_db, 2):
+        audible = k * np.asarray(freq_hz) < 0.45 * fs
+        line += audible * amp * 10 ** (level / 20) * np.sin(k * phase + rng.uniform(0, 2 * np.pi))
     jet = _resonated_noise(freq_hz, fs, q, rng) * amplitude * skirt
     x = line + jet
     if gate is not None:
@@ -186,7 +199,8 @@ def _base(seconds, fs, seed, force, gate=None, amplitude=0.1, freq=None):
     return x, truth
 
 
-def _room(x, fs, seed, rt60=0.5, pink_rms=0.01):
+def room(x, fs, seed, rt60=0.5, pink_rms=0.01):
+    """``x`` heard in a room: reverb of RT60 ``rt60`` (s), pink noise of RMS ``pink_rms``, the tablet microphone."""
     return microphone(reverb(x, fs, rt60, seed + 1) + coloured_noise(len(x), fs, seed + 2, 1.0, pink_rms), fs)
 
 
@@ -198,27 +212,27 @@ def scenario(name: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) ->
     if name == "steady":
         force = steady
         x, truth = _base(seconds, fs, seed, force)
-        x = _room(x, fs, seed)
+        x = room(x, fs, seed)
     elif name == "presses":  # 2 → 12 N presses held 0.5 s with 0.15 s ramps
         starts = np.arange(1.0, seconds - 1.0, 2.0)
         force = press_profile(seconds, fs, [(s, s + 0.8, 12.0) for s in starts], ramp_s=0.15)
         x, truth = _base(seconds, fs, seed, force)
-        x = _room(x, fs, seed, rt60=0.3)
+        x = room(x, fs, seed, rt60=0.3)
     elif name == "tapping":  # 2 taps a second to 10 N: 50 ms ramps, 0.2 s held, 0.2 s released
         starts = np.arange(0.5, seconds - 0.5, 0.5)
         force = press_profile(seconds, fs, [(s, s + 0.3, 10.0) for s in starts], ramp_s=0.05)
         x, truth = _base(seconds, fs, seed, force)
-        x = _room(x, fs, seed, rt60=0.3)
+        x = room(x, fs, seed, rt60=0.3)
     elif name == "gaps":  # sings half the time; starts silent (the paper: may not sing unloaded)
         gate = ((t % 2.0) > 1.0).astype(float)
         force = steady
         x, truth = _base(seconds, fs, seed, force, gate=gate)
-        x = _room(x, fs, seed)
+        x = room(x, fs, seed)
     elif name == "short-tone":  # 1 s of tone in a long quiet recording
         gate = ((t > seconds / 2) & (t < seconds / 2 + 1.0)).astype(float)
         force = steady
         x, truth = _base(seconds, fs, seed, force, gate=gate)
-        x = _room(x, fs, seed)
+        x = room(x, fs, seed)
     elif name == "buzz-only":  # silent taxel, 60 Hz buzz
         force = steady
         truth = np.full(n, np.nan)
@@ -227,27 +241,27 @@ def scenario(name: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) ->
     elif name == "buzz+tone":
         force = steady
         x, truth = _base(seconds, fs, seed, force)
-        x = _room(x + buzz(n, fs, 60.0, rms=0.05, seed=seed), fs, seed)
+        x = room(x + buzz(n, fs, 60.0, rms=0.05, seed=seed), fs, seed)
     elif name == "speech-only":
         force = steady
         truth = np.full(n, np.nan)
-        x = _room(speech_like(n, fs, seed, rms=0.1), fs, seed)
+        x = room(speech_like(n, fs, seed, rms=0.1), fs, seed)
     elif name == "speech+tone":
         force = steady
         x, truth = _base(seconds, fs, seed, force)
-        x = _room(x + speech_like(n, fs, seed, rms=0.1), fs, seed)
+        x = room(x + speech_like(n, fs, seed, rms=0.1), fs, seed)
     elif name == "neighbour":  # a louder second taxel 300 Hz above in the band
         force = steady
         x, truth = _base(seconds, fs, seed, force)
         other = taxel(frequency_of_force(force) + 300.0, fs, seed + 7, amplitude=0.3)
-        x = _room(x + other, fs, seed)
+        x = room(x + other, fs, seed)
     elif name == "overblown":  # from 6 to 7 s the jet drives another mode, 25 % higher
         force = steady
         jump = (t > seconds * 0.6) & (t < seconds * 0.7)
         freq = frequency_of_force(force) * np.where(jump, 1.22, 1.0)
         x, truth = _base(seconds, fs, seed, force, freq=freq)
         truth = np.where(jump, np.nan, truth)  # not the taxel's load-bearing mode: must be flagged, not sensed
-        x = _room(x, fs, seed)
+        x = room(x, fs, seed)
     elif name == "room-noise":  # a fan's broadband noise heard through a reverberant room (RT60 0.6 s), no tone
         force = steady
         truth = np.full(n, np.nan)
@@ -317,7 +331,7 @@ def board_scenario(seconds: float = 10.0, seed: int = 0, fs: float = FS, f0_hz=B
         forces.append(force)
         freqs.append(frequency_of_force(force, EQ5.v0_mm3 * f0**2))
     x = sum(taxel(f, fs, seed + 11 * k, amplitude=a) for k, (f, a) in enumerate(zip(freqs, amplitudes)))
-    x = _room(x, fs, seed, rt60=0.4)
+    x = room(x, fs, seed, rt60=0.4)
     return BoardRecording(x, fs, tuple(f"t{k + 1}" for k in range(len(f0_hz))), np.array(freqs), np.array(forces),
                           tuple(board_band_hz(f0) for f0 in f0_hz))
 
@@ -352,4 +366,4 @@ def crossing_scenario(kind: str, seconds: float = 10.0, seed: int = 0, fs: float
     x, truth = _base(seconds, fs, seed, force)
     t = np.arange(len(force)) / fs
     x = x + taxel(frequency_of_force(other), fs, seed + 7, gate=(t > 1.0).astype(float))
-    return Recording(_room(x, fs, seed), fs, truth, force)
+    return Recording(room(x, fs, seed), fs, truth, force)

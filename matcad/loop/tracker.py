@@ -11,6 +11,8 @@ times s, levels dB.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from matcad.listening import EXCLUDE_BINS
@@ -66,6 +68,7 @@ class BandTracker:
         # decided frames: time, ridge frequency and excess, the strongest other line (bin, excess, level)
         self.times, self.track, self.excess, self.other_bin, self.other_excess, self.other_level = \
             [], [], [], [], [], []
+        self.peak_db = []  # the ridge's own level (dB of power, not over the floor)
         self._emitted = 0  # frames whose voicing is final and reported
         self.band_peak_power = np.zeros(nb)
 
@@ -121,6 +124,7 @@ class BandTracker:
         self.other_bin.extend(other.tolist())
         self.other_excess.extend(other_excess.tolist())
         self.other_level.extend(other_level.tolist())
+        self.peak_db.extend(m.tolist())
         for i, harmonic_line, position in zip(range(first, first + count), harmonic.tolist(),
                                               ((freq - first_hz) / self.bins.df).tolist()):
             e = -np.inf if harmonic_line else self.excess[i]
@@ -150,4 +154,4 @@ class BandTracker:
         frames = Frames(np.array(self.times), np.array(self.track), np.array(self.excess),
                         np.array(self._voicing.state, dtype=int), np.array(self.other_bin),
                         np.array(self.other_excess), np.array(self.other_level))
-        return conclude(frames, self.bins, duration_s, loudest, plot)
+        return replace(conclude(frames, self.bins, duration_s, loudest, plot), frame_level_db=np.array(self.peak_db))

@@ -140,8 +140,17 @@ def _singular_corner(cm: CapMesh, sec: CapSection, point) -> str:
 
 
 def cap_curve(case) -> CapCurve:
-    """The load curve of a :class:`~matcad.mechanics.case.CapCase` (see :func:`compress`)."""
-    return compress(case.section, case.material, case.contact, case.displacement_mm, case.steps, case.element_size_mm)
+    """The load curve of a :class:`~matcad.mechanics.case.CapCase` (see :func:`compress`), read from the disk cache
+    of :mod:`matcad.mechanics.store` when an earlier run computed this case with this code, else computed and
+    stored."""
+    from matcad.mechanics import store
+
+    curve = store.load(case, CapCurve, CapStep)
+    if curve is None:
+        curve = compress(case.section, case.material, case.contact, case.displacement_mm, case.steps,
+                         case.element_size_mm)
+        store.save(case, curve)
+    return curve
 
 
 def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking", displacement_mm: float = 2.0,
