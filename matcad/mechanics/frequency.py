@@ -124,7 +124,7 @@ def force_curve(d: Design, curve: CapCurve, f0_hz: float | None = None, fem_leve
         eq5 = Eq5(cal.v0_mm3, cal.a, cal.b, area_convention="pi_d2/4", name="mechanics")
         # A = d²/4 is A(πd²/4)/π: every volume of the fit scales by 1/π
         eq5_paper = Eq5(cal.v0_mm3 / np.pi, cal.a / np.pi, cal.b / np.pi, area_convention="d2/4", name="mechanics")
-    except LoopError as exc:
+    except (LoopError, np.linalg.LinAlgError) as exc:  # a curve Eq. 5 cannot follow (e.g. a crushed tiny cavity)
         note = f"no Eq. 5 fit: {exc}"
     states = tuple(ForceState(float(F), float(x), float(v), float(le), float(a),
                               None if f_fem is None or np.isnan(f_fem[i]) else float(f_fem[i]), float(b))
