@@ -107,7 +107,8 @@ def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, r
     guess sqrt(r/(lL)) (tan x ≥ x) and π·sqrt(r/(8mM + 4rM²)), m = min(l, L) (tan x ≥ 8x/(π² − 4x²) on
     the longer segment). Newton in u therefore descends monotonically onto the fundamental in ~5 steps and
     never jumps to an overtone; a bisection safeguard inside the bracket guards against rounding.
-    Broadcasts over array inputs.
+    Broadcasts over array inputs; an entry stops iterating once it has converged, so its root is the same whether
+    it is solved alone or among a sweep's variants.
     """
     r, ln, lc = np.broadcast_arrays(*(np.asarray(x, dtype=float)
                                       for x in (area_ratio, neck_length_mm, cavity_length_mm)))
@@ -115,6 +116,7 @@ def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, r
     lo = np.zeros_like(r)
     hi = np.pi / (2.0 * long)
     k = np.minimum(np.sqrt(r / (ln * lc)), np.pi * np.sqrt(r / (8.0 * short * long + 4.0 * r * long * long)))
+    active = np.ones(k.shape, dtype=bool)  # a converged root stays as it is: each entry's iterates are its own
     for _ in range(max_iter):
         t1, t2 = np.tan(k * ln), np.tan(k * lc)
         phi = np.log(t1 * t2 / r)
@@ -123,9 +125,10 @@ def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, r
         hi = np.where(phi > 0.0, k, hi)
         newton = k * np.exp(-phi / dphi_du)
         k_new = np.where((newton >= lo) & (newton <= hi), newton, 0.5 * (lo + hi))
-        done = np.all(np.abs(k_new - k) <= rtol * k_new)
-        k = k_new
-        if done:
+        converged = np.abs(k_new - k) <= rtol * k_new
+        k = np.where(active, k_new, k)
+        active &= ~converged
+        if not active.any():
             break
     return k
 
