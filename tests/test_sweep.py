@@ -176,7 +176,19 @@ def test_dead_worker_fails_its_variants_not_the_sweep():
     results = run(crash_on_index_3, [{"index": i} for i in range(8)], Executor(2))
     assert [r["index"] for r in results] == list(range(8))
     assert results[3]["status"] == "failed" and "worker lost" in results[3]["reason"]
-    assert all(r["status"] in ("ok", "failed") for r in results)
+    # only the dead worker's chunk (one variant here: 8 tasks in 2 x 4 chunks) fails; the others are run again
+    assert [r["status"] for r in results] == ["ok"] * 3 + ["failed"] + ["ok"] * 4
+
+
+@pytest.mark.parametrize("address", ["nonsense", "tcp://host:notaport", "tcp://127.0.0.1:99999", "localhost:8786x",
+                                     "http://127.0.0.1:8786", "tcp://:8786"])
+def test_malformed_scheduler_is_bad_input_at_once(tmp_path, address):
+    with pytest.raises(ValueError, match="host:port"):  # refused when the executor is made, before any connection
+        Executor(scheduler=address)                     # (Dask itself would wait 20 s, then raise a traceback)
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--scheduler", address,
+                           "--out", tmp_path / "s")
+    assert code == 2 and f"--scheduler {address}" in err and "host:port" in err and "Traceback" not in err, err
+    assert not (tmp_path / "s").exists()
 
 
 def test_unreachable_scheduler_is_bad_input(tmp_path):

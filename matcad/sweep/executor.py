@@ -1,18 +1,45 @@
 """Run plain-data tasks on local processes (concurrent.futures) or on a Dask cluster (``--scheduler``).
 
-Tasks go out in chunks (one round trip per chunk) and come back as plain dicts in task order. A chunk whose
-worker dies (out of memory, killed) is recorded as ``status = "failed"`` for each of its variants, never fatal.
-``dask.distributed`` is imported only when a scheduler address is given (the optional extra ``matcad[cluster]``).
+Tasks go out in chunks (one round trip per chunk) and come back as plain dicts in task order. A local worker
+that dies (out of memory, killed) breaks its pool: the chunks that did not come back are run again, each in a
+fresh process of its own, and only a chunk whose process dies again is recorded as ``status = "failed"`` for each
+of its variants (``reason`` "worker lost"); the sweep goes on. Dask resubmits a dead worker's tasks itself.
+``dask.distributed`` is imported only when a scheduler address is given (the optional extra ``matcad[cluster]``);
+the address is checked before anything connects (:func:`check_address`).
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 CHUNKS_PER_WORKER = 4
 """Chunks per worker: few enough to amortise the per-task overhead, enough to balance uneven variants."""
 CONNECT_TIMEOUT_S = 10.0
+PROTOCOLS = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+"""The Dask comm protocols a ``--scheduler`` address may name (none: tcp)."""
+_HOST_PORT = re.compile(r"^(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})$")
+
+
+def check_address(address: str) -> str:
+    """``address`` if it is a Dask scheduler address (``[protocol://]host:port``, port 1-65535; ``inproc://...``
+    as given); otherwise ValueError naming it and the form allowed, before any connection is tried."""
+    allowed = "must be [protocol://]host:port with a port 1-65535, e.g. tcp://10.0.0.5:8786"
+    protocol, sep, rest = address.partition("://")
+    if not sep:
+        protocol, rest = "tcp", address
+    if protocol not in PROTOCOLS:
+        raise ValueError(f"--scheduler {address}: protocol {protocol!r} unknown, one of {', '.join(PROTOCOLS)}; "
+                         f"the address {allowed}")
+    if protocol == "inproc":
+        if not rest:
+            raise ValueError(f"--scheduler {address}: {allowed}")
+        return address
+    match = _HOST_PORT.match(rest)
+    if not match or not 1 <= int(match.group(2)) <= 65535:
+        raise ValueError(f"--scheduler {address}: {allowed}")
+    return address
 
 
 @dataclass(frozen=True)
@@ -22,6 +49,10 @@ class Executor:
 
     workers: int = 1
     scheduler: str | None = None
+
+    def __post_init__(self):
+        if self.scheduler is not None:
+            check_address(self.scheduler)
 
     def describe(self) -> str:
         if self.scheduler:
@@ -52,20 +83,46 @@ def run(fn_chunk, tasks: list[dict], executor: Executor) -> list[dict]:
     from concurrent.futures import ProcessPoolExecutor
 
     # spawn: workers start clean (no inherited threads or CAD-kernel state), the same on every platform
-    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        chunks = _chunks(tasks, workers)
+    context = multiprocessing.get_context("spawn")
+    chunks = _chunks(tasks, workers)
+    with ProcessPoolExecutor(workers, mp_context=context) as pool:
         futures = [pool.submit(fn_chunk, c) for c in chunks]
-        return _collect(chunks, futures)
+        done = _results(futures)
+    lost = [k for k, r in enumerate(done) if isinstance(r, BaseException)]
+    if lost:  # a dead worker broke the pool: every chunk that did not come back again, one fresh process each
+        for start in range(0, len(lost), workers):
+            batch = lost[start:start + workers]
+            pools = [ProcessPoolExecutor(1, mp_context=context) for _ in batch]
+            try:
+                again = _results([p.submit(fn_chunk, chunks[k]) for p, k in zip(pools, batch)])
+            finally:
+                for p in pools:
+                    p.shutdown(wait=True, cancel_futures=True)
+            for k, r in zip(batch, again):
+                done[k] = r
+    return _joined(chunks, done)
+
+
+def _results(futures) -> list:
+    """Each future's result, or the exception it raised."""
+    out = []
+    for future in futures:
+        try:
+            out.append(future.result())
+        except Exception as exc:  # noqa: BLE001 - a dead worker fails its variants, not the sweep
+            out.append(exc)
+    return out
+
+
+def _joined(chunks, results) -> list[dict]:
+    out = []
+    for chunk, result in zip(chunks, results):
+        out += _lost(chunk, result) if isinstance(result, BaseException) else result
+    return out
 
 
 def _collect(chunks, futures) -> list[dict]:
-    out = []
-    for chunk, future in zip(chunks, futures):
-        try:
-            out += future.result()
-        except Exception as exc:  # noqa: BLE001 - a dead worker fails its variants, not the sweep
-            out += _lost(chunk, exc)
-    return out
+    return _joined(chunks, _results(futures))
 
 
 def _dask(fn_chunk, tasks: list[dict], address: str) -> list[dict]:
