@@ -96,8 +96,18 @@ def model_error_share(error: dict, valid):
 def _ends(shifts, array: bool):
     """(low, high) of the shifts of one line, 0 included (Hz)."""
     if array:
-        return np.minimum(np.minimum(*shifts), 0.0), np.maximum(np.maximum(*shifts), 0.0)
+        return _fold(list(shifts) + [0.0], np.less), _fold(list(shifts) + [0.0], np.greater)
     return min(shifts + [0.0]), max(shifts + [0.0])
+
+
+def _fold(values, better):
+    """Python's ``min`` (``better`` np.less) or ``max`` (np.greater) of ``values`` entry by entry on arrays: the
+    first value replaced by each later one that is better, so a NaN is kept only where it comes first (a tolerance
+    end outside the model's domain drops out exactly as in one prediction)."""
+    out = np.asarray(values[0], dtype=float)
+    for value in values[1:]:
+        out = np.where(better(value, out), value, out)
+    return out
 
 
 def budget(d, res, model: str, f0_hz, valid=True, reference=None) -> list[BudgetLine]:
@@ -217,7 +227,7 @@ def _sampled_f0(cheap, res, moduli, losses, array: bool) -> np.ndarray:
 
 def _sample_ends(shifts: np.ndarray, array: bool) -> tuple:
     """(low, high) of a line sampled over the silicone's range, 0 included (Hz): floats, or arrays of variants."""
-    low, high = np.minimum(shifts.min(axis=0), 0.0), np.maximum(shifts.max(axis=0), 0.0)
+    low, high = _fold(list(shifts) + [0.0], np.less), _fold(list(shifts) + [0.0], np.greater)
     return (low, high) if array else (float(low), float(high))
 
 
