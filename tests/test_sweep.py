@@ -15,7 +15,7 @@ from matcad.spec import from_dict, read_spec_data
 from matcad.sweep import MAX_POINTS, Executor, parse_axes, sweep
 from matcad.sweep import fast
 from matcad.sweep.run import LOAD_SENSITIVITY, sensitivity_column
-from tests.conftest import MINIMAL, PAPER, run_cli
+from tests.conftest import MINIMAL, PAPER, ROOT, run_cli
 
 
 def _random_specs(n, seed):
@@ -100,11 +100,69 @@ def test_grid_model_and_rules_match_predict_per_variant():
         assert row["rule_warnings"] == sum(f.level == "warning" for f in findings)
 
 
-def test_per_variant_model_and_grid_slope():
-    """elastic_wall runs predict per variant; df0/dfield is then numpy.gradient along the axis."""
+@pytest.mark.parametrize("template,vary", [
+    (PAPER, ["cavity.diameter=1.5:9:4", "neck.diameter=1.2,2.1,3.3", "mold.draft_deg=0,8",
+             "microphone.sample_rate_hz=9000,48000"]),
+    ("templates/mat-laser-only.toml", ["cavity.length=1:14:4", "neck.diameter=0.4,2.0,3.9", "plate.width=10,30",
+                                       "neck.length=0.8,9"]),
+])
+def test_array_sweep_equals_the_per_variant_path(template, vary):
+    """Validation messages, f0, band and every rule verdict of the array sweep against the per-variant path
+    (:func:`matcad.sweep.tasks.run_variant`: from_dict, predict, check) on grids with invalid and rule-breaking
+    variants (fails if a memoised rule misses a field it reads, or the array checks miss a refusal)."""
+    from matcad.sweep.grid import grid, variant_data
+    from matcad.sweep.tasks import run_variant
+
+    data = read_spec_data(ROOT / template)
+    axes = parse_axes(vary)
+    result = sweep(data, axes, model="transmission_line")
+    assert result.vectorised
+    statuses = set()
+    for row, values in zip(result.rows, grid(axes)):
+        one = run_variant({"index": row["index"], "data": variant_data(data, axes, values),
+                           "model": "transmission_line", "predict": True, "rules": True})
+        for key in ("status", "reason", "f0_hz", "band_low_hz", "band_high_hz", "model_valid", "rule_errors",
+                    "rule_warnings", "failing_rules"):
+            assert row.get(key) == one.get(key), (key, values, row.get(key), one.get(key))
+        statuses.add((row["status"], bool(row.get("rule_errors"))))
+    assert {("invalid", False), ("ok", True), ("ok", False)} <= statuses
+
+
+def test_elastic_wall_sweeps_on_arrays_equal_to_predict():
+    """The silicone wall (the paper spec's own model) runs on arrays: each row is predict's f0 and band exactly, and
+    df0/dfield is the model's own derivative (against predict at +-1e-3 mm, O(h^2))."""
     data = read_spec_data(PAPER)
     result = sweep(data, parse_axes(["cavity.length=4:5:3"]), rules=False)
-    assert result.model == "elastic_wall" and not result.vectorised
+    assert result.model == "elastic_wall" and result.vectorised
+    col = sensitivity_column(result.axes[0])
+    for row, x in zip(result.rows, (4.0, 4.5, 5.0)):
+        p = predict(from_dict({**data, "cavity": {**data["cavity"], "length": x}}), mechanics=False)
+        assert row["f0_hz"] == p.f0_hz and (row["band_low_hz"], row["band_high_hz"]) == p.band_hz
+        f = [predict(from_dict({**data, "cavity": {**data["cavity"], "length": x + s}}), mechanics=False).f0_hz
+             for s in (-1e-3, 1e-3)]
+        assert row[col] == pytest.approx((f[1] - f[0]) / 2e-3, rel=1e-4)
+
+
+def test_cavity_diameter_slope_moves_the_cap_that_follows_it():
+    """Where the spec leaves the cap's size to its default (2.5 x and 0.6 x cavity.diameter), df0/d(cavity.diameter)
+    moves the cap with the cavity, as a spec file with that diameter would."""
+    data = read_spec_data(PAPER)
+    data = {**data, "end_cap": {}}
+    result = sweep(data, parse_axes(["cavity.diameter=3.0,3.2"]), rules=False)
+    col = sensitivity_column(result.axes[0])
+    for row in result.rows:
+        f = [predict(from_dict({**data, "cavity": {**data["cavity"], "diameter": row["cavity.diameter"] + s}}),
+                     mechanics=False).f0_hz for s in (-1e-3, 1e-3)]
+        assert row[col] == pytest.approx((f[1] - f[0]) / 2e-3, rel=1e-4)
+
+
+def test_per_variant_model_and_grid_slope():
+    """A spec with a [reference] runs predict per variant ('relative'); df0/dfield is then numpy.gradient along
+    the axis."""
+    data = read_spec_data(PAPER)
+    data = {**data, "reference": {"f0_hz": 4000.0, "f0_tolerance_hz": 100.0}}
+    result = sweep(data, parse_axes(["cavity.length=4:5:3"]), rules=False)
+    assert result.model == "relative" and not result.vectorised
     f0 = [r["f0_hz"] for r in result.rows]
     for row, x in zip(result.rows, (4.0, 4.5, 5.0)):
         p = predict(from_dict({**data, "cavity": {**data["cavity"], "length": x}}), mechanics=False)
@@ -120,21 +178,25 @@ def test_per_variant_model_and_grid_slope():
     assert col not in edge.rows[2]
 
 
-def test_failed_variant_is_recorded_not_fatal(monkeypatch):
-    import matcad.rules
+@pytest.mark.parametrize("model", ["transmission_line", "relative"])
+def test_failed_variant_is_recorded_not_fatal(monkeypatch, model):
+    """A design rule that raises on one variant fails that row only, on arrays and per variant alike."""
+    from matcad.rules import laser
 
-    real = matcad.rules.check
-
-    def flaky(spec, prediction=None):
+    def flaky(spec):
         if spec.cavity.length > 5:
             raise RuntimeError("solver diverged")
-        return real(spec, prediction)
+        return []
 
-    monkeypatch.setattr(matcad.rules, "check", flaky)
-    result = sweep(read_spec_data(PAPER), parse_axes(["cavity.length=4,6"]), model="transmission_line")
+    monkeypatch.setattr(laser, "RULES", laser.RULES + (flaky,))
+    data = read_spec_data(PAPER)
+    if model == "relative":
+        data = {**data, "reference": {"f0_hz": 4000.0, "f0_tolerance_hz": 100.0}}
+    result = sweep(data, parse_axes(["cavity.length=4,6"]), model=model)
+    assert result.vectorised == (model != "relative")
     assert [r["status"] for r in result.rows] == ["ok", "failed"]
     assert "RuntimeError: solver diverged" in result.rows[1]["reason"]
-    assert result.rows[0]["rule_errors"] is not None
+    assert result.rows[0]["rule_errors"] is not None and "rule_errors" not in result.rows[1]
 
 
 def _table(result):

@@ -118,15 +118,22 @@ def f0_hz(v: Variants, model: str) -> np.ndarray:
     return _chunked(chunk, v)
 
 
-def valid(v: Variants, model: str, f0) -> np.ndarray:
-    """The model's validity checks (:mod:`matcad.acoustics.checks`) per variant: True where all pass."""
+def failed_checks(v: Variants, model: str, f0) -> np.ndarray:
+    """How many of the model's validity checks (:mod:`matcad.acoustics.checks`) fail, per variant (each failed
+    check is one warning of `matcad predict`)."""
     m = _model(model)
 
     def chunk(part, f):
         results = checks.evaluate(m.checks, Evaluation(part.design()), np.asarray(f))
-        return np.logical_and.reduce([np.asarray(r, dtype=bool) for r in results.values()])
+        return np.sum([~np.broadcast_to(np.asarray(r, dtype=bool), np.shape(f)) for r in results.values()], axis=0,
+                      dtype=np.int64) if results else np.zeros(np.shape(f), dtype=np.int64)
 
     return _chunked(chunk, v, np.asarray(f0, dtype=float))
+
+
+def valid(v: Variants, model: str, f0) -> np.ndarray:
+    """The model's validity checks per variant: True where all pass."""
+    return failed_checks(v, model, f0) == 0
 
 
 def band_hz(v: Variants, model: str, f0, ok) -> tuple[np.ndarray, np.ndarray]:

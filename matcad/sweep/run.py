@@ -2,9 +2,11 @@
 
 Frequencies Hz; sensitivities in Hz per the varied field's unit (Hz/mm for lengths) and Hz/N.
 
-- The closed-form rungs (:data:`matcad.sweep.fast.VECTORISED`) are evaluated on all variants at once; their
-  df0/dfield is the model's own derivative (central difference at each variant).
-- Any other model (elastic_wall, soft_wall, relative, fem) runs :func:`matcad.prediction.predict` per
+- The closed-form rungs (:data:`matcad.sweep.fast.VECTORISED`, the silicone wall's included) of a one-taxel spec
+  without [reference] are evaluated on arrays end to end, validation and design rules included
+  (:mod:`matcad.sweep.arrays`), in chunks of the grid on the executor; their df0/dfield is the model's own
+  derivative (central difference at each variant).
+- Any other sweep (fem, relative, a board of taxels, ``cad``) runs :func:`matcad.prediction.predict` per
   variant on the executor; df0/dfield is then the slope of f0 along that axis of the grid (``numpy.gradient``:
   central differences inside, one-sided at the ends and next to a failed variant; blank for an axis of one value).
 - df0/dF (Hz/N) is paper Eq. 5's slope at 0 N, f(0)·b/(2·V0) (:meth:`matcad.acoustics.eq5.Eq5.slope_hz_per_n`), from
@@ -22,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.sweep import fast
+from matcad.sweep import arrays, fast
 from matcad.sweep.executor import Executor, run as run_tasks
 from matcad.sweep.grid import Axis, grid, variant_data
 from matcad.sweep.tasks import run_chunk
@@ -115,6 +117,10 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
         model = predict(base, mechanics=False).model
     elif model not in allowed_models(base):
         raise ValueError(f"--model {model!r} invalid, must be one of {', '.join(allowed_models(base))}")
+    if not cad and arrays.eligible(base, model):
+        rows, worker_seconds = _array_rows(data, axes, model, rules, executor)
+        return SweepResult(base.name, model, tuple(axes), tuple(rows), True, executor.describe(), rules,
+                           time.perf_counter() - start, worker_seconds)
     rows: list[dict] = []
     datas, specs = {}, {}
     for i, values in enumerate(grid(axes)):
@@ -152,6 +158,55 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     if not vectorised:
         _grid_slopes(result)
     return SweepResult(**{**result.__dict__, "seconds": time.perf_counter() - start})
+
+
+def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor) -> tuple[list[dict], float]:
+    """Every variant's row by :func:`array_chunk` over chunks of :data:`matcad.sweep.arrays.CHUNK` variants on the
+    executor; a chunk whose worker was lost is a row ``failed`` per variant."""
+    size = int(np.prod([len(a.values) for a in axes]))
+    tasks = [{"index": k, "data": data, "axes": tuple(axes), "start": lo, "stop": min(lo + arrays.CHUNK, size),
+              "model": model, "rules": rules} for k, lo in enumerate(range(0, size, arrays.CHUNK))]
+    rows, seconds = [], 0.0
+    for task, result in zip(tasks, run_tasks(array_chunks, tasks, executor)):
+        if "rows" in result:
+            rows += result["rows"]
+            seconds += result["seconds"]
+            continue
+        for i, values in zip(range(task["start"], task["stop"]), grid(axes)[task["start"]:task["stop"]]):
+            rows.append({"index": i, **{a.field: v for a, v in zip(axes, values)}, "status": "failed",
+                         "reason": result["reason"], "model": model})
+    return rows, seconds
+
+
+def array_chunks(tasks: list[dict]) -> list[dict]:
+    """Executor function: each task (a chunk of the grid) → {"index", "rows", "seconds"}."""
+    return [array_chunk(t) for t in tasks]
+
+
+def array_chunk(task: dict) -> dict:
+    """The rows of variants ``start:stop`` of the grid by :func:`matcad.sweep.arrays.evaluate`."""
+    from matcad.spec import from_dict
+
+    t0 = time.perf_counter()
+    data, axes, model = task["data"], task["axes"], task["model"]
+    chunk = arrays.GridChunk(data, axes, np.arange(task["start"], task["stop"]))
+    out = arrays.evaluate(chunk, from_dict(data), model, task["rules"], arrays.rule_memos(), arrays.slope_memo())
+    columns = [(sensitivity_column(a), out[("slope", a.field)]) for a in axes if ("slope", a.field) in out]
+    rows = []
+    for j, i in enumerate(chunk.rows.tolist()):
+        row = {"index": i, **{a.field: a.values[int(chunk.index[k][j])] for k, a in enumerate(axes)},
+               "status": out["status"][j], "reason": out["reason"][j], "model": model}
+        if row["status"] != "invalid":
+            row.update(f0_hz=float(out["f0_hz"][j]), band_low_hz=float(out["band_low_hz"][j]),
+                       band_high_hz=float(out["band_high_hz"][j]), model_valid=bool(out["model_valid"][j]),
+                       **{name: float(c[j]) for name, c in columns})
+            if out["load_slope"][j] is not None and not isinstance(out["load_slope"][j], tuple):
+                row[LOAD_SENSITIVITY] = out["load_slope"][j]
+            if task["rules"] and row["status"] == "ok":
+                row.update(rule_errors=int(out["rule_errors"][j]), rule_warnings=int(out["rule_warnings"][j]),
+                           failing_rules=out["failing_rules"][j])
+        rows.append(row)
+    return {"index": task["index"], "rows": rows, "seconds": time.perf_counter() - t0}
 
 
 def _grid_slopes(result: SweepResult) -> None:
