@@ -69,10 +69,13 @@ class GridChunk:
         return variant_data(self.data, self.axes, values)
 
     def spec(self, j: int):
-        """Variant ``j``'s validated spec."""
+        """Variant ``j``'s validated spec (made once per variant and chunk, however many rules ask)."""
         from matcad.spec import from_dict
 
-        return from_dict(self.data_of(j))
+        cache = self.__dict__.setdefault("_specs", {})
+        if j not in cache:
+            cache[j] = from_dict(self.data_of(j))
+        return cache[j]
 
     def axes_of(self, reads) -> tuple[int, ...]:
         """The axes whose field is among ``reads`` (dotted fields; ``table.*`` for a whole table), the cavity's
@@ -188,10 +191,11 @@ def _summary(findings) -> tuple:
 
 
 def spec_rules():
-    """Every rule of the spec modules, in :func:`matcad.rules.check`'s order."""
+    """Every rule of the spec modules that can give an error or a warning, in :func:`matcad.rules.check`'s order
+    (those a module lists in ``INFO_RULES`` only inform: they never change a verdict column)."""
     from matcad.rules.registry import SPEC_MODULES
 
-    return [rule for module in SPEC_MODULES for rule in module.RULES]
+    return [rule for module in SPEC_MODULES for rule in module.RULES if rule not in getattr(module, "INFO_RULES", ())]
 
 
 def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, model: str, f0, low, high,

@@ -44,7 +44,7 @@ def _traced_class(cls: type) -> type:
 
 def _wrap(section):
     traced = object.__new__(_traced_class(type(section)))
-    traced.__dict__.update(vars(section))
+    object.__getattribute__(traced, "__dict__").update(vars(section))
     return traced
 
 
@@ -63,10 +63,11 @@ def traced(spec):
 def run(function, spec) -> tuple[frozenset, object]:
     """(fields read, result) of ``function(spec)`` on a traced copy; an exception is the result
     ``("failed", "Type: message")``."""
+    copy_ = traced(spec)  # made before recording starts: copying is not reading
     _state.reads = set()
     try:
         try:
-            result = function(traced(spec))
+            result = function(copy_)
         except Exception as exc:  # noqa: BLE001 - a variant's failure is a row of the table, never fatal
             result = ("failed", f"{exc.__class__.__name__}: {exc}")
         return frozenset(_state.reads), result

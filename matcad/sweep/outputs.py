@@ -47,8 +47,12 @@ def write_table(result: SweepResult, folder: Path) -> list[str]:
         writer.writerow(columns)
         for row in result.rows:
             writer.writerow(["" if _plain(row.get(k)) is None else row.get(k) for k in columns])
-    (folder / "sweep.json").write_text(json.dumps(table_dict(result), indent=1, allow_nan=False) + "\n",
-                                       encoding="utf-8")
+    doc = table_dict(result)
+    rows = doc.pop("rows")
+    head = json.dumps({**doc, "rows": []}, indent=1, allow_nan=False)  # one row a line, by json's C encoder
+    body = ",\n  ".join(json.dumps(row, allow_nan=False) for row in rows)
+    text = head[:head.rindex("[]")] + (f"[\n  {body}\n ]" if rows else "[]") + head[head.rindex("[]") + 2:]
+    (folder / "sweep.json").write_text(text + "\n", encoding="utf-8")
     return ["sweep.csv", "sweep.json"]
 
 
@@ -76,7 +80,8 @@ def write_maps(result: SweepResult, folder: Path) -> list[str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
-    from matplotlib.patches import Rectangle
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as Outline
 
     (folder / "maps").mkdir()
     errors = result.column("rule_errors") if result.rules else np.zeros(result.shape)
@@ -103,9 +108,11 @@ def write_maps(result: SweepResult, folder: Path) -> list[str]:
                                  shading="flat", cmap="viridis")
             fig.colorbar(mesh, ax=ax, label=label)
             xe, ye = _edges(x_axis.values), _edges(y_axis.values)
-            for i, j in zip(*np.nonzero(errors > 0)):
-                ax.add_patch(Rectangle((xe[j], ye[i]), xe[j + 1] - xe[j], ye[i + 1] - ye[i], fill=False,
-                                       hatch="///", edgecolor="white", linewidth=0.0))
+            cells = [Outline([(xe[j], ye[i]), (xe[j + 1], ye[i]), (xe[j + 1], ye[i + 1]), (xe[j], ye[i + 1]),
+                           (xe[j], ye[i])], closed=True) for i, j in zip(*np.nonzero(errors > 0))]
+            if cells:  # every hatched cell in one path: one fill however large the grid
+                ax.add_patch(PathPatch(Outline.make_compound_path(*cells), fill=False, hatch="///",
+                                       edgecolor="white", linewidth=0.0))
             ax.set_title(f"{label}\nhatched: design-rule errors; blank: invalid or failed", fontsize=10)
             y_label = _label(y_axis)
         ax.set_xlabel(_label(x_axis))

@@ -179,18 +179,21 @@ def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor) -
 
 
 def array_chunks(tasks: list[dict]) -> list[dict]:
-    """Executor function: each task (a chunk of the grid) → {"index", "rows", "seconds"}."""
-    return [array_chunk(t) for t in tasks]
+    """Executor function: each task (a chunk of the grid) → {"index", "rows", "seconds"}. The chunks of one call
+    share their memos (keyed on the whole grid's values, so valid across chunks)."""
+    memos = arrays.rule_memos(), arrays.slope_memo()
+    return [array_chunk(t, *memos) for t in tasks]
 
 
-def array_chunk(task: dict) -> dict:
+def array_chunk(task: dict, rule_memos=None, slope_memo=None) -> dict:
     """The rows of variants ``start:stop`` of the grid by :func:`matcad.sweep.arrays.evaluate`."""
     from matcad.spec import from_dict
 
     t0 = time.perf_counter()
     data, axes, model = task["data"], task["axes"], task["model"]
     chunk = arrays.GridChunk(data, axes, np.arange(task["start"], task["stop"]))
-    out = arrays.evaluate(chunk, from_dict(data), model, task["rules"], arrays.rule_memos(), arrays.slope_memo())
+    out = arrays.evaluate(chunk, from_dict(data), model, task["rules"], rule_memos or arrays.rule_memos(),
+                          slope_memo or arrays.slope_memo())
     columns = [(sensitivity_column(a), out[("slope", a.field)]) for a in axes if ("slope", a.field) in out]
     rows = []
     for j, i in enumerate(chunk.rows.tolist()):
