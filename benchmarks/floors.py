@@ -124,10 +124,6 @@ def rows(tmp: Path, quick: bool) -> list[Row]:
         Row("sweep-paper", "`sweep` mat-paper (silicone wall), 1 000 variants, rules off, 1 process",
             ["sweep", PAPER, "--vary", "cavity.length=3:6:40", "--vary", "neck.diameter=1.5:2.4:25", "--no-rules",
              "--workers", "1", "--out", "{tmp}/sp"], None, "", "rate", "1e5/s", 1 if quick else 3, 1_000),
-        Row("sweep-big", "`sweep` mat-paper (silicone wall), 10^6 variants, rules on, 2 processes (wall clock)",
-            ["sweep", PAPER, "--vary", "cavity.length=3:6:100", "--vary", "neck.diameter=1.5:2.4:100",
-             "--vary", "cavity.diameter=2.8:3.6:100", "--workers", "2", "--out", "{tmp}/sb"], None, "",
-            "wall_rate", "1e5/s", 1 if quick else 3, 1_000_000),
         Row("fem", "`predict --model fem`, coupled, `baffled` mouth (CPU)",
             ["predict", PAPER, "--model", "fem", "--set", "neck.mouth='baffled'"],
             ["predict", PAPER, "--model", "fem"], "the same with `mount`", "cpu", "2", few),
@@ -248,7 +244,7 @@ def main() -> None:
     ap.add_argument("--tree", action="append", default=[], metavar="LABEL=PATH",
                     help="also measure another checkout (alternated with this one)")
     ap.add_argument("--only", nargs="+", metavar="ROW", help="rows to run: predict laser build analyze "
-                                                              "sweep-laser sweep-paper sweep-big fem")
+                                                              "sweep-laser sweep-paper fem")
     ap.add_argument("--runs", type=int, help="runs per command (default per row)")
     ap.add_argument("--quick", action="store_true", help="fewer runs per row")
     ap.add_argument("--readme", action="store_true", help="rewrite README's performance table with the result")
