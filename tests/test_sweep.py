@@ -374,3 +374,37 @@ def test_cad_rung_stl_volume_matches_closed_form():
     for row in result.rows:
         assert row["cad_watertight"] is True
         assert row["cad_stl_volume_mm3"] == pytest.approx(row["cad_closed_form_volume_mm3"], rel=5e-3)
+
+
+def test_memo_runs_a_rule_once_per_combination_of_the_fields_it_reads():
+    """A rule reading one varied field runs once per value of it, one reading none once per grid, one branching
+    on a field reads more where it branches; every variant gets its own result (fails if the memo keys on fields
+    a rule did not read, or misses one it did)."""
+    import numpy as np
+
+    from matcad.sweep.arrays import GridChunk
+    from matcad.sweep.memo import Memo
+
+    data = read_spec_data(PAPER)
+    axes = parse_axes(["cavity.length=3:6:4", "neck.diameter=1.5:2.4:5", "mold.draft_deg=0,0.5,1"])
+    chunk = GridChunk(data, axes, np.arange(60))
+    calls = {"neck": 0, "none": 0, "branch": 0}
+
+    def neck(spec):
+        calls["neck"] += 1
+        return round(spec.neck.diameter, 6)
+
+    def none(spec):
+        calls["none"] += 1
+        return spec.name
+
+    def branch(spec):
+        calls["branch"] += 1
+        return spec.neck.diameter if spec.cavity.length > 4.5 else -1.0
+
+    for function, expected in ((neck, 5), (none, 1), (branch, 2 + 2 * 5)):
+        memo = Memo(function)
+        numbers = memo.apply(chunk)
+        assert calls[function.__name__] == expected
+        for j in range(60):
+            assert memo.outcomes[numbers[j]] == function(chunk.spec(j))
