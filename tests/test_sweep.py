@@ -281,8 +281,12 @@ def test_bad_vary_is_exit_2_and_writes_nothing(tmp_path, vary, words):
 
 def test_grid_cap_and_bad_model(tmp_path):
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3:6:200", "--vary", "neck.diameter=1:2:200",
-                           "--out", tmp_path / "s")
-    assert code == 2 and "40000 variants, at most 20000" in err
+                           "--model", "fem", "--out", tmp_path / "s")  # per variant: at most MAX_VARIANTS
+    assert code == 2 and "40000 variants, at most 20000" in err and "model fem" in err and "Traceback" not in err
+    code, _, err = run_cli("sweep", PAPER, *[x for f in ("cavity.length", "neck.diameter", "neck.length",
+                                                         "mold.draft_deg") for x in ("--vary", f"{f}=0.5:0.9:200")],
+                           "--out", tmp_path / "s")  # on arrays: at most MAX_GRID
+    assert code == 2 and "1600000000 variants, at most 10000000" in err
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--model", "lumpd", "--out", tmp_path / "s")
     assert code == 2 and "'lumpd'" in err and "lumped" in err
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--model", "elastic_wall",
@@ -408,3 +412,28 @@ def test_memo_runs_a_rule_once_per_combination_of_the_fields_it_reads():
         assert calls[function.__name__] == expected
         for j in range(60):
             assert memo.outcomes[numbers[j]] == function(chunk.spec(j))
+
+
+def test_large_grid_streams_to_the_csv(tmp_path):
+    """A three-axis grid beyond MAX_VARIANTS on arrays: the CSV holds every variant in grid order with the rows an
+    in-memory sweep gives, the JSON the counts (no rows), no maps; the sweep kept no rows."""
+    vary = ["cavity.length=2:10:30", "neck.diameter=0.8:2.4:30", "neck.length=1:8:25"]  # 22 500 variants
+    out = tmp_path / "big"
+    code, stdout, err = run_cli("sweep", ROOT / "templates" / "mat-laser-only.toml", *[x for v in vary
+                                for x in ("--vary", v)], "--workers", "1", "--out", out, "--json")
+    assert code == 0, err
+    summary = json.loads(stdout)
+    with open(out / "sweep.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert summary["variants"] == len(rows) == 22_500 and [int(r["index"]) for r in rows] == list(range(22_500))
+    doc = json.loads((out / "sweep.json").read_text())
+    assert "rows" not in doc and doc["rows_in"] == "sweep.csv" and doc["counts"]["ok"] == summary["ok"]
+    assert summary["ok"] == sum(r["status"] == "ok" for r in rows) and not (out / "maps").exists()
+    assert summary["rule_errors"] == sum(r["rule_errors"] not in ("", "0") for r in rows) > 0
+    data = read_spec_data(ROOT / "templates" / "mat-laser-only.toml")
+    kept = []
+    result = sweep(data, parse_axes(vary), sink=kept.extend)
+    assert result.rows == () and result.tally == {k: summary[k] for k in ("ok", "invalid", "failed", "rule_errors")}
+    for row, line in zip(kept[::997], rows[::997]):
+        assert line["failing_rules"] == (row.get("failing_rules") or "")
+        assert float(line["f0_hz"]) == row["f0_hz"] and line["status"] == row["status"]

@@ -10,6 +10,7 @@ the address is checked before anything connects (:func:`check_address`).
 
 from __future__ import annotations
 
+import collections
 import math
 import re
 from dataclasses import dataclass
@@ -139,3 +140,69 @@ def _dask(fn_chunk, tasks: list[dict], address: str) -> list[dict]:
         chunks = _chunks(tasks, n_workers)
         futures = client.map(fn_chunk, chunks, pure=False)
         return _collect(chunks, futures)
+
+
+def stream(fn_chunk, tasks: list[dict], executor: Executor):
+    """Like :func:`run`, but one task per chunk, yielding each task's result list in task order as it comes, with
+    at most :data:`CHUNKS_PER_WORKER` tasks per worker in flight (a sweep streamed to disk holds no more). A task
+    whose local worker died is run again alone in a fresh process (the pool is restarted and the tasks in flight
+    resubmitted); if that dies too, its result is the lost-worker rows."""
+    if not tasks:
+        return
+    if executor.scheduler:
+        yield from _dask_stream(fn_chunk, tasks, executor.scheduler)
+        return
+    workers = min(executor.workers, len(tasks))
+    if workers == 1:
+        for task in tasks:
+            yield fn_chunk([task])
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    context = multiprocessing.get_context("spawn")
+    pool = ProcessPoolExecutor(workers, mp_context=context)
+    todo, pending = iter(tasks), collections.deque()
+
+    def submit() -> None:
+        task = next(todo, None)
+        if task is not None:
+            pending.append((task, pool.submit(fn_chunk, [task])))
+
+    try:
+        for _ in range(workers * CHUNKS_PER_WORKER):
+            submit()
+        while pending:
+            task, future = pending.popleft()
+            try:
+                result = future.result()
+            except Exception:  # noqa: BLE001 - a dead worker: restart the pool, resubmit, run this task alone
+                pool.shutdown(wait=True, cancel_futures=True)
+                pool = ProcessPoolExecutor(workers, mp_context=context)
+                pending = collections.deque((t, pool.submit(fn_chunk, [t])) for t, _ in pending)
+                alone = ProcessPoolExecutor(1, mp_context=context)
+                try:
+                    result = _results([alone.submit(fn_chunk, [task])])[0]
+                finally:
+                    alone.shutdown(wait=True, cancel_futures=True)
+                result = _joined([[task]], [result])
+            yield result
+            submit()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _dask_stream(fn_chunk, tasks: list[dict], address: str):
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        raise ValueError("--scheduler needs dask.distributed: pip install 'matcad[cluster]'") from None
+    try:
+        client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ValueError(f"--scheduler {address}: cannot connect to a Dask scheduler there ({exc})") from None
+    with client:
+        futures = client.map(fn_chunk, [[t] for t in tasks], pure=False)
+        for task, future in zip(tasks, futures):
+            yield _joined([[task]], _results([future]))
+            future.release()
