@@ -242,6 +242,16 @@ def test_dead_worker_fails_its_variants_not_the_sweep():
     assert [r["status"] for r in results] == ["ok"] * 3 + ["failed"] + ["ok"] * 4
 
 
+@pytest.mark.slow
+def test_streamed_chunks_come_in_order_and_a_dead_worker_fails_only_its_own():
+    from matcad.sweep.executor import stream
+
+    results = [r for chunk in stream(crash_on_index_3, [{"index": i} for i in range(8)], Executor(2)) for r in chunk]
+    assert [r["index"] for r in results] == list(range(8))
+    assert [r["status"] for r in results] == ["ok"] * 3 + ["failed"] + ["ok"] * 4
+    assert "worker lost" in results[3]["reason"]
+
+
 @pytest.mark.parametrize("address", ["nonsense", "tcp://host:notaport", "tcp://127.0.0.1:99999", "localhost:8786x",
                                      "http://127.0.0.1:8786", "tcp://:8786"])
 def test_malformed_scheduler_is_bad_input_at_once(tmp_path, address):
