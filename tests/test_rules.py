@@ -4,7 +4,7 @@ import pytest
 
 from matcad import spec as spec_mod
 from matcad.rules import check
-from tests.conftest import PAPER
+from tests.conftest import PAPER, ROOT
 
 
 def _paper_with(**over):
@@ -100,3 +100,23 @@ def test_every_rule_module_is_registered_once():
     assert sorted(registered) == declaring and len(set(registered)) == len(registered)
     for module in SPEC_MODULES:
         assert set(getattr(module, "TAXEL_RULES", ())) <= set(module.RULES), module.__name__
+        assert set(getattr(module, "INFO_RULES", ())) <= set(module.RULES), module.__name__
+
+
+def test_info_rules_only_inform():
+    """A rule listed in INFO_RULES (a sweep skips it) gives only info findings, on every template and on designs
+    at the ends of the ranges (fails if such a rule gains a warning or an error)."""
+    import dataclasses
+
+    from matcad.rules.registry import SPEC_MODULES
+
+    rules = [r for m in SPEC_MODULES for r in getattr(m, "INFO_RULES", ())]
+    assert rules
+    specs = [spec_mod.load(p) for p in sorted((ROOT / "templates").glob("*.toml"))]
+    paper = spec_mod.load(PAPER)
+    specs += [dataclasses.replace(paper, cavity=dataclasses.replace(paper.cavity, diameter=d, length=length),
+                                  end_cap=dataclasses.replace(paper.end_cap, outer_diameter=3 * d))
+              for d in (2.2, 6.0) for length in (0.5, 12.0)]
+    for spec in specs:
+        for rule in rules:
+            assert {f.level for f in rule(spec)} <= {"info"}, (rule.__name__, spec.name)

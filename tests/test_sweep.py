@@ -15,7 +15,7 @@ from matcad.spec import from_dict, read_spec_data
 from matcad.sweep import MAX_POINTS, Executor, parse_axes, sweep
 from matcad.sweep import fast
 from matcad.sweep.run import LOAD_SENSITIVITY, sensitivity_column
-from tests.conftest import MINIMAL, PAPER, run_cli
+from tests.conftest import MINIMAL, PAPER, ROOT, run_cli
 
 
 def _random_specs(n, seed):
@@ -100,12 +100,82 @@ def test_grid_model_and_rules_match_predict_per_variant():
         assert row["rule_warnings"] == sum(f.level == "warning" for f in findings)
 
 
-def test_per_variant_model_and_grid_slope():
-    """elastic_wall runs predict per variant; df0/dfield is then numpy.gradient along the axis."""
+@pytest.mark.parametrize("template,vary", [
+    (PAPER, ["cavity.diameter=1.5:9:4", "neck.diameter=1.2,2.1,3.3", "mold.draft_deg=0,8",
+             "microphone.sample_rate_hz=9000,48000"]),
+    ("templates/mat-laser-only.toml", ["cavity.length=1:14:4", "neck.diameter=0.4,2.0,3.9", "plate.width=10,30",
+                                       "neck.length=0.8,9"]),
+])
+def test_array_sweep_equals_the_per_variant_path(template, vary):
+    """Validation messages, f0, band and every rule verdict of the array sweep against the per-variant path
+    (:func:`matcad.sweep.tasks.run_variant`: from_dict, predict, check) on grids with invalid and rule-breaking
+    variants (fails if a memoised rule misses a field it reads, or the array checks miss a refusal)."""
+    from matcad.sweep.grid import grid, variant_data
+    from matcad.sweep.tasks import run_variant
+
+    data = read_spec_data(ROOT / template)
+    axes = parse_axes(vary)
+    result = sweep(data, axes, model="transmission_line")
+    assert result.vectorised
+    statuses = set()
+    for row, values in zip(result.rows, grid(axes)):
+        one = run_variant({"index": row["index"], "data": variant_data(data, axes, values),
+                           "model": "transmission_line", "predict": True, "rules": True})
+        for key in ("status", "reason", "f0_hz", "band_low_hz", "band_high_hz", "model_valid", "rule_errors",
+                    "rule_warnings", "failing_rules"):
+            assert row.get(key) == one.get(key), (key, values, row.get(key), one.get(key))
+        statuses.add((row["status"], bool(row.get("rule_errors"))))
+    assert {("invalid", False), ("ok", True), ("ok", False)} <= statuses
+
+
+def test_elastic_wall_sweeps_on_arrays_equal_to_predict():
+    """The silicone wall (the paper spec's own physics, its calibration left out) runs on arrays: each row is
+    predict's f0 and band exactly, and df0/dfield is the model's own derivative (against predict at +-1e-3 mm,
+    O(h^2))."""
+    data = {k: v for k, v in read_spec_data(PAPER).items() if k != "calibration"}
+    result = sweep(data, parse_axes(["cavity.length=4:5:3"]), rules=False)
+    assert result.model == "elastic_wall" and result.vectorised
+    col = sensitivity_column(result.axes[0])
+    for row, x in zip(result.rows, (4.0, 4.5, 5.0)):
+        p = predict(from_dict({**data, "cavity": {**data["cavity"], "length": x}}), mechanics=False)
+        assert row["f0_hz"] == p.f0_hz and (row["band_low_hz"], row["band_high_hz"]) == p.band_hz
+        f = [predict(from_dict({**data, "cavity": {**data["cavity"], "length": x + s}}), mechanics=False).f0_hz
+             for s in (-1e-3, 1e-3)]
+        assert row[col] == pytest.approx((f[1] - f[0]) / 2e-3, rel=1e-4)
+
+
+def test_a_calibrated_spec_sweeps_by_its_calibration():
+    """The paper template's calibration anchors every variant of its sweep (the calibrated f(0) times the physics
+    ratio to the calibrated drawing), row for row predict's."""
     data = read_spec_data(PAPER)
     result = sweep(data, parse_axes(["cavity.length=4:5:3"]), rules=False)
-    # the paper template's calibration anchors every variant (each the calibrated f(0) times the physics ratio)
     assert result.model == "calibration" and not result.vectorised
+    for row, x in zip(result.rows, (4.0, 4.5, 5.0)):
+        p = predict(from_dict({**data, "cavity": {**data["cavity"], "length": x}}), mechanics=False)
+        assert p.model == "calibration" and row["f0_hz"] == p.f0_hz and (row["band_low_hz"], row["band_high_hz"]) == p.band_hz
+    assert result.rows[0]["f0_hz"] > result.rows[2]["f0_hz"]  # a longer cavity sings lower
+
+
+def test_cavity_diameter_slope_moves_the_cap_that_follows_it():
+    """Where the spec leaves the cap's size to its default (2.5 x and 0.6 x cavity.diameter), df0/d(cavity.diameter)
+    moves the cap with the cavity, as a spec file with that diameter would."""
+    data = read_spec_data(PAPER)
+    data = {**data, "end_cap": {}}
+    result = sweep(data, parse_axes(["cavity.diameter=3.0,3.2"]), rules=False)
+    col = sensitivity_column(result.axes[0])
+    for row in result.rows:
+        f = [predict(from_dict({**data, "cavity": {**data["cavity"], "diameter": row["cavity.diameter"] + s}}),
+                     mechanics=False).f0_hz for s in (-1e-3, 1e-3)]
+        assert row[col] == pytest.approx((f[1] - f[0]) / 2e-3, rel=1e-4)
+
+
+def test_per_variant_model_and_grid_slope():
+    """A spec with a [reference] runs predict per variant ('relative'); df0/dfield is then numpy.gradient along
+    the axis."""
+    data = read_spec_data(PAPER)
+    data = {**data, "reference": {"f0_hz": 4000.0, "f0_tolerance_hz": 100.0}}
+    result = sweep(data, parse_axes(["cavity.length=4:5:3"]), rules=False)
+    assert result.model == "relative" and not result.vectorised
     f0 = [r["f0_hz"] for r in result.rows]
     for row, x in zip(result.rows, (4.0, 4.5, 5.0)):
         p = predict(from_dict({**data, "cavity": {**data["cavity"], "length": x}}), mechanics=False)
@@ -121,21 +191,25 @@ def test_per_variant_model_and_grid_slope():
     assert col not in edge.rows[2]
 
 
-def test_failed_variant_is_recorded_not_fatal(monkeypatch):
-    import matcad.rules
+@pytest.mark.parametrize("model", ["transmission_line", "relative"])
+def test_failed_variant_is_recorded_not_fatal(monkeypatch, model):
+    """A design rule that raises on one variant fails that row only, on arrays and per variant alike."""
+    from matcad.rules import laser
 
-    real = matcad.rules.check
-
-    def flaky(spec, prediction=None):
+    def flaky(spec):
         if spec.cavity.length > 5:
             raise RuntimeError("solver diverged")
-        return real(spec, prediction)
+        return []
 
-    monkeypatch.setattr(matcad.rules, "check", flaky)
-    result = sweep(read_spec_data(PAPER), parse_axes(["cavity.length=4,6"]), model="transmission_line")
+    monkeypatch.setattr(laser, "RULES", laser.RULES + (flaky,))
+    data = read_spec_data(PAPER)
+    if model == "relative":
+        data = {**data, "reference": {"f0_hz": 4000.0, "f0_tolerance_hz": 100.0}}
+    result = sweep(data, parse_axes(["cavity.length=4,6"]), model=model)
+    assert result.vectorised == (model != "relative")
     assert [r["status"] for r in result.rows] == ["ok", "failed"]
     assert "RuntimeError: solver diverged" in result.rows[1]["reason"]
-    assert result.rows[0]["rule_errors"] is not None
+    assert result.rows[0]["rule_errors"] is not None and "rule_errors" not in result.rows[1]
 
 
 def _table(result):
@@ -177,7 +251,29 @@ def test_dead_worker_fails_its_variants_not_the_sweep():
     results = run(crash_on_index_3, [{"index": i} for i in range(8)], Executor(2))
     assert [r["index"] for r in results] == list(range(8))
     assert results[3]["status"] == "failed" and "worker lost" in results[3]["reason"]
-    assert all(r["status"] in ("ok", "failed") for r in results)
+    # only the dead worker's chunk (one variant here: 8 tasks in 2 x 4 chunks) fails; the others are run again
+    assert [r["status"] for r in results] == ["ok"] * 3 + ["failed"] + ["ok"] * 4
+
+
+@pytest.mark.slow
+def test_streamed_chunks_come_in_order_and_a_dead_worker_fails_only_its_own():
+    from matcad.sweep.executor import stream
+
+    results = [r for chunk in stream(crash_on_index_3, [{"index": i} for i in range(8)], Executor(2)) for r in chunk]
+    assert [r["index"] for r in results] == list(range(8))
+    assert [r["status"] for r in results] == ["ok"] * 3 + ["failed"] + ["ok"] * 4
+    assert "worker lost" in results[3]["reason"]
+
+
+@pytest.mark.parametrize("address", ["nonsense", "tcp://host:notaport", "tcp://127.0.0.1:99999", "localhost:8786x",
+                                     "http://127.0.0.1:8786", "tcp://:8786"])
+def test_malformed_scheduler_is_bad_input_at_once(tmp_path, address):
+    with pytest.raises(ValueError, match="host:port"):  # refused when the executor is made, before any connection
+        Executor(scheduler=address)                     # (Dask itself would wait 20 s, then raise a traceback)
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--scheduler", address,
+                           "--out", tmp_path / "s")
+    assert code == 2 and f"--scheduler {address}" in err and "host:port" in err and "Traceback" not in err, err
+    assert not (tmp_path / "s").exists()
 
 
 def test_unreachable_scheduler_is_bad_input(tmp_path):
@@ -208,8 +304,12 @@ def test_bad_vary_is_exit_2_and_writes_nothing(tmp_path, vary, words):
 
 def test_grid_cap_and_bad_model(tmp_path):
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3:6:200", "--vary", "neck.diameter=1:2:200",
-                           "--out", tmp_path / "s")
-    assert code == 2 and "40000 variants, at most 20000" in err
+                           "--model", "fem", "--out", tmp_path / "s")  # per variant: at most MAX_VARIANTS
+    assert code == 2 and "40000 variants, at most 20000" in err and "model fem" in err and "Traceback" not in err
+    code, _, err = run_cli("sweep", PAPER, *[x for f in ("cavity.length", "neck.diameter", "neck.length",
+                                                         "mold.draft_deg") for x in ("--vary", f"{f}=0.5:0.9:200")],
+                           "--out", tmp_path / "s")  # on arrays: at most MAX_GRID
+    assert code == 2 and "1600000000 variants, at most 10000000" in err
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--model", "lumpd", "--out", tmp_path / "s")
     assert code == 2 and "'lumpd'" in err and "lumped" in err
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--model", "elastic_wall",
@@ -301,3 +401,62 @@ def test_cad_rung_stl_volume_matches_closed_form():
     for row in result.rows:
         assert row["cad_watertight"] is True
         assert row["cad_stl_volume_mm3"] == pytest.approx(row["cad_closed_form_volume_mm3"], rel=5e-3)
+
+
+def test_memo_runs_a_rule_once_per_combination_of_the_fields_it_reads():
+    """A rule reading one varied field runs once per value of it, one reading none once per grid, one branching
+    on a field reads more where it branches; every variant gets its own result (fails if the memo keys on fields
+    a rule did not read, or misses one it did)."""
+    import numpy as np
+
+    from matcad.sweep.arrays import GridChunk
+    from matcad.sweep.memo import Memo
+
+    data = read_spec_data(PAPER)
+    axes = parse_axes(["cavity.length=3:6:4", "neck.diameter=1.5:2.4:5", "mold.draft_deg=0,0.5,1"])
+    chunk = GridChunk(data, axes, np.arange(60))
+    calls = {"neck": 0, "none": 0, "branch": 0}
+
+    def neck(spec):
+        calls["neck"] += 1
+        return round(spec.neck.diameter, 6)
+
+    def none(spec):
+        calls["none"] += 1
+        return spec.name
+
+    def branch(spec):
+        calls["branch"] += 1
+        return spec.neck.diameter if spec.cavity.length > 4.5 else -1.0
+
+    for function, expected in ((neck, 5), (none, 1), (branch, 2 + 2 * 5)):
+        memo = Memo(function)
+        numbers = memo.apply(chunk)
+        assert calls[function.__name__] == expected
+        for j in range(60):
+            assert memo.outcomes[numbers[j]] == function(chunk.spec(j))
+
+
+def test_large_grid_streams_to_the_csv(tmp_path):
+    """A three-axis grid beyond MAX_VARIANTS on arrays: the CSV holds every variant in grid order with the rows an
+    in-memory sweep gives, the JSON the counts (no rows), no maps; the sweep kept no rows."""
+    vary = ["cavity.length=2:10:30", "neck.diameter=0.8:2.4:30", "neck.length=1:8:25"]  # 22 500 variants
+    out = tmp_path / "big"
+    code, stdout, err = run_cli("sweep", ROOT / "templates" / "mat-laser-only.toml", *[x for v in vary
+                                for x in ("--vary", v)], "--workers", "1", "--out", out, "--json")
+    assert code == 0, err
+    summary = json.loads(stdout)
+    with open(out / "sweep.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert summary["variants"] == len(rows) == 22_500 and [int(r["index"]) for r in rows] == list(range(22_500))
+    doc = json.loads((out / "sweep.json").read_text())
+    assert "rows" not in doc and doc["rows_in"] == "sweep.csv" and doc["counts"]["ok"] == summary["ok"]
+    assert summary["ok"] == sum(r["status"] == "ok" for r in rows) and not (out / "maps").exists()
+    assert summary["rule_errors"] == sum(r["rule_errors"] not in ("", "0") for r in rows) > 0
+    data = read_spec_data(ROOT / "templates" / "mat-laser-only.toml")
+    kept = []
+    result = sweep(data, parse_axes(vary), sink=kept.extend)
+    assert result.rows == () and result.tally == {k: summary[k] for k in ("ok", "invalid", "failed", "rule_errors")}
+    for row, line in zip(kept[::997], rows[::997]):
+        assert line["failing_rules"] == (row.get("failing_rules") or "")
+        assert float(line["f0_hz"]) == row["f0_hz"] and line["status"] == row["status"]

@@ -66,10 +66,10 @@ CHECKS: dict[str, Check] = {c.name: c for c in (
           lambda name, ev: f"{name}: the cap's wall modes lie below {wall_model.QUASI_STATIC_RATIO:g} x f0, where a "
                            "quasi-static (massless) wall is invalid: it ignores the wall's inertia, which moves f up "
                            "when the modes lie below f; use elastic_wall or --model fem"),
-    Check("wall_shape_in_table", lambda ev, f0: not wall_model.shape_outside_table(ev.cap_shape),
+    Check("wall_shape_in_table", lambda ev, f0: wall_model.shape_in_table(ev.cap_shape),
           lambda name, ev: f"{name}: the cap's shape lies outside the wall-mode table (clamped to its edge); check with "
                            "--model fem"),
-    Check("no_wall_mode_near_f", lambda ev, f0: wall_model.mode_near(ev.dynamic_modes, f0) is None,
+    Check("no_wall_mode_near_f", lambda ev, f0: np.logical_not(wall_model.mode_coupled_near(ev.dynamic_modes, f0)),
           lambda name, ev: f"{name}: a cap wall mode with volume coupling lies within "
                            f"{100 * wall_model.HYBRID_BAND:.0f} % of f0: cavity and wall hybridise, two resonances can "
                            "compete, and this fast model's measured error is larger there (the band carries it); check "

@@ -113,7 +113,8 @@ def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, s
     π·sqrt(r/(8mM + 4rM²)), m = min(l, L) (tan x ≥ 8x/(π² − 4x²) on the longer segment), else 0.99 of the pole.
     Newton in u then descends onto the fundamental in ~5 steps and never jumps to an overtone; a bisection
     safeguard inside the bracket (Φ = +∞ where 1 − q·tan(kl)/k ≤ 0) guards against rounding. Broadcasts over
-    array inputs.
+    array inputs; an entry stops iterating once it has converged, so its root is the same whether it is solved
+    alone or among a sweep's variants (of the same kind: plain, or with joined air or a cone).
     """
     r, ln, lc, side, q = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
         area_ratio, neck_length_mm, cavity_length_mm, side_length_mm, cone_per_mm)))
@@ -125,6 +126,7 @@ def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, s
         k = np.minimum(np.sqrt(r / (ln * lc)), np.pi * np.sqrt(r / (8.0 * short * long + 4.0 * r * long * long)))
     else:
         k = np.minimum(np.sqrt(r * (1.0 - q * ln) / (ln * (lc + side))), 0.99 * hi)
+    active = np.ones(k.shape, dtype=bool)  # a converged root stays as it is: each entry's iterates are its own
     for _ in range(max_iter):
         t1, t2 = np.tan(k * ln), np.tan(k * lc)
         if plain:
@@ -142,9 +144,10 @@ def transmission_line_wavenumber(area_ratio, neck_length_mm, cavity_length_mm, s
         with np.errstate(over="ignore", invalid="ignore"):
             newton = k * np.exp(-phi / dphi_du)
         k_new = np.where((newton >= lo) & (newton <= hi), newton, 0.5 * (lo + hi))
-        done = np.all(np.abs(k_new - k) <= rtol * k_new)
-        k = k_new
-        if done:
+        converged = np.abs(k_new - k) <= rtol * k_new
+        k = np.where(active, k_new, k)
+        active &= ~converged
+        if not active.any():
             break
     return k
 

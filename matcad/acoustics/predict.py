@@ -153,10 +153,26 @@ def _relative(ev: Evaluation, reference: Reference, model: str, this: ModelResul
                        f"(this design {f_model_hz:.0f} Hz / reference {ref.f0_hz:.0f} Hz by the same model)")
 
 
+def is_paper_taxel(d: Design):
+    """Whether ``d`` is the source paper's taxel (:data:`PAPER_TAXEL_MM` to 1e-6) with a silicone cap: a bool, or
+    a bool array for a design of arrays."""
+    dims = np.broadcast_arrays(d.cavity_diameter, d.cavity_length, d.neck_diameter, d.neck_length)
+    paper = np.all(np.isclose(dims, np.reshape(PAPER_TAXEL_MM, (4,) + (1,) * dims[0].ndim), rtol=1e-6), axis=0)
+    paper = paper & (d.wall.model == "silicone")
+    return bool(paper) if np.ndim(paper) == 0 else paper
+
+
+def warning_count(d: Design, f0_hz, failed_checks, reference: Reference | None = None):
+    """How many warnings :func:`predict` gives the chosen model on ``d`` (floats or arrays): its failed checks,
+    the boundary layers' when they are worth a warning, and the paper anchor."""
+    eps = boundary_layer_shift(f0_hz, np.asarray(d.neck_diameter) / 2)
+    anchor = is_paper_taxel(d) if reference is None else False
+    return np.asarray(failed_checks) + (eps > BOUNDARY_LAYER_WARN) + np.asarray(anchor, dtype=int)
+
+
 def _paper_anchor(d: Design, chosen: str, f0_hz: float, band_low_hz: float) -> list[str]:
     """For the paper's taxel with a silicone cap: what physics predicts against the one published measurement."""
-    dims = (d.cavity_diameter, d.cavity_length, d.neck_diameter, d.neck_length)
-    if d.wall.model != "silicone" or not np.allclose(dims, PAPER_TAXEL_MM, rtol=1e-6):
+    if not is_paper_taxel(d):
         return []
     gap = 100 * (1 - PAPER_MEASURED_HZ / f0_hz)
     where = "below the band" if PAPER_MEASURED_HZ < band_low_hz else "inside the band's low tail"

@@ -69,13 +69,14 @@ class AcousticModel:
         return None, 0.0
 
     def f0_hz(self, res, material=None, shear_modulus_pa=None, loss_factor=None):
-        """f0 (Hz) of a closed-form rung on a resonator (floats, or arrays of variants for the rigid rungs), at the
-        middle of ``material``'s ranges unless a modulus (Pa) and loss factor are given."""
+        """f0 (Hz) of a closed-form rung on a resonator (floats, or arrays of variants; the wall rungs also at arrays
+        of moduli and loss factors), at the middle of ``material``'s ranges unless a modulus (Pa) and loss factor
+        are given."""
         if not self.cheap:
             raise ValueError(f"model {self.name!r} solves a mesh: evaluate it through its result()")
         if shear_modulus_pa is None and material is not None:
             shear_modulus_pa, loss_factor = self.wall_arguments(material)
-        return self.function()(res, shear_modulus_pa, loss_factor or 0.0)
+        return self.function()(res, shear_modulus_pa, 0.0 if loss_factor is None else loss_factor)
 
     def result(self, ev, f_guess_hz: float | None = None, level: int | None = None) -> ModelResult:
         """This rung on one :class:`matcad.acoustics.evaluation.Evaluation`: f0 (Hz), checks, source. A mesh rung

@@ -3,8 +3,8 @@
 :func:`resonator` turns a :class:`matcad.acoustics.design.Design` into the quantities every model reads (the
 drafted cavity as its equal-volume cylinder, areas, end corrections, the cap around it); the ``*_hz`` functions are
 the closed-form rungs the registry (:mod:`matcad.acoustics.registry`) names. Each takes the resonator, the wall's
-shear modulus (Pa) and loss factor, and works on floats or on numpy arrays of a sweep's variants (the elastic wall
-on floats only).
+shear modulus (Pa) and loss factor, and works on floats or on numpy arrays of a sweep's variants (the wall models
+also on arrays of moduli and loss factors for one design: the uncertainty budget's samples).
 """
 
 from __future__ import annotations
@@ -98,8 +98,8 @@ def cap_shape(res: Resonator) -> wall.CapShape:
                          clamp_height=res.cap_clamp_height)
 
 
-def wall_modes(res: Resonator, shear_modulus_pa: float) -> wall.Modes:
-    """The cap's wall modes at the given (dynamic) shear modulus, Pa."""
+def wall_modes(res: Resonator, shear_modulus_pa) -> wall.Modes:
+    """The cap's wall modes at the given (dynamic) shear modulus, Pa (arrays of designs or of moduli too)."""
     return wall.modes(cap_shape(res), shear_modulus_pa, res.silicone_density)
 
 
@@ -146,17 +146,18 @@ def soft_wall_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0):
                                        res.cavity_length, n, extra, res.side_volume, _cone(res))
 
 
-def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0):
-    """The transmission line coupled to the cap's wall modes at the (dynamic) shear modulus (Pa, scalar) and
-    loss factor: peak of the driven response (Hz)."""
+def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor=0.0):
+    """The transmission line coupled to the cap's wall modes at the (dynamic) shear modulus (Pa) and loss factor:
+    peak of the driven response (Hz). Arrays of designs, or one design at arrays of moduli and loss factors, give
+    arrays, each entry the same arithmetic as one call (:func:`matcad.acoustics.wall.peak_ratio`)."""
     f_tl = transmission_line_hz(res)
-    return f_tl * wall.peak_ratio(float(f_tl), res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
+    return f_tl * wall.peak_ratio(f_tl, res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
                                   res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor, res.side_volume)
 
 
 def elastic_wall_doublet_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0) -> float | None:
     """The other resonance of a doublet of :func:`elastic_wall_hz` (Hz; :func:`matcad.acoustics.wall.doublet_hz`),
-    or None when one peak clearly wins."""
+    or None when one peak clearly wins (one design, scalar moduli)."""
     f_tl = transmission_line_hz(res)
     return wall.doublet_hz(float(f_tl), res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
                            res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor, res.side_volume)

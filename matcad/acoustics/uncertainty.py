@@ -10,7 +10,9 @@ modulus × loss rectangle, because f is not monotonic in G when wall modes cross
 lows and highs add in quadrature separately, in ln f (relative shifts), which keeps a wide band above zero.
 
 The budget works on a :class:`~matcad.acoustics.design.Design` of floats (one prediction, with its lines' words)
-or of numpy arrays (a sweep's variants, the rigid closed-form rungs: the same numbers per variant, no words).
+or of numpy arrays (a sweep's variants, every closed-form rung: the same numbers per variant, no words). Each
+line's variants are evaluated together (the ten tolerance ends in one call, the wall's modulus samples in another):
+each entry is the same arithmetic as its variant alone.
 """
 
 from __future__ import annotations
@@ -94,8 +96,18 @@ def model_error_share(error: dict, valid):
 def _ends(shifts, array: bool):
     """(low, high) of the shifts of one line, 0 included (Hz)."""
     if array:
-        return np.minimum(np.minimum(*shifts), 0.0), np.maximum(np.maximum(*shifts), 0.0)
+        return _fold(list(shifts) + [0.0], np.less), _fold(list(shifts) + [0.0], np.greater)
     return min(shifts + [0.0]), max(shifts + [0.0])
+
+
+def _fold(values, better):
+    """Python's ``min`` (``better`` np.less) or ``max`` (np.greater) of ``values`` entry by entry on arrays: the
+    first value replaced by each later one that is better, so a NaN is kept only where it comes first (a tolerance
+    end outside the model's domain drops out exactly as in one prediction)."""
+    out = np.asarray(values[0], dtype=float)
+    for value in values[1:]:
+        out = np.where(better(value, out), value, out)
+    return out
 
 
 def budget(d, res, model: str, f0_hz, valid=True, reference=None) -> list[BudgetLine]:
@@ -109,8 +121,7 @@ def budget(d, res, model: str, f0_hz, valid=True, reference=None) -> list[Budget
     # the cheap model's sensitivities, applied to the chosen f0 (the same model: a factor of exactly 1)
     scale = 1.0 if cheap.name == model else f0_hz / float(cheap.f0_hz(res, shear_modulus_pa=shear, loss_factor=loss))
 
-    def shifts(variants):
-        fs = [cheap.f0_hz(resonator(v), shear_modulus_pa=shear, loss_factor=loss) for v in variants]
+    def shifts(fs):
         return _ends([(f if array else float(f)) * scale - f0_hz for f in fs], array)
 
     def words(text) -> str:
@@ -144,8 +155,10 @@ def budget(d, res, model: str, f0_hz, valid=True, reference=None) -> list[Budget
     ends = tolerance_ends(d.neck_diameter, d.neck_length, d.cavity_diameter, d.cavity_length, d.draft_deg,
                           d.air.temperature_c, d_tol, sheet_tol, cav_tol)
 
+    moved_f0 = _moved_f0(cheap, d, ends, shear, loss)
+
     def moved(field):
-        return shifts([d.replace(**{TOLERANCES[field]: x if array else float(x)}) for x in ends[field]])
+        return shifts(moved_f0[field])
 
     what = "" if array else "measured" if making.sheet_measured else "ISO 7823-1 cast sheet"
     lines += [BudgetLine("neck diameter", words(lambda: f"+-{d_tol:g} mm ({'drilled' if drilled else 'laser cut'})"),
@@ -171,28 +184,29 @@ def budget(d, res, model: str, f0_hz, valid=True, reference=None) -> list[Budget
                                                              f"-{100 * drop:.1f} %"), -drop * f0_hz, 0.0))
     if cheap.name == "soft_wall":
         g_lo, _, g_hi = d.wall.static_moduli_pa()
-        fs = [float(cheap.f0_hz(res, shear_modulus_pa=g)) * scale - f0_hz for g in (g_lo, g_hi)]
-        lines.append(BudgetLine("silicone shear modulus", f"{g_lo / 1e6:g}-{g_hi / 1e6:g} MPa static",
-                                min(fs + [0.0]), max(fs + [0.0])))
+        fs = _sampled_f0(cheap, res, np.array([g_lo, g_hi]), np.zeros(2), array) * scale - f0_hz
+        lines.append(BudgetLine("silicone shear modulus", words(lambda: f"{g_lo / 1e6:g}-{g_hi / 1e6:g} MPa static"),
+                                *_sample_ends(fs, array)))
     elif cheap.name == "elastic_wall":
         g_lo, _, g_hi = d.wall.dynamic_moduli_pa()
         eta_lo, _, eta_hi = d.wall.loss_factors()
-        corners = [(g, eta) for g in np.geomspace(g_lo, g_hi, MODULUS_SAMPLES) for eta in (eta_lo, eta_hi)]
-        fs = np.array([float(cheap.f0_hz(res, shear_modulus_pa=g, loss_factor=eta)) for g, eta in corners])
+        moduli = np.repeat(np.geomspace(g_lo, g_hi, MODULUS_SAMPLES), 2)
+        losses = np.tile([eta_lo, eta_hi], MODULUS_SAMPLES)
         static, factor = d.wall.shear_modulus_mpa, d.wall.khz_modulus_factor
         what = "" if not relative else " on the ratio to the reference (one silicone for both)"
-        if relative:  # the reference was measured at the true modulus: what varies is the ratio
+        if relative:  # the reference was measured at the true modulus: what varies is the ratio (one design)
             ref_res = resonator(reference.design)
-            fs = fs / np.array([float(cheap.f0_hz(ref_res, shear_modulus_pa=g, loss_factor=eta)) for g, eta in corners])
-            fs *= f0_hz / (float(cheap.f0_hz(res, shear_modulus_pa=shear, loss_factor=loss))
-                           / float(cheap.f0_hz(ref_res, shear_modulus_pa=shear, loss_factor=loss)))
+            ratios = (_sampled_f0(cheap, res, moduli, losses, array)
+                      / _sampled_f0(cheap, ref_res, moduli, losses, array))
+            fs = ratios * f0_hz / (float(cheap.f0_hz(res, shear_modulus_pa=shear, loss_factor=loss))
+                                   / float(cheap.f0_hz(ref_res, shear_modulus_pa=shear, loss_factor=loss))) - f0_hz
         else:
-            fs = fs * scale
-        shifts_hz = list(fs - f0_hz)
+            fs = _sampled_f0(cheap, res, moduli, losses, array) * scale - f0_hz
         lines.append(BudgetLine("silicone modulus and loss",
-                                f"G {g_lo / 1e6:.3g}-{g_hi / 1e6:.3g} MPa at kHz (static {static[0]:g}-{static[1]:g} x "
-                                f"{factor[0]:g}-{factor[1]:g}), eta {eta_lo:g}-{eta_hi:g}{what}",
-                                min(shifts_hz + [0.0]), max(shifts_hz + [0.0])))
+                                words(lambda: f"G {g_lo / 1e6:.3g}-{g_hi / 1e6:.3g} MPa at kHz (static {static[0]:g}-"
+                                              f"{static[1]:g} x {factor[0]:g}-{factor[1]:g}), eta {eta_lo:g}-{eta_hi:g}"
+                                              f"{what}"),
+                                *_sample_ends(fs, array)))
         if relative:
             lines += reference_doublet(reference, cheap, f0_hz)
     return lines
@@ -214,6 +228,36 @@ def reference_doublet(reference, cheap, f0_hz: float) -> list[BudgetLine]:
     return [BudgetLine("reference doublet", f"the reference's cavity also peaks at {other:.0f} Hz (its model f "
                                             f"{f_ref:.0f} Hz): its measured tone may be that peak",
                        min(shift, 0.0), max(shift, 0.0))]
+
+
+def _moved_f0(cheap, d, ends: dict, shear, loss) -> dict:
+    """f0 (Hz) of ``cheap`` with each tolerance at each of its ends, all in one evaluation of the model: a design
+    whose moved fields carry a leading axis of 2 × 5 variants (each row the same arithmetic as that variant
+    alone). {dotted field: (f at the low end, f at the high end)}, floats or arrays of the design's variants."""
+    count = 2 * len(TOLERANCES)
+    base = {name: getattr(d, name) for name in TOLERANCES.values() if name != "air_temperature_c"}
+    base["air_temperature_c"] = d.air.temperature_c
+    columns = {name: np.array(np.broadcast_to(value, (count,) + np.shape(value)), dtype=float)
+               for name, value in base.items()}
+    for j, (field, name) in enumerate(TOLERANCES.items()):
+        for end, value in enumerate(ends[field]):
+            columns[name][2 * j + end] = value
+    f = cheap.f0_hz(resonator(d.replace(**columns)), shear_modulus_pa=shear, loss_factor=loss)
+    return {field: (f[2 * j], f[2 * j + 1]) for j, field in enumerate(TOLERANCES)}
+
+
+def _sampled_f0(cheap, res, moduli, losses, array: bool) -> np.ndarray:
+    """f0 (Hz) of a wall model at each (modulus Pa, loss factor) sample: (samples,) for one design in one
+    evaluation, (samples, variants) for a sweep's, one sample at a time."""
+    if not array:
+        return np.asarray(cheap.f0_hz(res, shear_modulus_pa=moduli, loss_factor=losses), dtype=float)
+    return np.array([cheap.f0_hz(res, shear_modulus_pa=g, loss_factor=eta) for g, eta in zip(moduli, losses)])
+
+
+def _sample_ends(shifts: np.ndarray, array: bool) -> tuple:
+    """(low, high) of a line sampled over the silicone's range, 0 included (Hz): floats, or arrays of variants."""
+    low, high = _fold(list(shifts) + [0.0], np.less), _fold(list(shifts) + [0.0], np.greater)
+    return (low, high) if array else (float(low), float(high))
 
 
 def total(lines: list[BudgetLine], f0_hz: float) -> tuple[float, float]:

@@ -72,74 +72,98 @@ class CapShape:
 
 @dataclass(frozen=True)
 class Modes:
-    """Wall modes of one cap at one (G, ρ): frequencies (Hz), volume compliances and static compliance (mm³/Pa)."""
+    """Wall modes of one cap at one (G, ρ): frequencies (Hz), volume compliances and static compliance (mm³/Pa).
+    For arrays of caps (or moduli) the fields carry those leading axes: (..., modes) and (...)."""
 
     frequencies_hz: np.ndarray
     compliances_mm3_pa: np.ndarray
     static_mm3_pa: float
 
     def coupled_hz(self) -> np.ndarray:
-        """Frequencies of the modes that carry ≥ :data:`SIGNIFICANT_MODE` of the static compliance."""
-        return self.frequencies_hz[self.compliances_mm3_pa >= SIGNIFICANT_MODE * self.static_mm3_pa]
+        """Frequencies of the modes that carry ≥ :data:`SIGNIFICANT_MODE` of the static compliance (one cap)."""
+        return self.frequencies_hz[_coupled(self)]
 
 
 @lru_cache(maxsize=1)
 def _table():
+    """The table as arrays over its grid (outer, top, length, clamp, mode): log frequencies, compliances, static
+    compliance and its log; and the grid's axes and nodes (in log, but the clamp fraction)."""
     data = json.loads(TABLE_PATH.read_text(encoding="utf-8"))
     shape = [len(TABLE_AXES[k]) for k in TABLE_AXES]
-    return (np.array(data["frequencies_hz"]).reshape(*shape, -1),
-            np.array(data["compliances_mm3_pa"]).reshape(*shape, -1), np.array(data["static_mm3_pa"]).reshape(shape))
+    freqs = np.array(data["frequencies_hz"]).reshape(*shape, -1)
+    comps = np.array(data["compliances_mm3_pa"]).reshape(*shape, -1)
+    static = np.array(data["static_mm3_pa"]).reshape(shape)
+    axes = {name: np.array(values) for name, values in TABLE_AXES.items()}
+    nodes = {name: (x if name == "clamp_fraction" else np.log(x)) for name, x in axes.items()}
+    return np.log(freqs), comps, static, np.log(static), axes, nodes
 
 
 def shape_outside_table(shape: CapShape) -> list[str]:
-    """Names of the shape ratios outside the table's grid (they are clamped to its edge)."""
-    values = _ratios(shape)
-    return [name for name, v in zip(TABLE_AXES, values) if not TABLE_AXES[name][0] <= v <= TABLE_AXES[name][-1]]
+    """Names of the shape ratios outside the table's grid (they are clamped to its edge); one cap."""
+    return [name for name, v in zip(TABLE_AXES, _ratios(shape))
+            if not TABLE_AXES[name][0] <= v <= TABLE_AXES[name][-1]]
+
+
+def shape_in_table(shape: CapShape):
+    """True where every shape ratio lies on the table's grid: a bool for one cap, a bool array for arrays of caps."""
+    inside = np.logical_and.reduce([(TABLE_AXES[name][0] <= v) & (v <= TABLE_AXES[name][-1])
+                                    for name, v in zip(TABLE_AXES, _ratios(shape))])
+    return bool(inside) if np.ndim(inside) == 0 else inside
 
 
 def _ratios(shape: CapShape):
     a = shape.cavity_radius
-    return (shape.outer_radius / a, shape.top_thickness / a, shape.cavity_length / a,
-            min(shape.clamp_height / shape.cavity_length, 1.0))
+    return (np.divide(shape.outer_radius, a), np.divide(shape.top_thickness, a), np.divide(shape.cavity_length, a),
+            np.minimum(np.divide(shape.clamp_height, shape.cavity_length), 1.0))
 
 
-def modes(shape: CapShape, shear_modulus_pa: float, density_kg_m3: float) -> Modes:
+def _interpolated(shape: CapShape):
+    """The table interpolated at the cap's ratios (arrays of caps too): log frequencies and shares (..., modes), and
+    the log static compliance (...), of the unit cap."""
+    log_f, comps, static, log_static, axes, nodes = _table()
+    corners = []
+    for name, v in zip(TABLE_AXES, _ratios(shape)):
+        axis, node = axes[name], nodes[name]
+        x = np.clip(v, axis[0], axis[-1])
+        i = np.clip(np.searchsorted(axis, x) - 1, 0, len(axis) - 2)
+        t = ((x if name == "clamp_fraction" else np.log(x)) - node[i]) / (node[i + 1] - node[i])
+        corners.append(((i, 1 - t), (i + 1, t)))
+    f = s = c = 0.0
+    for corner in np.ndindex(2, 2, 2, 2):  # frequencies and the static compliance in log, the shares linearly
+        idx = tuple(corners[d][corner[d]][0] for d in range(4))
+        w = corners[0][corner[0]][1] * corners[1][corner[1]][1] * corners[2][corner[2]][1] * corners[3][corner[3]][1]
+        f = f + w[..., None] * log_f[idx]
+        c = c + w[..., None] * comps[idx] / static[idx][..., None]
+        s = s + w * log_static[idx]
+    return f, c, s
+
+
+def modes(shape: CapShape, shear_modulus_pa, density_kg_m3) -> Modes:
     """The cap's wall modes, interpolated multilinearly (in log of the ratios; log frequencies, log static
     compliance, each mode's share of it) from wall_modes.json and scaled to its size, modulus (Pa) and density
-    (kg/m³)."""
-    freqs, comps, static = _table()
-    weights = []
-    for name, v in zip(TABLE_AXES, _ratios(shape)):
-        axis = np.array(TABLE_AXES[name])
-        x = np.clip(v, axis[0], axis[-1])
-        i = int(np.clip(np.searchsorted(axis, x) - 1, 0, len(axis) - 2))
-        lo, hi = (axis[i], axis[i + 1]) if name == "clamp_fraction" else (math.log(axis[i]), math.log(axis[i + 1]))
-        t = ((x if name == "clamp_fraction" else math.log(x)) - lo) / (hi - lo)
-        weights.append(((i, 1 - t), (i + 1, t)))
-    f = np.zeros(freqs.shape[-1])
-    c = np.zeros(comps.shape[-1])
-    s = 0.0
-    for corner in np.ndindex(2, 2, 2, 2):
-        idx = tuple(weights[d][corner[d]][0] for d in range(4))
-        w = math.prod(weights[d][corner[d]][1] for d in range(4))
-        if w:  # frequencies and the static compliance in log, each mode's share of it linearly
-            f += w * np.log(freqs[idx])
-            c += w * comps[idx] / static[idx]
-            s += w * math.log(static[idx])
-    a = shape.cavity_radius
-    static_c = math.exp(s) * a**3 * UNIT_SHEAR_PA / shear_modulus_pa
-    return Modes(np.exp(f) * math.sqrt(shear_modulus_pa / UNIT_SHEAR_PA * UNIT_DENSITY / density_kg_m3) / a,
-                 c * static_c, static_c)
+    (kg/m³). The shape's fields, the modulus and the density may be arrays that broadcast together (a sweep's
+    variants, or one cap at several moduli): the fields of :class:`Modes` then carry those leading axes."""
+    f, c, s = _interpolated(shape)
+    a = np.asarray(shape.cavity_radius, dtype=float)
+    g = np.asarray(shear_modulus_pa, dtype=float)
+    static_c = np.exp(s) * a**3 * UNIT_SHEAR_PA / g
+    scale = np.sqrt(g / UNIT_SHEAR_PA * UNIT_DENSITY / np.asarray(density_kg_m3, dtype=float))
+    return Modes(np.exp(f) * scale[..., None] / a[..., None], c * static_c[..., None], static_c)
 
 
-def dynamic_compliance_mm3_pa(f_hz, wall: Modes, loss_factor: float):
+def dynamic_compliance_mm3_pa(f_hz, wall: Modes, loss_factor):
     """C_w(f) = ΔV/p of the cap (mm³/Pa, complex; time e^{iωt}): the modal sum, plus the compliance the retained
     modes miss (static minus their sum) as one more mode at the highest retained frequency, so that it acts as a
-    spring below the retained modes and as a mass above them, like the modes it stands for."""
+    spring below the retained modes and as a mass above them, like the modes it stands for. ``f_hz`` (..., F)
+    against caps (...): the result is (..., F)."""
     f = np.asarray(f_hz, dtype=float)[..., None]
-    g = 1.0 + 1j * loss_factor
-    freqs = np.append(wall.frequencies_hz, wall.frequencies_hz[-1])
-    comps = np.append(wall.compliances_mm3_pa, max(wall.static_mm3_pa - wall.compliances_mm3_pa.sum(), 0.0))
+    loss = np.asarray(loss_factor, dtype=float)
+    g = 1.0 + 1j * loss.reshape(loss.shape + (1,) * (f.ndim - loss.ndim))  # caps' losses against (..., F, modes)
+    freqs = np.concatenate([wall.frequencies_hz, wall.frequencies_hz[..., -1:]], axis=-1)
+    rest = np.maximum(wall.static_mm3_pa - wall.compliances_mm3_pa.sum(axis=-1), 0.0)
+    comps = np.concatenate([wall.compliances_mm3_pa, np.asarray(rest)[..., None]], axis=-1)
+    if freqs.ndim > 1:  # caps (..., modes) against frequencies (..., F, 1)
+        freqs, comps = freqs[..., None, :], comps[..., None, :]
     return (comps / (g - (f / freqs) ** 2)).sum(axis=-1)
 
 
@@ -156,7 +180,7 @@ def _cavity_end_response(f_hz, c_m_s, neck_area, cavity_area, neck_length_eff, c
     u = 1j * omega * wall_compliance * p  # volume velocity into the wall at the closed end
     kl = k * cavity_length
     p, u = np.cos(kl) * p + 1j * z_cav * np.sin(kl) * u, 1j * np.sin(kl) / z_cav * p + np.cos(kl) * u
-    if side_volume:
+    if np.any(side_volume):
         u = u + 1j * omega * side_volume / BULK_MODULUS_PA * p
     kl = k * neck_length_eff
     p, u = np.cos(kl) * p + 1j * z_neck * np.sin(kl) * u, 1j * np.sin(kl) / z_neck * p + np.cos(kl) * u
@@ -171,6 +195,51 @@ def _refine_hz(f_grid, response, i: int) -> float:
     denom = y[0] - 2 * y[1] + y[2]
     shift = 0.5 * (y[0] - y[2]) / denom if denom > 0 else 0.0
     return float(np.exp(x[1] + np.clip(shift, -1, 1) * (x[2] - x[1])))
+
+
+def _peak_hz(f_grid, response):
+    """Frequency of the largest value of ``response`` on the grid (last axis), refined by a parabola through
+    1/|H|²; rows of grids give one peak each."""
+    i = np.clip(np.argmax(response, axis=-1), 1, response.shape[-1] - 2)[..., None] + np.arange(-1, 2)
+    y = 1.0 / np.take_along_axis(response, i, axis=-1) ** 2
+    x = np.log(np.take_along_axis(np.broadcast_to(f_grid, response.shape), i, axis=-1))
+    denom = y[..., 0] - 2 * y[..., 1] + y[..., 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shift = np.where(denom > 0, 0.5 * (y[..., 0] - y[..., 2]) / denom, 0.0)
+    return np.exp(x[..., 1] + np.clip(shift, -1, 1) * (x[..., 2] - x[..., 1]))
+
+
+@lru_cache(maxsize=1)
+def _grid() -> np.ndarray:
+    return np.geomspace(*SWEEP[:2], SWEEP[2])
+
+
+BLOCK_ROWS = 32
+"""Driven responses evaluated per numpy pass (32 × 601 frequencies × ~21 modes: a few MB of temporaries)."""
+
+
+def _peaks(geometry: tuple, wall: Modes | None, loss_factor) -> np.ndarray:
+    """Peak frequency (Hz) of the driven response per row: ``geometry`` = (f_TL, c, A, S, l_eff, L, V_side) arrays
+    of one shape, and the wall (None: rigid) with its loss, broadcast against it, in blocks of :data:`BLOCK_ROWS`."""
+    parts = [*geometry] if wall is None else [*geometry, wall.static_mm3_pa, np.asarray(loss_factor, dtype=float)]
+    shape = np.broadcast_shapes(*(np.shape(x) for x in parts))
+    n = math.prod(shape)
+    flat = [np.broadcast_to(x, shape).reshape(n) for x in geometry]
+    if wall is not None:
+        m = wall.frequencies_hz.shape[-1]
+        freqs = np.broadcast_to(wall.frequencies_hz, shape + (m,)).reshape(n, m)
+        comps = np.broadcast_to(wall.compliances_mm3_pa, shape + (m,)).reshape(n, m)
+        static = np.broadcast_to(wall.static_mm3_pa, shape).reshape(n)
+        loss = np.broadcast_to(loss_factor, shape).reshape(n)
+    out = np.empty(n)
+    for start in range(0, n, BLOCK_ROWS):
+        rows = slice(start, start + BLOCK_ROWS)
+        f_tl, *net, side = (x[rows, None] for x in flat)
+        f = f_tl * _grid()
+        compliance = 0.0 if wall is None else \
+            dynamic_compliance_mm3_pa(f, Modes(freqs[rows], comps[rows], static[rows]), loss[rows])
+        out[rows] = _peak_hz(f, _cavity_end_response(f, *net, compliance, side))
+    return out.reshape(shape)
 
 
 def _followed_peak_hz(f_grid, responses) -> float:
@@ -193,17 +262,30 @@ def _losses(loss_factor: float) -> np.ndarray:
 
 
 def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
-               loss_factor: float, side_volume: float = 0.0) -> float:
+               loss_factor, side_volume=0.0):
     """Peak of the cavity pressure with the elastic wall over the peak with a rigid wall (same network, air of
-    ``side_volume`` mm³ joined at the neck in both). Below :data:`SELECT_LOSS` the taxel's (Helmholtz) peak is found
-    at SELECT_LOSS and followed down to ``loss_factor``: an almost undamped wall mode rings as a sharp spike that can
-    out-peak it on the grid (η = 0 on the paper's taxel gave 3033 Hz, a wall mode, for its 5288 Hz), though it is
-    not the resonance the jet drives."""
-    f = f_tl_hz * np.geomspace(*SWEEP[:2], SWEEP[2])
+    ``side_volume`` mm³ joined at the neck in both): a float for one design, an array for arrays of designs, moduli
+    or loss factors (each row the same arithmetic as one design: the grid of :data:`SWEEP` and its parabola, so the
+    numbers do not depend on the batch). Below :data:`SELECT_LOSS` (one design) the taxel's (Helmholtz) peak is
+    found at SELECT_LOSS and followed down to ``loss_factor``: an almost undamped wall mode rings as a sharp spike
+    that can out-peak it on the grid (η = 0 on the paper's taxel gave 3033 Hz, a wall mode, for its 5288 Hz), though
+    it is not the resonance the jet drives."""
+    if np.ndim(loss_factor) == 0 and loss_factor < SELECT_LOSS and np.ndim(f_tl_hz) == 0:
+        return _followed_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall,
+                               loss_factor, side_volume)
+    geometry = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
+        f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume)))
+    ratio = _peaks(tuple(geometry), wall, loss_factor) / _peaks(tuple(geometry), None, 0.0)
+    return float(ratio) if ratio.ndim == 0 else ratio
+
+
+def _followed_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
+                    loss_factor: float, side_volume: float) -> float:
+    """:func:`peak_ratio` of one design below :data:`SELECT_LOSS`: its Helmholtz peak followed down the losses."""
+    f = f_tl_hz * _grid()
     geometry = (c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length)
-    losses = _losses(loss_factor)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # η = 0 exactly on a wall mode: C = ∞
-        compliance = np.stack([dynamic_compliance_mm3_pa(f, wall, eta) for eta in losses])
+        compliance = np.stack([dynamic_compliance_mm3_pa(f, wall, eta) for eta in _losses(loss_factor)])
         soft = np.nan_to_num(_cavity_end_response(f, *geometry, compliance, side_volume), nan=0.0, posinf=0.0)
     rigid = _cavity_end_response(f, *geometry, 0.0, side_volume)
     return _followed_peak_hz(f, soft) / _refine_hz(f, rigid, int(np.argmax(rigid)))
@@ -236,14 +318,27 @@ def doublet_hz(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
     return f_tl_hz * _refine_hz(f, soft, int(second)) / rigid
 
 
-def quasi_static_valid(wall: Modes, f_hz: float) -> bool:
-    """True where every wall mode with volume coupling lies ≥ :data:`QUASI_STATIC_RATIO` × f."""
-    coupled = wall.coupled_hz()
-    return bool(len(coupled) == 0 or coupled.min() >= QUASI_STATIC_RATIO * f_hz)
+def _coupled(wall: Modes):
+    return wall.compliances_mm3_pa >= SIGNIFICANT_MODE * np.asarray(wall.static_mm3_pa)[..., None]
+
+
+def quasi_static_valid(wall: Modes, f_hz):
+    """True where every wall mode with volume coupling lies ≥ :data:`QUASI_STATIC_RATIO` × f (arrays of caps and
+    frequencies give a bool array)."""
+    f = np.asarray(f_hz, dtype=float)[..., None]
+    ok = np.all(~_coupled(wall) | (wall.frequencies_hz >= QUASI_STATIC_RATIO * f), axis=-1)
+    return bool(ok) if np.ndim(ok) == 0 else ok
+
+
+def mode_coupled_near(wall: Modes, f_hz):
+    """True where a coupled wall mode lies within :data:`HYBRID_BAND` of ``f_hz`` (arrays give a bool array)."""
+    f = np.asarray(f_hz, dtype=float)[..., None]
+    near = np.any(_coupled(wall) & (np.abs(wall.frequencies_hz / f - 1) <= HYBRID_BAND), axis=-1)
+    return bool(near) if np.ndim(near) == 0 else near
 
 
 def mode_near(wall: Modes, f_hz: float) -> float | None:
-    """The coupled wall mode (Hz) nearest ``f_hz`` if it lies within :data:`HYBRID_BAND` of it, else None."""
+    """The coupled wall mode (Hz) nearest ``f_hz`` if it lies within :data:`HYBRID_BAND` of it, else None; one cap."""
     coupled = wall.coupled_hz()
     if not len(coupled):
         return None

@@ -36,7 +36,8 @@ def arguments(cmd) -> None:
 def run(args) -> int:
     from matcad.spec import apply_sets, read_spec_data
     from matcad.sweep import Executor, parse_axes, sweep
-    from matcad.sweep.outputs import write
+    from matcad.output import staged_output
+    from matcad.sweep.outputs import TableWriter, write_json, write_maps
 
     lo, hi = WORKERS
     if not lo <= args.workers <= hi:
@@ -44,10 +45,14 @@ def run(args) -> int:
     check_fem_level(args)
     axes = parse_axes(args.vary)
     data = apply_sets(read_spec_data(args.spec), args.set)
-    load_spec(args.spec, args)  # validates the base spec (exit 2 naming the field) and prints its notes
-    result = sweep(data, axes, model=args.model, executor=Executor(args.workers, args.scheduler),
-                   rules=not args.no_rules, cad=args.cad, fem_level=args.fem_level)
-    target, files = write(result, args.out or Path("out") / f"{result.name}-sweep")
+    spec = load_spec(args.spec, args)  # validates the base spec (exit 2 naming the field) and prints its notes
+    executor = Executor(args.workers, args.scheduler)
+    target = Path(args.out or Path("out") / f"{spec.name}-sweep")
+    with staged_output(target) as tmp:  # the table streams into it; on any error nothing is left
+        table = TableWriter(tmp, axes, not args.no_rules)
+        result = sweep(data, axes, model=args.model, executor=executor, rules=not args.no_rules, cad=args.cad,
+                       fem_level=args.fem_level, sink=table)
+        files = table.close() + write_json(result, tmp) + write_maps(result, tmp)
     if args.json:
         print_json(result.summary_dict(target, files))
     else:

@@ -177,4 +177,7 @@ def sla_inhibition(spec) -> list[Finding]:
 RULES = (printable_walls, key_clearance, fill_and_vents, cap_wall, silicone_batch, sla_inhibition, bore_overhang,
          cavity_appendages, clamp_nut)
 TAXEL_RULES = (fill_and_vents, cap_wall, bore_overhang)
+INFO_RULES = (silicone_batch,)
+"""Rules that only inform (level ``info``, never error or warning): a sweep, which counts errors and warnings, does
+not run them."""
 """The rules that read one taxel's own geometry: a board runs them on each taxel (:func:`matcad.rules.check`)."""

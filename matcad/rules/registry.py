@@ -2,7 +2,8 @@
 
 Adding a rule is one function in a module's ``RULES`` tuple; adding a rule module is that module and one entry
 here (docs/extending.md). A module of :data:`SPEC_MODULES` may also name, in ``TAXEL_RULES``, those of its
-``RULES`` that read one taxel's own geometry: a board runs them on each taxel instead of on the whole spec.
+``RULES`` that read one taxel's own geometry: a board runs them on each taxel instead of on the whole spec; and in
+``INFO_RULES`` those that only inform (never an error or a warning), which a sweep's verdict columns skip.
 """
 
 from __future__ import annotations

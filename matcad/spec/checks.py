@@ -42,9 +42,24 @@ def cross_checks(spec) -> None:
         _geometry_checks(t, lambda key, i=index: field_path(spec, i, key), spec.mold.draft_deg)
 
 
+def geometry_invalid(cavity_diameter, cavity_length, neck_diameter, draft_deg, cap_outer_diameter=None):
+    """Where :func:`_geometry_checks` refuses a taxel, on numpy arrays of variants (mm, deg; ``cap_outer_diameter``
+    None where the spec leaves it to its default): a bool array, True where some check fails. A sweep judges its
+    grid with it; the messages come from the checks themselves."""
+    import numpy as np
+
+    neck_wider = np.asarray(neck_diameter) > np.asarray(cavity_diameter)
+    tip = np.asarray(cavity_diameter) - 2 * np.asarray(cavity_length) * np.tan(np.radians(draft_deg))
+    bad = neck_wider | (tip <= 0)
+    if cap_outer_diameter is not None:
+        bad = bad | (np.asarray(cap_outer_diameter) <= np.asarray(cavity_diameter))
+    return bad
+
+
 def _geometry_checks(t, path, draft_deg: float) -> None:
     """What makes one taxel's geometry impossible (``t`` a :class:`matcad.spec.board.Taxel`; ``path(key)`` names the
-    spec field that sets ``key``, e.g. 'neck.diameter' or 'taxel[2].neck_diameter')."""
+    spec field that sets ``key``, e.g. 'neck.diameter' or 'taxel[2].neck_diameter'). :func:`geometry_invalid` is
+    the same test on arrays."""
     if t.neck.diameter > t.cavity.diameter:
         raise SpecError(path("neck.diameter"), t.neck.diameter,
                         f"must be <= {path('cavity.diameter')} = {t.cavity.diameter:g} mm (a neck cannot be "

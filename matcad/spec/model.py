@@ -108,6 +108,8 @@ def _entries(key: str, cls: type, data: Any) -> tuple:
     return tuple(read_section(cls, f"{key}[{i}]", item) for i, item in enumerate(data, 1))
 
 
+PROPORTIONAL_DEFAULTS = {"end_cap.outer_diameter": CAP_OUTER_PER_D, "end_cap.top_thickness": CAP_TOP_PER_D}
+"""The fields whose default follows cavity.diameter (this factor times it) when the spec leaves them out."""
 KEY_CLEARANCE_MM = {"fdm": 0.2, "sla": 0.1}
 """Registration-key clearance per side by printer process (docs/physics.md, shop practice)."""
 
@@ -122,9 +124,9 @@ def _resolve_defaults(spec: Spec) -> Spec:
         cap_top_thickness=_proportional(e.cap_top_thickness, cap.top_thickness, CAP_TOP_PER_D,
                                         e.cavity_diameter or spec.cavity.diameter)) for e in spec.taxel)
     d = spec.cavity.diameter
-    cap = dataclasses.replace(
-        cap, outer_diameter=cap.outer_diameter if cap.outer_diameter is not None else CAP_OUTER_PER_D * d,
-        top_thickness=cap.top_thickness if cap.top_thickness is not None else CAP_TOP_PER_D * d)
+    per_d = {key.split(".")[1]: factor for key, factor in PROPORTIONAL_DEFAULTS.items()}
+    cap = dataclasses.replace(cap, **{name: getattr(cap, name) if getattr(cap, name) is not None else factor * d
+                                      for name, factor in per_d.items()})
     machine = spec.machine
     if machine.key_clearance is None:
         machine = dataclasses.replace(machine, key_clearance=KEY_CLEARANCE_MM[machine.printer])

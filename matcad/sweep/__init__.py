@@ -6,7 +6,7 @@ rules, CAD as plain data) on executor.py (local processes or Dask) → run.py (t
 """
 
 from matcad.sweep.executor import Executor
-from matcad.sweep.grid import MAX_POINTS, MAX_VARIANTS, Axis, parse_axes
+from matcad.sweep.grid import MAX_GRID, MAX_POINTS, MAX_VARIANTS, Axis, parse_axes
 from matcad.sweep.run import SweepResult, sweep
 
-__all__ = ["Axis", "Executor", "MAX_POINTS", "MAX_VARIANTS", "SweepResult", "parse_axes", "sweep"]
+__all__ = ["Axis", "Executor", "MAX_GRID", "MAX_POINTS", "MAX_VARIANTS", "SweepResult", "parse_axes", "sweep"]

@@ -1,18 +1,46 @@
 """Run plain-data tasks on local processes (concurrent.futures) or on a Dask cluster (``--scheduler``).
 
-Tasks go out in chunks (one round trip per chunk) and come back as plain dicts in task order. A chunk whose
-worker dies (out of memory, killed) is recorded as ``status = "failed"`` for each of its variants, never fatal.
-``dask.distributed`` is imported only when a scheduler address is given (the optional extra ``matcad[cluster]``).
+Tasks go out in chunks (one round trip per chunk) and come back as plain dicts in task order. A local worker
+that dies (out of memory, killed) breaks its pool: the chunks that did not come back are run again, each in a
+fresh process of its own, and only a chunk whose process dies again is recorded as ``status = "failed"`` for each
+of its variants (``reason`` "worker lost"); the sweep goes on. Dask resubmits a dead worker's tasks itself.
+``dask.distributed`` is imported only when a scheduler address is given (the optional extra ``matcad[cluster]``);
+the address is checked before anything connects (:func:`check_address`).
 """
 
 from __future__ import annotations
 
+import collections
 import math
+import re
 from dataclasses import dataclass
 
 CHUNKS_PER_WORKER = 4
 """Chunks per worker: few enough to amortise the per-task overhead, enough to balance uneven variants."""
 CONNECT_TIMEOUT_S = 10.0
+PROTOCOLS = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+"""The Dask comm protocols a ``--scheduler`` address may name (none: tcp)."""
+_HOST_PORT = re.compile(r"^(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})$")
+
+
+def check_address(address: str) -> str:
+    """``address`` if it is a Dask scheduler address (``[protocol://]host:port``, port 1-65535; ``inproc://...``
+    as given); otherwise ValueError naming it and the form allowed, before any connection is tried."""
+    allowed = "must be [protocol://]host:port with a port 1-65535, e.g. tcp://10.0.0.5:8786"
+    protocol, sep, rest = address.partition("://")
+    if not sep:
+        protocol, rest = "tcp", address
+    if protocol not in PROTOCOLS:
+        raise ValueError(f"--scheduler {address}: protocol {protocol!r} unknown, one of {', '.join(PROTOCOLS)}; "
+                         f"the address {allowed}")
+    if protocol == "inproc":
+        if not rest:
+            raise ValueError(f"--scheduler {address}: {allowed}")
+        return address
+    match = _HOST_PORT.match(rest)
+    if not match or not 1 <= int(match.group(2)) <= 65535:
+        raise ValueError(f"--scheduler {address}: {allowed}")
+    return address
 
 
 @dataclass(frozen=True)
@@ -22,6 +50,10 @@ class Executor:
 
     workers: int = 1
     scheduler: str | None = None
+
+    def __post_init__(self):
+        if self.scheduler is not None:
+            check_address(self.scheduler)
 
     def describe(self) -> str:
         if self.scheduler:
@@ -52,20 +84,46 @@ def run(fn_chunk, tasks: list[dict], executor: Executor) -> list[dict]:
     from concurrent.futures import ProcessPoolExecutor
 
     # spawn: workers start clean (no inherited threads or CAD-kernel state), the same on every platform
-    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        chunks = _chunks(tasks, workers)
+    context = multiprocessing.get_context("spawn")
+    chunks = _chunks(tasks, workers)
+    with ProcessPoolExecutor(workers, mp_context=context) as pool:
         futures = [pool.submit(fn_chunk, c) for c in chunks]
-        return _collect(chunks, futures)
+        done = _results(futures)
+    lost = [k for k, r in enumerate(done) if isinstance(r, BaseException)]
+    if lost:  # a dead worker broke the pool: every chunk that did not come back again, one fresh process each
+        for start in range(0, len(lost), workers):
+            batch = lost[start:start + workers]
+            pools = [ProcessPoolExecutor(1, mp_context=context) for _ in batch]
+            try:
+                again = _results([p.submit(fn_chunk, chunks[k]) for p, k in zip(pools, batch)])
+            finally:
+                for p in pools:
+                    p.shutdown(wait=True, cancel_futures=True)
+            for k, r in zip(batch, again):
+                done[k] = r
+    return _joined(chunks, done)
+
+
+def _results(futures) -> list:
+    """Each future's result, or the exception it raised."""
+    out = []
+    for future in futures:
+        try:
+            out.append(future.result())
+        except Exception as exc:  # noqa: BLE001 - a dead worker fails its variants, not the sweep
+            out.append(exc)
+    return out
+
+
+def _joined(chunks, results) -> list[dict]:
+    out = []
+    for chunk, result in zip(chunks, results):
+        out += _lost(chunk, result) if isinstance(result, BaseException) else result
+    return out
 
 
 def _collect(chunks, futures) -> list[dict]:
-    out = []
-    for chunk, future in zip(chunks, futures):
-        try:
-            out += future.result()
-        except Exception as exc:  # noqa: BLE001 - a dead worker fails its variants, not the sweep
-            out += _lost(chunk, exc)
-    return out
+    return _joined(chunks, _results(futures))
 
 
 def _dask(fn_chunk, tasks: list[dict], address: str) -> list[dict]:
@@ -82,3 +140,69 @@ def _dask(fn_chunk, tasks: list[dict], address: str) -> list[dict]:
         chunks = _chunks(tasks, n_workers)
         futures = client.map(fn_chunk, chunks, pure=False)
         return _collect(chunks, futures)
+
+
+def stream(fn_chunk, tasks: list[dict], executor: Executor):
+    """Like :func:`run`, but one task per chunk, yielding each task's result list in task order as it comes, with
+    at most :data:`CHUNKS_PER_WORKER` tasks per worker in flight (a sweep streamed to disk holds no more). A task
+    whose local worker died is run again alone in a fresh process (the pool is restarted and the tasks in flight
+    resubmitted); if that dies too, its result is the lost-worker rows."""
+    if not tasks:
+        return
+    if executor.scheduler:
+        yield from _dask_stream(fn_chunk, tasks, executor.scheduler)
+        return
+    workers = min(executor.workers, len(tasks))
+    if workers == 1:
+        for task in tasks:
+            yield fn_chunk([task])
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    context = multiprocessing.get_context("spawn")
+    pool = ProcessPoolExecutor(workers, mp_context=context)
+    todo, pending = iter(tasks), collections.deque()
+
+    def submit() -> None:
+        task = next(todo, None)
+        if task is not None:
+            pending.append((task, pool.submit(fn_chunk, [task])))
+
+    try:
+        for _ in range(workers * CHUNKS_PER_WORKER):
+            submit()
+        while pending:
+            task, future = pending.popleft()
+            try:
+                result = future.result()
+            except Exception:  # noqa: BLE001 - a dead worker: restart the pool, resubmit, run this task alone
+                pool.shutdown(wait=True, cancel_futures=True)
+                pool = ProcessPoolExecutor(workers, mp_context=context)
+                pending = collections.deque((t, pool.submit(fn_chunk, [t])) for t, _ in pending)
+                alone = ProcessPoolExecutor(1, mp_context=context)
+                try:
+                    result = _results([alone.submit(fn_chunk, [task])])[0]
+                finally:
+                    alone.shutdown(wait=True, cancel_futures=True)
+                result = _joined([[task]], [result])
+            yield result
+            submit()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _dask_stream(fn_chunk, tasks: list[dict], address: str):
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        raise ValueError("--scheduler needs dask.distributed: pip install 'matcad[cluster]'") from None
+    try:
+        client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ValueError(f"--scheduler {address}: cannot connect to a Dask scheduler there ({exc})") from None
+    with client:
+        futures = client.map(fn_chunk, [[t] for t in tasks], pure=False)
+        for task, future in zip(tasks, futures):
+            yield _joined([[task]], _results([future]))
+            future.release()

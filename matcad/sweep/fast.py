@@ -2,16 +2,16 @@
 few numpy calls. These are the registered models (:mod:`matcad.acoustics.registry`), their checks
 (:mod:`matcad.acoustics.checks`) and the uncertainty budget (:mod:`matcad.acoustics.uncertainty`) evaluated on a
 :class:`~matcad.acoustics.design.Design` whose fields are arrays: the same code `matcad predict` runs on one
-variant, so the numbers are the same (tested to 1e-9 relative on random variants).
+variant, each entry the same arithmetic, so the numbers are the same (tested equal on random variants).
 
 Inputs are a dict of arrays keyed by dotted spec field (:data:`FIELDS`; lengths mm, angles deg, temperature °C,
-speed of sound m/s, NaN where the spec leaves it to the temperature) and what the variants share (the neck's mouth,
-the wall material, how they are made). The closed forms read no cap: its fields are NaN.
+speed of sound m/s — NaN where the spec leaves it to the temperature —, density g/cm³) and what the variants
+share (the neck's mouth, the wall material, how they are made).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -19,23 +19,24 @@ from matcad.acoustics import checks, registry, uncertainty
 from matcad.acoustics.design import Air, Design, Making, WallMaterial, gap_radius_mm
 from matcad.acoustics.evaluation import Evaluation
 
-VECTORISED = tuple(m.name for m in registry.MODELS if m.cheap and "rigid" in m.walls)
-"""The registered rungs that are closed forms of the geometry alone (no wall, no reference, no FEM): lumped,
-end_corrected, transmission_line."""
+VECTORISED = tuple(m.name for m in registry.MODELS if m.cheap)
+"""The registered rungs that are closed forms of the design (no FEM): lumped, end_corrected, transmission_line and
+the silicone wall models soft_wall and elastic_wall."""
 FIELDS = ("cavity.diameter", "cavity.length", "neck.diameter", "neck.length", "mold.draft_deg", "air.temperature_c",
-          "air.speed_of_sound", "spacer.height", "plate.width", "plate.depth")
-"""The spec fields the closed-form rungs read; df0/dfield of any other field is exactly 0 for them."""
+          "air.speed_of_sound", "spacer.height", "plate.width", "plate.depth", "end_cap.outer_diameter",
+          "end_cap.top_thickness", "guide.thickness", "end_cap.flange_squeeze", "silicone.density_g_cm3")
+"""The spec fields the closed-form rungs read (the cap's and the silicone's only through the wall models);
+df0/dfield of any other field is exactly 0."""
 CHUNK = 16_384
-"""Variants per numpy pass: arrays that stay in cache (measured ~2x faster than one 1e6 pass)."""
+"""Variants per numpy pass of the rigid rungs: arrays that stay in cache (measured ~2x faster than one 1e6 pass)."""
 RELATIVE_STEP = 1e-6
 """Central-difference step of :func:`sensitivity`, relative to the field's value (at least 1e-6 of its unit)."""
-NO_CAP = float("nan")
 
 
 @dataclass(frozen=True)
 class Variants:
     """Arrays of the :data:`FIELDS` (one entry per variant), how each variant is made (a :class:`Making` of
-    arrays) and what every variant shares: the neck's mouth and the wall material (the closed forms ignore it)."""
+    arrays) and what every variant shares: the neck's mouth and the wall material (its density per variant)."""
 
     values: dict[str, np.ndarray]
     mouth: str
@@ -60,25 +61,28 @@ class Variants:
         return Design(cavity_diameter=x["cavity.diameter"], cavity_length=x["cavity.length"],
                       draft_deg=x["mold.draft_deg"], neck_diameter=x["neck.diameter"], neck_length=x["neck.length"],
                       mouth=self.mouth, gap_mm=x["spacer.height"],
-                      gap_radius_mm=gap_radius_mm(x["plate.width"], x["plate.depth"]), cap_outer_diameter=NO_CAP,
-                      cap_top_thickness=NO_CAP, cap_clamp_height=NO_CAP,
-                      air=Air(x["air.temperature_c"], x["air.speed_of_sound"]), wall=self.wall, making=self.making)
+                      gap_radius_mm=gap_radius_mm(x["plate.width"], x["plate.depth"]),
+                      cap_outer_diameter=x["end_cap.outer_diameter"], cap_top_thickness=x["end_cap.top_thickness"],
+                      cap_clamp_height=x["guide.thickness"] + x["end_cap.flange_squeeze"],
+                      air=Air(x["air.temperature_c"], x["air.speed_of_sound"]),
+                      wall=replace(self.wall, density_kg_m3=x["silicone.density_g_cm3"] * 1000.0), making=self.making)
+
+
+def field_value(spec, key: str) -> float:
+    """A resolved spec's value of one of the :data:`FIELDS` (NaN where the spec leaves it unset)."""
+    section, name = key.split(".")
+    value = getattr(getattr(spec, section), name)
+    return np.nan if value is None else value
 
 
 def from_specs(specs) -> Variants:
-    """The arrays of validated specs that share one ``neck.mouth``."""
+    """The arrays of validated specs that share one ``neck.mouth`` and one wall material."""
     from matcad.acoustics.design import design
 
     mouths = {s.neck.mouth for s in specs}
     if len(mouths) != 1:
         raise ValueError(f"variants must share one neck.mouth, got {sorted(mouths)}")
-
-    def get(spec, key):
-        section, name = key.split(".")
-        value = getattr(getattr(spec, section), name)
-        return np.nan if value is None else value
-
-    values = {key: np.array([get(s, key) for s in specs], dtype=float) for key in FIELDS}
+    values = {key: np.array([field_value(s, key) for s in specs], dtype=float) for key in FIELDS}
     made = [design(s).making for s in specs]
     making = Making(np.array([m.neck_drilled for m in made]), np.array([m.sheet_measured for m in made]),
                     np.array([m.printer for m in made]))
@@ -103,20 +107,33 @@ def _model(model: str):
 
 
 def f0_hz(v: Variants, model: str) -> np.ndarray:
-    """f0 (Hz) of every variant by one of :data:`VECTORISED` (paper Eq. 1; Rayleigh/Ingard; Selamet 1997)."""
+    """f0 (Hz) of every variant by one of :data:`VECTORISED` (paper Eq. 1; Rayleigh/Ingard; Selamet 1997; the
+    silicone wall at the middle of its modulus and loss ranges)."""
     m = _model(model)
-    return _chunked(lambda part: np.asarray(m.f0_hz(Evaluation(part.design()).res), dtype=float), v)
+
+    def chunk(part):
+        d = part.design()
+        return np.asarray(m.f0_hz(Evaluation(d).res, d.wall), dtype=float)
+
+    return _chunked(chunk, v)
 
 
-def valid(v: Variants, model: str, f0) -> np.ndarray:
-    """The model's validity checks (:mod:`matcad.acoustics.checks`) per variant: True where all pass."""
+def failed_checks(v: Variants, model: str, f0) -> np.ndarray:
+    """How many of the model's validity checks (:mod:`matcad.acoustics.checks`) fail, per variant (each failed
+    check is one warning of `matcad predict`)."""
     m = _model(model)
 
     def chunk(part, f):
         results = checks.evaluate(m.checks, Evaluation(part.design()), np.asarray(f))
-        return np.logical_and.reduce([np.asarray(r, dtype=bool) for r in results.values()])
+        return np.sum([~np.broadcast_to(np.asarray(r, dtype=bool), np.shape(f)) for r in results.values()], axis=0,
+                      dtype=np.int64) if results else np.zeros(np.shape(f), dtype=np.int64)
 
     return _chunked(chunk, v, np.asarray(f0, dtype=float))
+
+
+def valid(v: Variants, model: str, f0) -> np.ndarray:
+    """The model's validity checks per variant: True where all pass."""
+    return failed_checks(v, model, f0) == 0
 
 
 def band_hz(v: Variants, model: str, f0, ok) -> tuple[np.ndarray, np.ndarray]:
@@ -133,11 +150,20 @@ def band_hz(v: Variants, model: str, f0, ok) -> tuple[np.ndarray, np.ndarray]:
     return _chunked(chunk, v, np.asarray(f0, dtype=float), np.asarray(ok))
 
 
-def sensitivity(v: Variants, model: str, field: str) -> np.ndarray:
+def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None) -> np.ndarray:
     """df0/dfield per variant (Hz per the field's unit: Hz/mm for lengths) by a central difference of the
-    vectorised model, step :data:`RELATIVE_STEP` × the value; exactly 0 for a field the model does not read."""
+    vectorised model, step :data:`RELATIVE_STEP` × the value; exactly 0 for a field the model does not read.
+    ``follows`` ({field: factor}) moves the fields whose default follows this one with it (the cap's size follows
+    the cavity diameter)."""
     if field not in v.values:
         return np.zeros(len(v))
     x = v.values[field]
     h = RELATIVE_STEP * np.maximum(np.abs(x), 1.0)
-    return (f0_hz(v.with_value(field, x + h), model) - f0_hz(v.with_value(field, x - h), model)) / (2 * h)
+
+    def moved(value):
+        out = v.with_value(field, value)
+        for other, factor in (follows or {}).items():
+            out = out.with_value(other, factor * value)
+        return out
+
+    return (f0_hz(moved(x + h), model) - f0_hz(moved(x - h), model)) / (2 * h)

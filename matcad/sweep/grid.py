@@ -16,8 +16,11 @@ import numpy as np
 MAX_POINTS = 200
 """Most values one ``--vary`` axis may take."""
 MAX_VARIANTS = 20_000
-"""Most variants one sweep may have (the product of its axes): each runs the design rules (~10 ms, more with
-the elastic wall) and the table and maps stay readable."""
+"""Most variants a per-variant sweep may have (fem, relative, a board, --cad: each variant runs predict and the
+rules on its own, and its rows are held in memory)."""
+MAX_GRID = 10_000_000
+"""Most variants any sweep may have (the product of its axes): a sweep on arrays streams its table to disk chunk
+by chunk, so its memory does not grow with the grid."""
 VARIABLE_KINDS = ("number", "integer")
 """Only numeric spec fields can be swept; choices (wall.model, neck.mouth) are set with ``--set``."""
 
@@ -117,22 +120,23 @@ def parse_axis(text: str) -> Axis:
 
 
 def parse_axes(texts) -> tuple[Axis, ...]:
-    """Every ``--vary``; a field at most once, and at most :data:`MAX_VARIANTS` variants in all."""
+    """Every ``--vary``; a field at most once, and at most :data:`MAX_GRID` variants in all (a per-variant sweep
+    refuses more than :data:`MAX_VARIANTS` when its model is known)."""
     axes = tuple(parse_axis(t) for t in texts)
     seen = [a.field for a in axes]
     for a in axes:
         if seen.count(a.field) > 1:
             raise _error(a.field, "twice", "vary each field at most once")
     size = math.prod(len(a.values) for a in axes)
-    if size > MAX_VARIANTS:
-        raise _error(" ".join(seen), size, f"the grid has {size} variants, at most {MAX_VARIANTS} are allowed")
+    if size > MAX_GRID:
+        raise _error(" ".join(seen), size, f"the grid has {size} variants, at most {MAX_GRID} are allowed")
     return axes
 
 
-def grid(axes: tuple[Axis, ...]) -> list[tuple[float, ...]]:
-    """Every combination of the axes' values, the first axis varying slowest (row-major: reshape to the axes'
-    lengths)."""
-    return list(itertools.product(*(a.values for a in axes)))
+def grid(axes: tuple[Axis, ...], start: int = 0, stop: int | None = None) -> list[tuple[float, ...]]:
+    """The combinations ``start:stop`` of the axes' values (all by default), the first axis varying slowest
+    (row-major: reshape to the axes' lengths)."""
+    return list(itertools.islice(itertools.product(*(a.values for a in axes)), start, stop))
 
 
 def variant_data(data: dict, axes: tuple[Axis, ...], values: tuple[float, ...]) -> dict:

@@ -1,5 +1,7 @@
 """A sweep's folder, written through :func:`matcad.output.staged_output` (manifest, never half-written):
-``sweep.csv`` and ``sweep.json`` (the table; JSON adds the axes, units and how it was made) and ``maps/*.png``.
+``sweep.csv`` (the table, written chunk by chunk as the sweep streams it: :class:`TableWriter`) and
+``sweep.json`` (the axes, units and how it was made, and the rows too when the sweep kept them: up to
+:data:`matcad.sweep.grid.MAX_VARIANTS` variants, or any grid of one or two axes) and ``maps/*.png``.
 
 Maps (matplotlib, imported here only): one figure per quantity — f0, band low, band high, df0/dfield per axis,
 rule errors. One axis: a line over the field, rule-failing variants marked ×. Two axes: a heat map, variants with
@@ -14,7 +16,7 @@ import json
 import math
 from pathlib import Path
 
-from matcad.sweep.run import LOAD_SENSITIVITY, SweepResult, sensitivity_column
+from matcad.sweep.run import LOAD_SENSITIVITY, SweepResult, sensitivity_column, table_columns
 
 
 def _plain(value):
@@ -24,32 +26,68 @@ def _plain(value):
 
 
 def table_dict(result: SweepResult) -> dict:
-    """The JSON document: how the sweep was made, the axes with units, and every row (NaN → null)."""
+    """The JSON document: how the sweep was made, the axes with units, the counts, and every row (NaN → null)
+    when the sweep kept them (else ``rows_in``: the CSV)."""
     from matcad import __version__
 
     columns = result.columns()
-    return {"matcad": __version__, "spec": result.name, "model": result.model,
-            "vectorised": result.vectorised, "executor": result.executor, "rules": result.rules,
-            "seconds": round(result.seconds, 3), "worker_seconds": round(result.worker_seconds, 3),
-            "axes": [{"field": a.field, "unit": a.unit, "values": list(a.values)} for a in result.axes],
-            "sensitivity": {sensitivity_column(a): f"df0/d({a.field}) in Hz per {a.unit or 'unit'}"
-                            for a in result.axes} | {LOAD_SENSITIVITY: "df0/dF at 0 N by paper Eq. 5 and the "
-                                                                       "spec's [calibration] (Hz/N)"},
-            "columns": columns,
-            "rows": [{k: _plain(row.get(k)) for k in columns} for row in result.rows]}
+    doc = {"matcad": __version__, "spec": result.name, "model": result.model,
+           "vectorised": result.vectorised, "executor": result.executor, "rules": result.rules,
+           "seconds": round(result.seconds, 3), "worker_seconds": round(result.worker_seconds, 3),
+           "axes": [{"field": a.field, "unit": a.unit, "values": list(a.values)} for a in result.axes],
+           "sensitivity": {sensitivity_column(a): f"df0/d({a.field}) in Hz per {a.unit or 'unit'}"
+                           for a in result.axes} | {LOAD_SENSITIVITY: "df0/dF at 0 N by paper Eq. 5 and the "
+                                                                      "spec's [calibration] (Hz/N)"},
+           "columns": columns}
+    if result.tally is not None:
+        return {**doc, "variants": result.variants, "counts": result.counts(), "rows_in": "sweep.csv"}
+    return {**doc, "rows": [{k: _plain(row.get(k)) for k in columns} for row in result.rows]}
+
+
+class TableWriter:
+    """``sweep.csv`` in ``folder``, written chunk by chunk (call it with each chunk's rows; blank where a variant
+    has no value); the columns are fixed by the first chunk (:func:`matcad.sweep.run.table_columns`)."""
+
+    def __init__(self, folder: Path, axes, rules: bool):
+        self.path, self.axes, self.rules = Path(folder) / "sweep.csv", tuple(axes), rules
+        self.file = self.writer = self.columns = None
+
+    def __call__(self, rows) -> None:
+        if self.file is None:
+            self.columns = table_columns(self.axes, self.rules, rows)
+            self.file = open(self.path, "w", newline="", encoding="utf-8")
+            self.writer = csv.writer(self.file)
+            self.writer.writerow(self.columns)
+        self.writer.writerows(["" if _plain(row.get(k)) is None else row.get(k) for k in self.columns]
+                              for row in rows)
+
+    def close(self) -> list[str]:
+        if self.file is None:
+            self([])
+        self.file.close()
+        return ["sweep.csv"]
+
+
+def write_json(result: SweepResult, folder: Path) -> list[str]:
+    """sweep.json into ``folder`` (one row a line, by json's C encoder); returns its name."""
+    doc = table_dict(result)
+    rows = doc.pop("rows", None)
+    if rows is None:
+        text = json.dumps(doc, indent=1, allow_nan=False)
+    else:
+        head = json.dumps({**doc, "rows": []}, indent=1, allow_nan=False)
+        body = ",\n  ".join(json.dumps(row, allow_nan=False) for row in rows)
+        cut = head.rindex("[]")
+        text = head[:cut] + (f"[\n  {body}\n ]" if rows else "[]") + head[cut + 2:]
+    (folder / "sweep.json").write_text(text + "\n", encoding="utf-8")
+    return ["sweep.json"]
 
 
 def write_table(result: SweepResult, folder: Path) -> list[str]:
-    """sweep.csv (blank where a variant has no value) and sweep.json into ``folder``; returns their names."""
-    columns = result.columns()
-    with open(folder / "sweep.csv", "w", newline="", encoding="utf-8") as f:
-        writer = csv.writer(f)
-        writer.writerow(columns)
-        for row in result.rows:
-            writer.writerow(["" if _plain(row.get(k)) is None else row.get(k) for k in columns])
-    (folder / "sweep.json").write_text(json.dumps(table_dict(result), indent=1, allow_nan=False) + "\n",
-                                       encoding="utf-8")
-    return ["sweep.csv", "sweep.json"]
+    """sweep.csv and sweep.json of a sweep that kept its rows into ``folder``; returns their names."""
+    writer = TableWriter(folder, result.axes, result.rules)
+    writer(result.rows)
+    return writer.close() + write_json(result, folder)
 
 
 def quantities(result: SweepResult) -> list[tuple[str, str, str]]:
@@ -69,14 +107,15 @@ def _label(axis) -> str:
 
 def write_maps(result: SweepResult, folder: Path) -> list[str]:
     """The design-space maps into ``folder/maps``; returns their names (none for three or more axes)."""
-    if len(result.axes) not in (1, 2):
+    if len(result.axes) not in (1, 2) or result.tally is not None:
         return []
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
-    from matplotlib.patches import Rectangle
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as Outline
 
     (folder / "maps").mkdir()
     errors = result.column("rule_errors") if result.rules else np.zeros(result.shape)
@@ -103,9 +142,11 @@ def write_maps(result: SweepResult, folder: Path) -> list[str]:
                                  shading="flat", cmap="viridis")
             fig.colorbar(mesh, ax=ax, label=label)
             xe, ye = _edges(x_axis.values), _edges(y_axis.values)
-            for i, j in zip(*np.nonzero(errors > 0)):
-                ax.add_patch(Rectangle((xe[j], ye[i]), xe[j + 1] - xe[j], ye[i + 1] - ye[i], fill=False,
-                                       hatch="///", edgecolor="white", linewidth=0.0))
+            cells = [Outline([(xe[j], ye[i]), (xe[j + 1], ye[i]), (xe[j + 1], ye[i + 1]), (xe[j], ye[i + 1]),
+                           (xe[j], ye[i])], closed=True) for i, j in zip(*np.nonzero(errors > 0))]
+            if cells:  # every hatched cell in one path: one fill however large the grid
+                ax.add_patch(PathPatch(Outline.make_compound_path(*cells), fill=False, hatch="///",
+                                       edgecolor="white", linewidth=0.0))
             ax.set_title(f"{label}\nhatched: design-rule errors; blank: invalid or failed", fontsize=10)
             y_label = _label(y_axis)
         ax.set_xlabel(_label(x_axis))

@@ -2,9 +2,11 @@
 
 Frequencies Hz; sensitivities in Hz per the varied field's unit (Hz/mm for lengths) and Hz/N.
 
-- The closed-form rungs (:data:`matcad.sweep.fast.VECTORISED`) are evaluated on all variants at once; their
-  df0/dfield is the model's own derivative (central difference at each variant).
-- Any other model (elastic_wall, soft_wall, relative, fem) runs :func:`matcad.prediction.predict` per
+- The closed-form rungs (:data:`matcad.sweep.fast.VECTORISED`, the silicone wall's included) of a one-taxel spec
+  without [reference] are evaluated on arrays end to end, validation and design rules included
+  (:mod:`matcad.sweep.arrays`), in chunks of the grid on the executor; their df0/dfield is the model's own
+  derivative (central difference at each variant).
+- Any other sweep (fem, relative, a board of taxels, ``cad``) runs :func:`matcad.prediction.predict` per
   variant on the executor; df0/dfield is then the slope of f0 along that axis of the grid (``numpy.gradient``:
   central differences inside, one-sided at the ends and next to a failed variant; blank for an axis of one value).
 - df0/dF (Hz/N) is paper Eq. 5's slope at 0 N, f(0)·b/(2·V0) (:meth:`matcad.acoustics.eq5.Eq5.slope_hz_per_n`), from
@@ -17,14 +19,15 @@ Variants that fail validation or a solver are rows with ``status`` invalid or fa
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.sweep import fast
-from matcad.sweep.executor import Executor, run as run_tasks
-from matcad.sweep.grid import Axis, grid, variant_data
+from matcad.sweep import arrays, fast
+from matcad.sweep.executor import Executor, run as run_tasks, stream
+from matcad.sweep.grid import MAX_VARIANTS, Axis, grid, variant_data
 from matcad.sweep.tasks import run_chunk
 
 RESULT_KEYS = ("status", "reason", "f0_hz", "band_low_hz", "band_high_hz", "model_valid", "rule_errors",
@@ -42,9 +45,29 @@ def sensitivity_column(axis: Axis) -> str:
 LOAD_SENSITIVITY = "df0_dF_hz_per_n"
 
 
+def table_columns(axes, rules: bool, rows=()) -> list[str]:
+    """The table's columns: index, the varied fields, status ... and the ``cad_`` columns ``rows`` carry."""
+    names = ["index", *(a.field for a in axes), "status", "reason", "model", "f0_hz", "band_low_hz",
+             "band_high_hz", "model_valid", *(sensitivity_column(a) for a in axes), LOAD_SENSITIVITY]
+    if rules:
+        names += ["rule_errors", "rule_warnings", "failing_rules"]
+    return names + sorted({k for r in rows for k in r if k.startswith("cad_")})
+
+
+def tally(rows, into: dict | None = None) -> dict:
+    """Variants by status (ok, invalid, failed) and how many break a design rule, added to ``into``."""
+    out = into if into is not None else {"ok": 0, "invalid": 0, "failed": 0, "rule_errors": 0}
+    for r in rows:
+        out[r["status"]] += 1
+        out["rule_errors"] += bool(r.get("rule_errors"))
+    return out
+
+
 @dataclass(frozen=True)
 class SweepResult:
-    """The table (one dict per variant, grid order: the first axis varies slowest) and how it was made."""
+    """The table (one dict per variant, grid order: the first axis varies slowest) and how it was made. A sweep
+    streamed to a sink keeps no rows when it has three or more axes and more than :data:`MAX_VARIANTS` variants
+    (no maps are drawn then): ``tally`` then holds its counts."""
 
     name: str
     model: str
@@ -55,34 +78,32 @@ class SweepResult:
     rules: bool
     seconds: float
     worker_seconds: float
+    tally: dict | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
         return tuple(len(a.values) for a in self.axes)
 
+    @property
+    def variants(self) -> int:
+        return math.prod(self.shape)
+
     def columns(self) -> list[str]:
-        names = ["index", *(a.field for a in self.axes), "status", "reason", "model", "f0_hz", "band_low_hz",
-                 "band_high_hz", "model_valid", *(sensitivity_column(a) for a in self.axes), LOAD_SENSITIVITY]
-        if self.rules:
-            names += ["rule_errors", "rule_warnings", "failing_rules"]
-        extra = sorted({k for r in self.rows for k in r if k.startswith("cad_")})
-        return names + extra
+        return table_columns(self.axes, self.rules, self.rows)
 
     def counts(self) -> dict:
         """Variants by status (ok, invalid, failed) and how many break a design rule."""
-        out = {s: sum(r["status"] == s for r in self.rows) for s in ("ok", "invalid", "failed")}
-        out["rule_errors"] = sum(bool(r.get("rule_errors")) for r in self.rows)
-        return out
+        return dict(self.tally) if self.tally is not None else tally(self.rows)
 
     def summary_dict(self, folder, files) -> dict:
         """`matcad sweep --json`: where the table went, the model, the counts and the run time (s)."""
-        return {"out_dir": str(folder), "written": files, "model": self.model, "variants": len(self.rows),
+        return {"out_dir": str(folder), "written": files, "model": self.model, "variants": self.variants,
                 **self.counts(), "seconds": round(self.seconds, 3)}
 
     def summary_text(self, folder, files) -> str:
         """What `matcad sweep` prints: the counts, the model and executor, the run time and the files."""
         c = self.counts()
-        return (f"{self.name}: {len(self.rows)} variants ({c['ok']} ok, {c['invalid']} invalid, {c['failed']} failed; "
+        return (f"{self.name}: {self.variants} variants ({c['ok']} ok, {c['invalid']} invalid, {c['failed']} failed; "
                 f"{c['rule_errors']} with design-rule errors) by {self.model} on {self.executor} in "
                 f"{self.seconds:.1f} s\n  {', '.join(files)} in {folder}/")
 
@@ -103,10 +124,11 @@ def allowed_models(spec) -> list[str]:
 
 
 def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor: Executor = Executor(),
-          rules: bool = True, cad: bool = False, fem_level: int | None = None) -> SweepResult:
+          rules: bool = True, cad: bool = False, fem_level: int | None = None, sink=None) -> SweepResult:
     """Sweep the spec ``data`` (raw TOML-like data; each variant is it with the axes' values set, validated like a
     file, so defaults such as the cap's 2.5 × D follow the varied cavity) over the full grid of ``axes``.
-    ``model`` defaults to the spec's own choice (:func:`predict`); ``cad`` also builds each variant's end cap."""
+    ``model`` defaults to the spec's own choice (:func:`predict`); ``cad`` also builds each variant's end cap.
+    ``sink`` (a callable) is given the rows chunk by chunk, in grid order, as they are made."""
     from matcad.acoustics.design import calibration
     from matcad.prediction import predict
     from matcad.spec import SpecError, from_dict
@@ -117,6 +139,19 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
         model = predict(base, mechanics=False).model
     elif model not in allowed_models(base):
         raise ValueError(f"--model {model!r} invalid, must be one of {', '.join(allowed_models(base))}")
+    size = math.prod(len(a.values) for a in axes)
+    if not cad and arrays.eligible(base, model):
+        keep = sink is None or len(axes) <= 2 or size <= MAX_VARIANTS
+        rows, counted, worker_seconds = _array_rows(data, axes, model, rules, executor, sink, keep)
+        return SweepResult(base.name, model, tuple(axes), tuple(rows), True, executor.describe(), rules,
+                           time.perf_counter() - start, worker_seconds, None if keep else counted)
+    if size > MAX_VARIANTS:
+        from matcad.spec import SpecError
+
+        raise SpecError(" ".join(a.field for a in axes), size,
+                        f"the grid has {size} variants, at most {MAX_VARIANTS} for a sweep that runs each variant "
+                        f"on its own (model {model}{', --cad' if cad else ''}; a one-taxel spec without "
+                        f"[reference] by a closed-form model sweeps up to 10^7 on arrays)")
     rows: list[dict] = []
     datas, specs = {}, {}
     for i, values in enumerate(grid(axes)):
@@ -153,7 +188,81 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
                          0.0, worker_seconds)
     if not vectorised:
         _grid_slopes(result)
+    if sink is not None:
+        sink(result.rows)
     return SweepResult(**{**result.__dict__, "seconds": time.perf_counter() - start})
+
+
+def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, sink, keep: bool):
+    """(rows if ``keep``, counts, worker seconds) of every variant by :func:`array_chunk` over chunks of
+    :data:`matcad.sweep.arrays.CHUNK` variants streamed from the executor (each chunk's rows go to ``sink`` as
+    they come); a chunk whose worker was lost is a row ``failed`` per variant."""
+    import uuid
+
+    size = math.prod(len(a.values) for a in axes)
+    key = uuid.uuid4().hex  # the workers' memos are kept per sweep
+    tasks = [{"index": k, "key": key, "data": data, "axes": tuple(axes), "start": lo,
+              "stop": min(lo + arrays.CHUNK, size), "model": model, "rules": rules}
+             for k, lo in enumerate(range(0, size, arrays.CHUNK))]
+    kept, counted, seconds = [], tally(()), 0.0
+    for task, results in zip(tasks, stream(array_chunks, tasks, executor)):
+        result = results[0]
+        if "rows" in result:
+            rows = result["rows"]
+            seconds += result["seconds"]
+        else:
+            rows = [{"index": i, **{a.field: v for a, v in zip(axes, values)}, "status": "failed",
+                     "reason": result["reason"], "model": model}
+                    for i, values in zip(range(task["start"], task["stop"]), grid(axes, task["start"], task["stop"]))]
+        tally(rows, counted)
+        if sink is not None:
+            sink(rows)
+        if keep:
+            kept += rows
+    return kept, counted, seconds
+
+
+_MEMOS: dict = {}
+"""This process's memos of the sweep it is working on: {sweep key: (rule memos, slope memo)}."""
+
+
+def array_chunks(tasks: list[dict]) -> list[dict]:
+    """Executor function: each task (a chunk of the grid) → {"index", "rows", "seconds"}. The chunks of one sweep
+    that reach one process share its memos (keyed on the whole grid's values, so valid across chunks)."""
+    out = []
+    for task in tasks:
+        if task["key"] not in _MEMOS:
+            _MEMOS.clear()
+            _MEMOS[task["key"]] = arrays.rule_memos(), arrays.slope_memo()
+        out.append(array_chunk(task, *_MEMOS[task["key"]]))
+    return out
+
+
+def array_chunk(task: dict, rule_memos=None, slope_memo=None) -> dict:
+    """The rows of variants ``start:stop`` of the grid by :func:`matcad.sweep.arrays.evaluate`."""
+    from matcad.spec import from_dict
+
+    t0 = time.perf_counter()
+    data, axes, model = task["data"], task["axes"], task["model"]
+    chunk = arrays.GridChunk(data, axes, np.arange(task["start"], task["stop"]))
+    out = arrays.evaluate(chunk, from_dict(data), model, task["rules"], rule_memos or arrays.rule_memos(),
+                          slope_memo or arrays.slope_memo())
+    columns = [(sensitivity_column(a), out[("slope", a.field)]) for a in axes if ("slope", a.field) in out]
+    rows = []
+    for j, i in enumerate(chunk.rows.tolist()):
+        row = {"index": i, **{a.field: a.values[int(chunk.index[k][j])] for k, a in enumerate(axes)},
+               "status": out["status"][j], "reason": out["reason"][j], "model": model}
+        if row["status"] != "invalid":
+            row.update(f0_hz=float(out["f0_hz"][j]), band_low_hz=float(out["band_low_hz"][j]),
+                       band_high_hz=float(out["band_high_hz"][j]), model_valid=bool(out["model_valid"][j]),
+                       **{name: float(c[j]) for name, c in columns})
+            if out["load_slope"][j] is not None and not isinstance(out["load_slope"][j], tuple):
+                row[LOAD_SENSITIVITY] = out["load_slope"][j]
+            if task["rules"] and row["status"] == "ok":
+                row.update(rule_errors=int(out["rule_errors"][j]), rule_warnings=int(out["rule_warnings"][j]),
+                           failing_rules=out["failing_rules"][j])
+        rows.append(row)
+    return {"index": task["index"], "rows": rows, "seconds": time.perf_counter() - t0}
 
 
 def _grid_slopes(result: SweepResult) -> None:

@@ -1,0 +1,292 @@
+"""A sweep of a one-taxel spec by a closed-form model (:data:`matcad.sweep.fast.VECTORISED`), evaluated on arrays
+of variants end to end: validation, the model's f0, checks, band and df0/dfield, the design rules and Eq. 5's
+slope, chunk by chunk of the grid. Every number is the one `matcad predict` / `matcad check` gives the variant.
+
+- Validation: each spec table that holds a varied field is read once per combination of its varied values (the
+  table's own checks); the whole-spec checks that a grid of a one-taxel spec without [reference] can change are
+  the taxel's geometry checks, judged on arrays by :func:`matcad.spec.checks.geometry_invalid` (the same test);
+  a variant they refuse gets its message from :func:`matcad.spec.from_dict`, once per combination of the
+  geometry fields.
+- Design rules of the spec (:data:`matcad.rules.registry.SPEC_MODULES`) run through :class:`matcad.sweep.memo.Memo`:
+  once per combination of the varied fields each rule reads (exact: see memo.py). The sound rules
+  (:mod:`matcad.rules.acoustic`) are arithmetic on the predicted band and warnings, evaluated on the arrays.
+- A spec of several taxels, with a [reference], or a per-variant model (fem, relative) takes the per-variant path
+  of :mod:`matcad.sweep.run`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from matcad.sweep import fast
+from matcad.sweep.grid import variant_data
+from matcad.sweep.memo import Memo
+
+CHUNK = 4_096
+"""Variants per pass of the whole pipeline (the models split it further: :data:`matcad.sweep.fast.CHUNK`)."""
+GEOMETRY = ("cavity.diameter", "cavity.length", "neck.diameter", "mold.draft_deg", "end_cap.outer_diameter",
+            "end_cap.top_thickness")
+"""The fields the whole-spec checks of one taxel read (:func:`matcad.spec.checks.cross_checks`), the cap's
+through their defaults."""
+
+
+def _proportional():
+    from matcad.spec.model import PROPORTIONAL_DEFAULTS
+
+    return PROPORTIONAL_DEFAULTS
+
+
+class GridChunk:
+    """Some variants of the grid of ``axes`` over the raw spec ``data`` (``rows``: flat grid indices, the first
+    axis varying slowest): each variant's axis values, its spec, and codes of its values on chosen axes."""
+
+    def __init__(self, data: dict, axes, rows):
+        self.data, self.axes = data, tuple(axes)
+        self.rows = np.asarray(rows, dtype=np.int64)
+        self.shape = tuple(len(a.values) for a in self.axes)
+        self.index = np.unravel_index(self.rows, self.shape) if self.axes else ()
+        self._values = [np.asarray(a.values, dtype=float) for a in self.axes]
+        unset = {key for key in _proportional()
+                 if (data.get(key.split(".")[0]) or {}).get(key.split(".")[1]) is None}
+        self.follows_cavity = {key: factor for key, factor in _proportional().items() if key in unset}
+        """The cap fields the spec leaves to their default, which follows cavity.diameter: {field: factor}."""
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def subset(self, positions) -> GridChunk:
+        return GridChunk(self.data, self.axes, self.rows[positions])
+
+    def axis(self, field: str) -> int | None:
+        return next((k for k, a in enumerate(self.axes) if a.field == field), None)
+
+    def value(self, k: int) -> np.ndarray:
+        """Axis ``k``'s value of every variant."""
+        return self._values[k][self.index[k]]
+
+    def data_of(self, j: int) -> dict:
+        values = tuple(a.values[int(self.index[k][j])] for k, a in enumerate(self.axes))
+        return variant_data(self.data, self.axes, values)
+
+    def spec(self, j: int):
+        """Variant ``j``'s validated spec (made once per variant and chunk, however many rules ask)."""
+        from matcad.spec import from_dict
+
+        cache = self.__dict__.setdefault("_specs", {})
+        if j not in cache:
+            cache[j] = from_dict(self.data_of(j))
+        return cache[j]
+
+    def axes_of(self, reads) -> tuple[int, ...]:
+        """The axes whose field is among ``reads`` (dotted fields; ``table.*`` for a whole table), the cavity's
+        diameter too where a cap field that follows it by default was read."""
+        reads = set(reads)
+        if any(key in reads or f"{key.split('.')[0]}.*" in reads for key in self.follows_cavity):
+            reads.add("cavity.diameter")
+        return tuple(k for k, a in enumerate(self.axes) if a.field in reads or f"{a.section}.*" in reads)
+
+    def codes(self, axes: tuple[int, ...], positions) -> np.ndarray:
+        """One integer per variant at ``positions`` naming its combination of values on ``axes``."""
+        positions = np.asarray(positions)
+        if not axes:
+            return np.zeros(len(positions), dtype=np.int64)
+        return np.ravel_multi_index(tuple(self.index[k][positions] for k in axes), tuple(self.shape[k] for k in axes))
+
+    def field(self, base, key: str) -> np.ndarray:
+        """Every variant's resolved value of the dotted ``key`` (float; NaN where unset): the axis's values, the
+        cavity-proportional default of a cap field the spec leaves out, else the base spec's value."""
+        k = self.axis(key)
+        if k is not None:
+            return self.value(k)
+        if key in self.follows_cavity:
+            return self.follows_cavity[key] * self.field(base, "cavity.diameter")
+        return np.full(len(self), fast.field_value(base, key), dtype=float)
+
+
+def eligible(base, model: str) -> bool:
+    """Whether a sweep of ``base`` by ``model`` runs on arrays: a closed-form model, one taxel, no [reference]."""
+    from matcad.spec import taxels
+
+    return model in fast.VECTORISED and base.reference is None and not base.taxel and len(taxels(base)) == 1
+
+
+def _by_combination(chunk: GridChunk, axes: tuple[int, ...], positions, function) -> np.ndarray:
+    """``function(j)`` once per combination of the values on ``axes`` among ``positions`` (j: the first variant
+    with it), given to every variant with that combination: an object array."""
+    positions = np.asarray(positions, dtype=np.int64)
+    out = np.empty(len(positions), dtype=object)
+    if not len(positions):
+        return out
+    uniq, first, inverse = np.unique(chunk.codes(axes, positions), return_index=True, return_inverse=True)
+    results = np.empty(len(uniq), dtype=object)
+    results[:] = [function(int(positions[f])) for f in first]
+    out[:] = results[inverse.reshape(-1)]
+    return out
+
+
+def validate(chunk: GridChunk, base) -> np.ndarray:
+    """Each variant's validation message ('' where it validates), exactly as :func:`matcad.spec.from_dict`."""
+    from matcad.spec import SECTIONS, SpecError
+    from matcad.spec.checks import geometry_invalid
+    from matcad.spec.fields import read_section
+
+    n = len(chunk)
+    reason = np.full(n, "", dtype=object)
+    everyone = np.arange(n)
+    for section, cls in SECTIONS.items():  # the first failing table in from_dict's order names the error
+        axes = tuple(k for k, a in enumerate(chunk.axes) if a.section == section)
+        if not axes:
+            continue
+
+        def read(j, section=section, cls=cls):
+            try:
+                read_section(cls, section, chunk.data_of(j)[section])
+            except SpecError as exc:
+                return str(exc)
+            return ""
+
+        found = _by_combination(chunk, axes, everyone, read)
+        reason = np.where(reason == "", found, reason)
+    g = {key: chunk.field(base, key) for key in GEOMETRY}
+    tolerances = {key: (_schema_range(key)) for key in chunk.follows_cavity}
+    suspect = geometry_invalid(g["cavity.diameter"], g["cavity.length"], g["neck.diameter"], g["mold.draft_deg"],
+                               g["end_cap.outer_diameter"])
+    for key, (lo, hi) in tolerances.items():  # a default out of its field's range: from_dict decides
+        suspect = suspect | (g[key] < lo) | (g[key] > hi)
+    ask = np.flatnonzero(suspect & (reason == ""))
+    if len(ask):
+        geometry = tuple(k for k, a in enumerate(chunk.axes) if a.field in GEOMETRY)
+
+        def whole(j):
+            try:
+                chunk.spec(j)
+            except SpecError as exc:
+                return str(exc)
+            return ""
+
+        reason[ask] = _by_combination(chunk, geometry, ask, whole)
+    return reason
+
+
+def _schema_range(key: str) -> tuple[float, float]:
+    from matcad.spec import schema
+
+    row = next(r for r in schema() if r["key"] == key)
+    return row["lo"], row["hi"]
+
+
+def variants(chunk: GridChunk, base) -> fast.Variants:
+    """The arrays of the model fields (:data:`matcad.sweep.fast.FIELDS`) of the chunk's (valid) variants."""
+    from matcad.acoustics.design import Making, design
+
+    one = design(base)
+    n = len(chunk)
+    making = Making(np.full(n, one.making.neck_drilled), np.full(n, one.making.sheet_measured),
+                    np.full(n, one.making.printer))
+    return fast.Variants({key: chunk.field(base, key) for key in fast.FIELDS}, base.neck.mouth, one.wall, making)
+
+
+def _summary(findings) -> tuple:
+    return tuple((f.id, f.level) for f in findings if f.level in ("error", "warning"))
+
+
+def spec_rules():
+    """Every rule of the spec modules that can give an error or a warning, in :func:`matcad.rules.check`'s order
+    (those a module lists in ``INFO_RULES`` only inform: they never change a verdict column)."""
+    from matcad.rules.registry import SPEC_MODULES
+
+    return [rule for module in SPEC_MODULES for rule in module.RULES if rule not in getattr(module, "INFO_RULES", ())]
+
+
+def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, model: str, f0, low, high,
+                 failed_checks) -> dict:
+    """rule_errors, rule_warnings, failing_rules (and status/reason where a rule raised) of the chunk's valid
+    variants, as :func:`matcad.sweep.tasks.rule_verdicts` gives them one by one."""
+    from matcad.acoustics.predict import warning_count
+    from matcad.rules import acoustic
+
+    n = len(chunk)
+    numbers = [memo.apply(chunk) for memo in memos]
+    sound = acoustic.array_counts(chunk.field(base, "microphone.sample_rate_hz"),
+                                  chunk.field(base, "microphone.floor_hz"), low, high,
+                                  warning_count(v.design(), f0, failed_checks))
+    matrix = np.stack(numbers + [np.asarray(c, dtype=np.int64) for c in sound.values()], axis=1) if n else \
+        np.zeros((0, len(memos) + len(sound)), dtype=np.int64)
+    uniq, inverse = np.unique(matrix, axis=0, return_inverse=True)
+    errors, warnings, failing, failed = [], [], [], []
+    for combo in uniq:
+        items, broken = [], ""
+        for memo, number in zip(memos, combo[:len(memos)]):
+            outcome = memo.outcomes[number]
+            if isinstance(outcome, tuple) and outcome[:1] == ("failed",):
+                broken = broken or outcome[1]
+                continue
+            items += list(outcome)
+        for (rule_id, level), count in zip(sound, combo[len(memos):]):
+            items += [(rule_id, level)] * int(count)
+        ordered = [x for x in items if x[1] == "error"] + [x for x in items if x[1] == "warning"]
+        errors.append(sum(x[1] == "error" for x in items))
+        warnings.append(sum(x[1] == "warning" for x in items))
+        failing.append(" ".join(dict.fromkeys(f"{i}:{lvl}" for i, lvl in ordered)))
+        failed.append(broken)
+    inverse = inverse.reshape(-1)
+    return {"rule_errors": np.array(errors, dtype=np.int64)[inverse] if n else np.zeros(0, np.int64),
+            "rule_warnings": np.array(warnings, dtype=np.int64)[inverse] if n else np.zeros(0, np.int64),
+            "failing_rules": np.array(failing, dtype=object)[inverse] if n else np.zeros(0, object),
+            "failed": np.array(failed, dtype=object)[inverse] if n else np.zeros(0, object)}
+
+
+def rule_memos() -> list[Memo]:
+    """One :class:`Memo` per spec rule, keeping the summary of its findings (id, level) at error and warning."""
+    return [Memo(lambda spec, rule=rule: _summary(rule(spec))) for rule in spec_rules()]
+
+
+def slope_memo() -> Memo:
+    """Eq. 5's df0/dF at 0 N (Hz/N) from the spec's [calibration], None without one, once per combination."""
+    from matcad.acoustics.design import calibration
+
+    def slope(spec):
+        cal = calibration(spec)
+        return None if cal is None else float(cal.slope_hz_per_n(0.0))
+
+    return Memo(slope)
+
+
+def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo) -> dict:
+    """Every column of the chunk's variants: status, reason, f0_hz, band_low_hz, band_high_hz, model_valid,
+    df0/dfield per axis (keyed by field), the load slope, and the rule columns when ``rules``; arrays."""
+    n = len(chunk)
+    reason = validate(chunk, base)
+    ok = np.flatnonzero(reason == "")
+    out = {"status": np.where(reason == "", "ok", "invalid").astype(object), "reason": reason,
+           "f0_hz": np.full(n, np.nan), "band_low_hz": np.full(n, np.nan), "band_high_hz": np.full(n, np.nan),
+           "model_valid": np.full(n, None, dtype=object), "load_slope": np.full(n, None, dtype=object)}
+    if not len(ok):
+        return out
+    good = chunk.subset(ok)
+    v = variants(good, base)
+    f0 = fast.f0_hz(v, model)
+    failed = fast.failed_checks(v, model, f0)
+    valid = failed == 0
+    low, high = fast.band_hz(v, model, f0, valid)
+    out["f0_hz"][ok], out["band_low_hz"][ok], out["band_high_hz"][ok] = f0, low, high
+    out["model_valid"][ok] = valid
+    for a in chunk.axes:
+        follows = good.follows_cavity if a.field == "cavity.diameter" else None
+        out[("slope", a.field)] = np.full(n, np.nan)
+        out[("slope", a.field)][ok] = fast.sensitivity(v, model, a.field, follows)
+    numbers = slope.apply(good)
+    outcomes = np.empty(len(slope.outcomes), dtype=object)
+    outcomes[:] = slope.outcomes
+    out["load_slope"][ok] = outcomes[numbers]
+    if rules:
+        verdicts = rule_columns(good, base, memos, v, model, f0, low, high, failed)
+        out["rule_errors"] = np.full(n, -1, dtype=np.int64)
+        out["rule_warnings"] = np.full(n, -1, dtype=np.int64)
+        out["failing_rules"] = np.full(n, None, dtype=object)
+        for key in ("rule_errors", "rule_warnings", "failing_rules"):
+            out[key][ok] = verdicts[key]
+        broken = ok[verdicts["failed"] != ""]
+        out["status"][broken] = "failed"
+        out["reason"][broken] = verdicts["failed"][verdicts["failed"] != ""]
+    return out

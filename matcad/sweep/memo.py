@@ -1,0 +1,135 @@
+"""Exact memoisation of functions of a spec over a sweep's grid: a function (a design rule, the calibration's slope)
+is run once per distinct combination of the varied fields it actually reads, and its result is given to every
+variant that agrees on those fields.
+
+While the function runs on one variant's resolved spec, every field it reads is recorded (the spec's tables are
+wrapped in subclasses that note each attribute read). A function of the spec is deterministic, so any variant
+that agrees with this one on the fields read follows the same path, reads the same fields and returns the same
+result: that is the memo's key. Reading more than needed (a ``dataclasses.replace``, a hash) only makes the key
+finer, never wrong. A rule reading one varied field runs once per value of that field, however large the grid.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import functools
+import threading
+
+import numpy as np
+
+_state = threading.local()
+
+
+def _record(key: str) -> None:
+    reads = getattr(_state, "reads", None)
+    if reads is not None:
+        reads.add(key)
+
+
+@functools.cache
+def _traced_class(cls: type) -> type:
+    names = frozenset(f.name for f in dataclasses.fields(cls))
+    table = cls.table
+
+    def __getattribute__(self, name):
+        if name in names:
+            _record(f"{table}.{name}")
+        elif name == "__dict__":  # every field at once
+            _record(f"{table}.*")
+        return object.__getattribute__(self, name)
+
+    return type(f"Traced{cls.__name__}", (cls,), {"__getattribute__": __getattribute__})
+
+
+def _wrap(section):
+    traced = object.__new__(_traced_class(type(section)))
+    object.__getattribute__(traced, "__dict__").update(vars(section))
+    return traced
+
+
+def traced(spec):
+    """A copy of the resolved ``spec`` whose tables record every field read (see :func:`run`)."""
+    from matcad.spec import SECTIONS
+
+    out = copy.copy(spec)
+    for name in SECTIONS:
+        section = getattr(spec, name)
+        if section is not None:
+            object.__setattr__(out, name, _wrap(section))
+    return out
+
+
+def run(function, spec) -> tuple[frozenset, object]:
+    """(fields read, result) of ``function(spec)`` on a traced copy; an exception is the result
+    ``("failed", "Type: message")``."""
+    copy_ = traced(spec)  # made before recording starts: copying is not reading
+    _state.reads = set()
+    try:
+        try:
+            result = function(copy_)
+        except Exception as exc:  # noqa: BLE001 - a variant's failure is a row of the table, never fatal
+            result = ("failed", f"{exc.__class__.__name__}: {exc}")
+        return frozenset(_state.reads), result
+    finally:
+        _state.reads = None
+
+
+class Memo:
+    """One function's results over a grid: for each set of axes it was seen to read, {code of those axes' value
+    indices: outcome number}; outcomes are stored once each (:attr:`outcomes`)."""
+
+    def __init__(self, function):
+        self.function = function
+        self.tables: dict[tuple[int, ...], dict[int, int]] = {}
+        self.outcomes: list = []
+        self._number: dict = {}
+
+    def _intern(self, outcome) -> int:
+        key = repr(outcome)
+        if key not in self._number:
+            self._number[key] = len(self.outcomes)
+            self.outcomes.append(outcome)
+        return self._number[key]
+
+    def apply(self, grid) -> np.ndarray:
+        """Outcome numbers of the chunk's variants (``grid``: a :class:`GridChunk`), running the function only on
+        variants whose combination of read fields has not been seen yet."""
+        n = len(grid)
+        out = np.full(n, -1, dtype=np.int64)
+        for axes, table in self.tables.items():
+            self._fill(out, grid, axes, table)
+        while (todo := np.flatnonzero(out < 0)).size:
+            reads, outcome = run(self.function, grid.spec(int(todo[0])))
+            axes = grid.axes_of(reads)
+            table = self.tables.setdefault(axes, {})
+            codes = grid.codes(axes, todo)
+            first = {}
+            for j, code in zip(todo.tolist(), codes.tolist()):
+                first.setdefault(code, j)
+            for code, j in first.items():  # one run per new combination of the fields read
+                if code in table:
+                    continue
+                if j == todo[0]:
+                    table[code] = self._intern(outcome)
+                    continue
+                reads_j, outcome_j = run(self.function, grid.spec(j))
+                if grid.axes_of(reads_j) == axes:
+                    table[code] = self._intern(outcome_j)
+                else:  # another path through the function: its own key
+                    other = grid.axes_of(reads_j)
+                    self.tables.setdefault(other, {})[int(grid.codes(other, np.array([j]))[0])] = \
+                        self._intern(outcome_j)
+            for axes_k, table_k in self.tables.items():
+                self._fill(out, grid, axes_k, table_k)
+        return out
+
+    @staticmethod
+    def _fill(out, grid, axes, table) -> None:
+        todo = np.flatnonzero(out < 0)
+        if not todo.size or not table:
+            return
+        codes = grid.codes(axes, todo)
+        uniq, inverse = np.unique(codes, return_inverse=True)
+        found = np.array([table.get(int(c), -1) for c in uniq.tolist()], dtype=np.int64)
+        out[todo] = found[inverse]
