@@ -115,7 +115,8 @@ class SweepResult:
 
 def allowed_models(spec) -> list[str]:
     """Model names a sweep of ``spec`` accepts: the registered models evaluated for its wall
-    (:mod:`matcad.acoustics.registry`), and the derived ``relative`` when it has a [reference]."""
+    (:mod:`matcad.acoustics.registry`), the anchors it has measurements for (:mod:`matcad.prediction.anchor`) and
+    ``relative`` when it has a [reference]."""
     from matcad.acoustics.registry import MODELS
     from matcad.prediction.anchor import available
 
@@ -146,8 +147,6 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
         return SweepResult(base.name, model, tuple(axes), tuple(rows), True, executor.describe(), rules,
                            time.perf_counter() - start, worker_seconds, None if keep else counted)
     if size > MAX_VARIANTS:
-        from matcad.spec import SpecError
-
         raise SpecError(" ".join(a.field for a in axes), size,
                         f"the grid has {size} variants, at most {MAX_VARIANTS} for a sweep that runs each variant "
                         f"on its own (model {model}{', --cad' if cad else ''}; a one-taxel spec without "
