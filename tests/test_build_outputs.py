@@ -295,7 +295,6 @@ def test_sheets_pdf_prints_every_sheet_at_one_to_one(built, tmp_path):
     """sheets_1to1.pdf read back with poppler: one page per sheet at its stated paper size; rendered at 254 dpi
     (10 px/mm, no anti-aliasing) its reference square measures 10 mm and every part outline its kerf-compensated
     size."""
-    import shutil
     import subprocess
 
     from PIL import Image
