@@ -77,7 +77,8 @@ def test_laser_only_build_never_imports_cad_kernel(tmp_path, write_spec):
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
     assert sorted(p.suffix for p in (tmp_path / "o").iterdir() if p.name != MANIFEST) == (
-        [".dxf"] * 4 + [".html", ".json", ".md"] + [".png"] * 6 + [".svg"] * 4 + [".zip"])  # 6th: the band chart
+        [".dxf"] * 7 + [".html", ".json", ".md", ".pdf"] + [".png"] * 6 + [".svg"] * 7 + [".zip"])
+    # 4 parts and 3 nested sheets (plate, guide, spacer) as DXF and SVG, the 1:1 PDF; 6th png: the band chart
 
 
 def test_check_exit_codes(write_spec):
