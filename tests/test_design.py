@@ -1,5 +1,6 @@
 """`matcad design --target-hz`: inverse design hits its target by `predict`, within rules and stock sheets."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -23,6 +24,7 @@ LASER = ROOT / "templates" / "mat-laser-only.toml"
 @pytest.mark.parametrize("target", [4200.0, 5000.0, 5200.0])
 def test_inverse_design_hits_target_by_predict(template, vary, target):
     s = spec_mod.load(template)
+    s = dataclasses.replace(s, calibration=None)  # the physics' own design (a calibrated spec: the next test)
     result = solve(s, target, parse_vary(s, vary))
     f0 = predict(result.spec).f0_hz  # an independent call of the whole prediction on the solved spec
     assert abs(f0 / target - 1) < 0.005 and result.f0_hz == f0
@@ -36,13 +38,14 @@ def test_inverse_design_hits_target_by_predict(template, vary, target):
 
 
 def test_a_calibrated_spec_is_designed_by_its_calibration():
-    """The paper template carries its calibration (f(0) 4010 Hz, physics 5292 Hz): a design for 4500 Hz is 4500 Hz
-    by that anchor, its physics-only f0 near 4500 x 5292/4010, and a target the anchored taxel cannot reach says so
+    """The paper template carries its calibration (f(0) 4010 Hz, physics 5292 Hz): a design for 3800 Hz is 3800 Hz
+    by that anchor, its physics-only f0 near 3800 x 5292/4010, and a target the anchored taxel cannot reach says so
     naming the anchor."""
     s = spec_mod.load(PAPER)
-    result = solve(s, 4500.0, parse_vary(s, ["cavity.length"]))
+    result = solve(s, 3800.0, parse_vary(s, ["cavity.length"]))
     p = predict(result.spec, mechanics=False)
-    assert p.model == "calibration" and p.f0_hz == pytest.approx(4500.0, rel=0.005)
+    assert p.model == "calibration" and p.f0_hz == pytest.approx(3800.0, rel=0.005)
+    assert result.spec.cavity.length > s.cavity.length
     assert p.physics_f0_hz / p.f0_hz == pytest.approx(5292.3 / 4010.4, rel=0.03)
     with pytest.raises(Unreachable, match=r"\(calibration\) reaches"):
         solve(s, 5900.0, parse_vary(s, ["cavity.diameter", "neck.diameter"]))
@@ -174,14 +177,14 @@ def test_taxels_that_do_not_fit_exit_2(tmp_path, write_spec):
 
 
 def test_taxels_interleave_with_harmonics_and_check_warns(tmp_path, write_spec):
-    """Issue 24: a band that another taxel's 2f lands in is no longer moved above the harmonic (which exited 2
-    here: t1's 2f, 5.0-6.1 kHz, covers the 4th and 5th bands' place). The bands sit side by side, the guard apart;
+    """Issue 24: a band that another taxel's 2f lands in is no longer moved above the harmonic (t1's 2f, 5.0-5.5 kHz
+    by its calibration, covers the 7th and 8th bands' place). The bands sit side by side, the guard apart;
     `check` passes with a bands.harmonic warning (the board tracker discounts the harmonic)."""
     from matcad.listening import guard_hz
     from matcad.prediction.bands import conflicts, taxel_bands
 
     out = tmp_path / "arr"
-    code, stdout, err = run_cli("design", _array_base(write_spec), "--taxels", "5", "--band", "2500", "6000",
+    code, stdout, err = run_cli("design", _array_base(write_spec), "--taxels", "8", "--band", "2500", "6000",
                                 "--vary", "neck.diameter", "cavity.length", "--out", out, "--json")
     assert code == 0, err
     written = spec_mod.load(out / f"{json.loads(stdout)['name']}.toml")

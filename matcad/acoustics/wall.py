@@ -270,11 +270,20 @@ def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
     found at SELECT_LOSS and followed down to ``loss_factor``: an almost undamped wall mode rings as a sharp spike
     that can out-peak it on the grid (η = 0 on the paper's taxel gave 3033 Hz, a wall mode, for its 5288 Hz), though
     it is not the resonance the jet drives."""
-    if np.ndim(loss_factor) == 0 and loss_factor < SELECT_LOSS and np.ndim(f_tl_hz) == 0:
-        return _followed_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall,
-                               loss_factor, side_volume)
     geometry = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
         f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume)))
+    if np.any(np.asarray(loss_factor) < SELECT_LOSS):  # row by row, each following its Helmholtz branch
+        shape = np.broadcast_shapes(geometry[0].shape, np.shape(wall.static_mm3_pa), np.shape(loss_factor))
+        m = wall.frequencies_hz.shape[-1]
+        freqs = np.broadcast_to(wall.frequencies_hz, shape + (m,))
+        comps = np.broadcast_to(wall.compliances_mm3_pa, shape + (m,))
+        static, loss = np.broadcast_to(wall.static_mm3_pa, shape), np.broadcast_to(loss_factor, shape)
+        rows = [np.broadcast_to(g, shape) for g in geometry]
+        out = np.empty(shape)
+        for i in np.ndindex(shape):
+            out[i] = _followed_ratio(*(float(g[i]) for g in rows[:6]),
+                                     Modes(freqs[i], comps[i], float(static[i])), float(loss[i]), float(rows[6][i]))
+        return float(out) if out.ndim == 0 else out
     ratio = _peaks(tuple(geometry), wall, loss_factor) / _peaks(tuple(geometry), None, 0.0)
     return float(ratio) if ratio.ndim == 0 else ratio
 
