@@ -15,6 +15,7 @@ from scipy.io import wavfile
 
 from matcad import spec as spec_mod
 from matcad.inputs import SPEC_MAX_BYTES
+from matcad.spec.measured import Measured
 from tests.conftest import MINIMAL, PAPER, run_cli
 
 K = 2.2e8
@@ -227,6 +228,11 @@ def test_cli_force_must_be_finite_and_bounded(force):
     _assert_clean(code, err, 2, "--force")
 
 
+ENTRIES = {"taxel[]": (spec_mod.TaxelEntry, "taxel", {"x": 0.0, "y": 0.0}),
+           "measured[]": (Measured, "measured", {"f0_hz": 4000.0})}
+"""Array-of-tables sections → (their entry class, their key, the smallest entry that carries a field)."""
+
+
 def test_every_numeric_field_at_its_extremes_gives_finite_json_or_exit_2(tmp_path):
     """Each number field at its bounds, one ulp inside them, and at 5e-324, 1e-300, 1e300: predict (with a load
     curve) answers with finite JSON or refuses naming the field — never an internal error."""
@@ -244,15 +250,15 @@ def test_every_numeric_field_at_its_extremes_gives_finite_json_or_exit_2(tmp_pat
             continue
         if "." in name:  # a sub-table's field (taxel[].calibration.*): the same declaration is tried at its table
             continue
-        entry = section == "taxel[]"  # a [[taxel]] field: one entry at the centre carrying it
-        cls = spec_mod.TaxelEntry if entry else spec_mod.SECTIONS[section]
+        entry = ENTRIES.get(section)  # a [[taxel]] or [[measured]] field: one entry carrying it
+        cls = entry[0] if entry else spec_mod.SECTIONS[section]
         meta = dict(next(f for f in dataclasses.fields(cls) if f.name == name).metadata)
         if meta["kind"] != "number":
             continue
         for value in {meta["lo"], math.nextafter(meta["lo"], math.inf), meta["hi"], 5e-324, 1e-300, 1e300}:
             doc = {k: dict(v) if isinstance(v, dict) else v for k, v in base.items()}
             if entry:
-                doc["taxel"] = [{"x": 0.0, "y": 0.0} | {name: value}]
+                doc[entry[1]] = [entry[2] | {name: value}]
             else:
                 doc.setdefault(section, {})[name] = value
             doc["outputs"] = {"end_cap_mold": False, "needle_mount": False, "assembly": False}

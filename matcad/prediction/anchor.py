@@ -75,6 +75,11 @@ class CalibrationAnchor:
         cal = calibration(measured, d)
         self.cal = cal
         f = float(cal.frequency_hz(0.0))
+        if not math.isfinite(f):  # an Eq. 5 with no unloaded state cannot anchor anything
+            from matcad.spec import SpecError
+
+            raise SpecError("calibration", f"v0_mm3 = {cal.v0_mm3:g}, a = {cal.a:g}, b = {cal.b:g}",
+                            f"gives no f(0) to anchor the prediction to: {cal.invalid_reason(0.0) or 'f(0) undefined'}")
         if spec.calibration.k_mm3_hz2 is not None and cal.temperature_c is not None:
             f *= math.sqrt((d.air.temperature_c + 273.15) / (cal.temperature_c + 273.15))
         self.f_cal = f

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from matcad.spec.board import field_path, taxels
-from matcad.spec.derive import reference_spec
+from matcad.spec.derive import calibrated_spec, reference_spec
 from matcad.spec.fields import SpecError
 from matcad.spec.measured import measured_spec
 
@@ -21,11 +21,12 @@ def cross_checks(spec) -> None:
     if spec.reference is not None and not spec.reference.f0_tolerance_hz < spec.reference.f0_hz:
         raise SpecError("reference.f0_tolerance_hz", spec.reference.f0_tolerance_hz,
                         f"must be < reference.f0_hz = {spec.reference.f0_hz:g} Hz (a band in ln f needs f0 - tol > 0)")
-    if spec.reference is not None:
-        try:
-            reference_spec(spec)
-        except SpecError as err:
-            raise SpecError(f"reference ({err.field})", err.value, err.allowed) from None
+    for key, drawing in (("reference", reference_spec), ("calibration", calibrated_spec)):
+        if getattr(spec, key) is not None:  # the measured taxel's own drawing must be a possible taxel
+            try:
+                drawing(spec)
+            except SpecError as err:
+                raise SpecError(f"{key} ({err.field})", err.value, err.allowed) from None
     if spec.array is not None and spec.taxel:
         raise SpecError("array", "[array] and [[taxel]]", "give either an [array] grid or [[taxel]] entries, not both")
     for key in ("taxel", "measured"):

@@ -46,10 +46,14 @@ def filled(entry, spec):
 
 def drawn_spec(spec, entry, **changes):
     """``spec`` with ``entry``'s drawn geometry (fields it leaves out stay ``spec``'s) and ``changes`` (other
-    top-level fields of the spec, e.g. ``reference=None``); validated like any replace."""
+    top-level fields of the spec, e.g. ``reference=None``); validated like any replace; ``spec`` itself when it
+    draws the entry already and nothing changes."""
     tables: dict = {}
     for key, (table, name) in DRAWN.items():
-        if getattr(entry, key) is not None:
-            tables.setdefault(table, {})[name] = getattr(entry, key)
+        value = getattr(entry, key)
+        if value is not None and value != getattr(getattr(spec, table), name):
+            tables.setdefault(table, {})[name] = value
+    if not tables and not changes:
+        return spec  # the spec draws it already
     return dataclasses.replace(spec, **{t: dataclasses.replace(getattr(spec, t), **v) for t, v in tables.items()},
                                **changes)
