@@ -57,3 +57,19 @@ def drawn_spec(spec, entry, **changes):
         return spec  # the spec draws it already
     return dataclasses.replace(spec, **{t: dataclasses.replace(getattr(spec, t), **v) for t, v in tables.items()},
                                **changes)
+
+
+def pinned(data: dict, spec) -> dict:
+    """Raw spec ``data`` whose [calibration], [reference] and [[measured]] tables name the drawing they were
+    measured on, taken from ``spec`` (``data`` as loaded): a variant made by editing the data (a sweep's) then keeps
+    them on the taxel that was built, as ``dataclasses.replace`` does. The data are not changed."""
+    out = dict(data)
+    for key in ("calibration", "reference"):
+        entry = getattr(spec, key)
+        if entry is not None and isinstance(data.get(key), dict):
+            out[key] = {k: getattr(entry, k) for k in DRAWN} | data[key]
+    if spec.measured and isinstance(data.get("measured"), list):
+        out["measured"] = [{k: getattr(entry, k) for k in DRAWN} | raw if isinstance(raw, dict) else raw
+                           for entry, raw in zip(spec.measured, data["measured"])]
+    return out
+

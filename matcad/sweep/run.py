@@ -133,9 +133,11 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     from matcad.acoustics.design import calibration
     from matcad.prediction import predict
     from matcad.spec import SpecError, from_dict
+    from matcad.spec.drawn import pinned
 
     start = time.perf_counter()
     base = from_dict(data)
+    data = pinned(data, base)  # every variant keeps the measured taxels on the drawing they were measured on
     if model is None:
         model = predict(base, mechanics=False).model
     elif model not in allowed_models(base):
