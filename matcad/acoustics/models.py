@@ -206,7 +206,8 @@ def soft_wall_length_scale(shear_modulus_pa, cavity_diameter_mm, cap_outer_diame
     stiffness_ratio = BULK_MODULUS_PA / g
     n2 = 1.0 + stiffness_ratio * b * b / (b * b - a * a)
     extra = HALF_SPACE_MEAN_DISPLACEMENT * a * stiffness_ratio / n2
-    return np.sqrt(n2), extra
+    with np.errstate(invalid="ignore"):  # a sweep's impossible variant (cap inside the cavity, b < a): NaN
+        return np.sqrt(n2), extra
 
 
 def wall_breathing_hz(shear_modulus_pa, density_kg_m3, cavity_diameter_mm, cap_outer_diameter_mm):
