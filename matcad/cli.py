@@ -39,6 +39,14 @@ def _on_signal(signum, frame) -> None:
     raise KeyboardInterrupt
 
 
+def _unraisable(unraisable) -> None:
+    """``sys.unraisablehook`` during a run: the interrupt :func:`_on_signal` raises inside a callback that cannot
+    propagate it (a weakref's, a finaliser's) is not printed as a traceback; anything else is, as Python would."""
+    if _SIGNALLED and issubclass(unraisable.exc_type, KeyboardInterrupt):
+        return
+    sys.__unraisablehook__(unraisable)
+
+
 def _install_signal_handlers() -> dict:
     """Route SIGINT and SIGTERM to :func:`_on_signal`; returns the handlers they replace."""
     _SIGNALLED.clear()  # a new run in the same interpreter (tests call main() repeatedly)
@@ -172,6 +180,7 @@ class _Stdout:
 def main(argv: list[str] | None = None) -> int:
     """Run one command; every outcome maps to one row of :data:`EXIT_CODES`."""
     previous = _install_signal_handlers()
+    sys.unraisablehook = _unraisable
     _STDOUT.clear()
     args = None
     try:
