@@ -126,7 +126,9 @@ def _collect(chunks, futures) -> list[dict]:
     return _joined(chunks, _results(futures))
 
 
-def _dask(fn_chunk, tasks: list[dict], address: str) -> list[dict]:
+def _client(address: str):
+    """A dask.distributed Client of the scheduler at ``address``; ValueError (bad input) without the extra or when
+    nothing answers there within CONNECT_TIMEOUT_S."""
     try:
         from dask.distributed import Client
     except ImportError:
@@ -135,6 +137,11 @@ def _dask(fn_chunk, tasks: list[dict], address: str) -> list[dict]:
         client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
         raise ValueError(f"--scheduler {address}: cannot connect to a Dask scheduler there ({exc})") from None
+    return client
+
+
+def _dask(fn_chunk, tasks: list[dict], address: str) -> list[dict]:
+    client = _client(address)
     with client:
         n_workers = max(1, sum(client.nthreads().values()))
         chunks = _chunks(tasks, n_workers)
@@ -193,14 +200,7 @@ def stream(fn_chunk, tasks: list[dict], executor: Executor):
 
 
 def _dask_stream(fn_chunk, tasks: list[dict], address: str):
-    try:
-        from dask.distributed import Client
-    except ImportError:
-        raise ValueError("--scheduler needs dask.distributed: pip install 'matcad[cluster]'") from None
-    try:
-        client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise ValueError(f"--scheduler {address}: cannot connect to a Dask scheduler there ({exc})") from None
+    client = _client(address)
     with client:
         futures = client.map(fn_chunk, [[t] for t in tasks], pure=False)
         for task, future in zip(tasks, futures):
