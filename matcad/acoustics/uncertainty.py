@@ -247,13 +247,16 @@ def _moved_f0(cheap, d, ends: dict, shear, loss) -> dict:
 
 
 def _sampled_f0(cheap, res, moduli, losses, array: bool) -> np.ndarray:
-    """f0 (Hz) of a wall model at each (modulus Pa, loss factor) sample: (samples,) for one design in one
-    evaluation, (samples, variants) for a sweep's, one sample at a time."""
+    """f0 (Hz) of a wall model at each (modulus Pa, loss factor) sample: (samples,) for one design, (samples,
+    variants) for a sweep's, in one evaluation (the samples a leading axis: the rigid peak and the transmission
+    line, which do not depend on them, computed once)."""
     from matcad.acoustics.wall import SELECT_LOSS
 
-    if not array and np.min(losses) >= SELECT_LOSS:
-        return np.asarray(cheap.f0_hz(res, shear_modulus_pa=moduli, loss_factor=losses), dtype=float)
-    # a sweep's variants, or a loss below SELECT_LOSS (one design: its Helmholtz branch is followed down the losses)
+    if np.min(losses) >= SELECT_LOSS:
+        shape = (-1, 1) if array else (-1,)
+        return np.asarray(cheap.f0_hz(res, shear_modulus_pa=np.reshape(moduli, shape),
+                                      loss_factor=np.reshape(losses, shape)), dtype=float)
+    # a loss below SELECT_LOSS (one design: its Helmholtz branch is followed down the losses)
     return np.array([cheap.f0_hz(res, shear_modulus_pa=float(g), loss_factor=float(eta)) if not array else
                      cheap.f0_hz(res, shear_modulus_pa=g, loss_factor=eta) for g, eta in zip(moduli, losses)])
 

@@ -22,14 +22,15 @@ tends exactly to the transmission line as G → ∞.
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from matcad.acoustics.air import BULK_MODULUS_PA
+from matcad.acoustics.peaks import (SWEEP, cavity_end_response as _cavity_end_response,  # noqa: F401
+                                     dynamic_compliance_mm3_pa, grid_ratios as _grid, peaks as _peaks,
+                                     scanned_peaks as _scanned_peaks)
 
 TABLE_PATH = Path(__file__).parent / "wall_modes.json"
 TABLE_AXES = {
@@ -47,7 +48,6 @@ SIGNIFICANT_MODE = 0.02
 HYBRID_BAND = 0.15
 """A coupled wall mode within ±15 % of f hybridises with the cavity: two resonances can compete, and the fast
 model's error there is larger (measured in docs/error_vs_runtime.md)."""
-SWEEP = (0.5, 2.0, 601)
 SELECT_LOSS = 0.05
 """Below this loss factor (the lowest any grade's range reaches) the resonance is followed from it, not picked as
 the grid's largest peak (:func:`peak_ratio`)."""
@@ -151,42 +151,6 @@ def modes(shape: CapShape, shear_modulus_pa, density_kg_m3) -> Modes:
     return Modes(np.exp(f) * scale[..., None] / a[..., None], c * static_c[..., None], static_c)
 
 
-def dynamic_compliance_mm3_pa(f_hz, wall: Modes, loss_factor):
-    """C_w(f) = ΔV/p of the cap (mm³/Pa, complex; time e^{iωt}): the modal sum, plus the compliance the retained
-    modes miss (static minus their sum) as one more mode at the highest retained frequency, so that it acts as a
-    spring below the retained modes and as a mass above them, like the modes it stands for. ``f_hz`` (..., F)
-    against caps (...): the result is (..., F)."""
-    f = np.asarray(f_hz, dtype=float)[..., None]
-    loss = np.asarray(loss_factor, dtype=float)
-    g = 1.0 + 1j * loss.reshape(loss.shape + (1,) * (f.ndim - loss.ndim))  # caps' losses against (..., F, modes)
-    freqs = np.concatenate([wall.frequencies_hz, wall.frequencies_hz[..., -1:]], axis=-1)
-    rest = np.maximum(wall.static_mm3_pa - wall.compliances_mm3_pa.sum(axis=-1), 0.0)
-    comps = np.concatenate([wall.compliances_mm3_pa, np.asarray(rest)[..., None]], axis=-1)
-    if freqs.ndim > 1:  # caps (..., modes) against frequencies (..., F, 1)
-        freqs, comps = freqs[..., None, :], comps[..., None, :]
-    return (comps / (g - (f / freqs) ** 2)).sum(axis=-1)
-
-
-def _cavity_end_response(f_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall_compliance,
-                         side_volume=0.0):
-    """|p| at the cavity's closed end per unit pressure at the mouth source (transfer matrices, mm, Pa, s); air of
-    ``side_volume`` (mm³) joined to the cavity at the neck is a compliance V/(ρc²) at that junction."""
-    c = c_m_s * 1e3
-    omega = 2 * np.pi * f_hz
-    k = omega / c
-    rho = BULK_MODULUS_PA / c**2
-    z_cav, z_neck = rho * c / cavity_area, rho * c / neck_area
-    p = np.ones_like(omega, dtype=complex)
-    u = 1j * omega * wall_compliance * p  # volume velocity into the wall at the closed end
-    kl = k * cavity_length
-    p, u = np.cos(kl) * p + 1j * z_cav * np.sin(kl) * u, 1j * np.sin(kl) / z_cav * p + np.cos(kl) * u
-    if np.any(side_volume):
-        u = u + 1j * omega * side_volume / BULK_MODULUS_PA * p
-    kl = k * neck_length_eff
-    p, u = np.cos(kl) * p + 1j * z_neck * np.sin(kl) * u, 1j * np.sin(kl) / z_neck * p + np.cos(kl) * u
-    return 1.0 / np.abs(p + rho * c * k * k / (2 * np.pi) * u)
-
-
 def _refine_hz(f_grid, response, i: int) -> float:
     """Frequency of the grid maximum ``i`` of ``response``, refined by a parabola through 1/|H|² in log f."""
     i = int(np.clip(i, 1, len(f_grid) - 2))
@@ -195,51 +159,6 @@ def _refine_hz(f_grid, response, i: int) -> float:
     denom = y[0] - 2 * y[1] + y[2]
     shift = 0.5 * (y[0] - y[2]) / denom if denom > 0 else 0.0
     return float(np.exp(x[1] + np.clip(shift, -1, 1) * (x[2] - x[1])))
-
-
-def _peak_hz(f_grid, response):
-    """Frequency of the largest value of ``response`` on the grid (last axis), refined by a parabola through
-    1/|H|²; rows of grids give one peak each."""
-    i = np.clip(np.argmax(response, axis=-1), 1, response.shape[-1] - 2)[..., None] + np.arange(-1, 2)
-    y = 1.0 / np.take_along_axis(response, i, axis=-1) ** 2
-    x = np.log(np.take_along_axis(np.broadcast_to(f_grid, response.shape), i, axis=-1))
-    denom = y[..., 0] - 2 * y[..., 1] + y[..., 2]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        shift = np.where(denom > 0, 0.5 * (y[..., 0] - y[..., 2]) / denom, 0.0)
-    return np.exp(x[..., 1] + np.clip(shift, -1, 1) * (x[..., 2] - x[..., 1]))
-
-
-@lru_cache(maxsize=1)
-def _grid() -> np.ndarray:
-    return np.geomspace(*SWEEP[:2], SWEEP[2])
-
-
-BLOCK_ROWS = 32
-"""Driven responses evaluated per numpy pass (32 × 601 frequencies × ~21 modes: a few MB of temporaries)."""
-
-
-def _peaks(geometry: tuple, wall: Modes | None, loss_factor) -> np.ndarray:
-    """Peak frequency (Hz) of the driven response per row: ``geometry`` = (f_TL, c, A, S, l_eff, L, V_side) arrays
-    of one shape, and the wall (None: rigid) with its loss, broadcast against it, in blocks of :data:`BLOCK_ROWS`."""
-    parts = [*geometry] if wall is None else [*geometry, wall.static_mm3_pa, np.asarray(loss_factor, dtype=float)]
-    shape = np.broadcast_shapes(*(np.shape(x) for x in parts))
-    n = math.prod(shape)
-    flat = [np.broadcast_to(x, shape).reshape(n) for x in geometry]
-    if wall is not None:
-        m = wall.frequencies_hz.shape[-1]
-        freqs = np.broadcast_to(wall.frequencies_hz, shape + (m,)).reshape(n, m)
-        comps = np.broadcast_to(wall.compliances_mm3_pa, shape + (m,)).reshape(n, m)
-        static = np.broadcast_to(wall.static_mm3_pa, shape).reshape(n)
-        loss = np.broadcast_to(loss_factor, shape).reshape(n)
-    out = np.empty(n)
-    for start in range(0, n, BLOCK_ROWS):
-        rows = slice(start, start + BLOCK_ROWS)
-        f_tl, *net, side = (x[rows, None] for x in flat)
-        f = f_tl * _grid()
-        compliance = 0.0 if wall is None else \
-            dynamic_compliance_mm3_pa(f, Modes(freqs[rows], comps[rows], static[rows]), loss[rows])
-        out[rows] = _peak_hz(f, _cavity_end_response(f, *net, compliance, side))
-    return out.reshape(shape)
 
 
 def _followed_peak_hz(f_grid, responses) -> float:
@@ -262,14 +181,15 @@ def _losses(loss_factor: float) -> np.ndarray:
 
 
 def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
-               loss_factor, side_volume=0.0):
+               loss_factor, side_volume=0.0, scan: bool = False):
     """Peak of the cavity pressure with the elastic wall over the peak with a rigid wall (same network, air of
     ``side_volume`` mm³ joined at the neck in both): a float for one design, an array for arrays of designs, moduli
-    or loss factors (each row the same arithmetic as one design: the grid of :data:`SWEEP` and its parabola, so the
+    or loss factors (each row the same arithmetic as one design: the root find of :func:`matcad.acoustics.peaks.peaks`, so the
     numbers do not depend on the batch). Below :data:`SELECT_LOSS` (one design) the taxel's (Helmholtz) peak is
     found at SELECT_LOSS and followed down to ``loss_factor``: an almost undamped wall mode rings as a sharp spike
     that can out-peak it on the grid (η = 0 on the paper's taxel gave 3033 Hz, a wall mode, for its 5288 Hz), though
-    it is not the resonance the jet drives."""
+    it is not the resonance the jet drives. Its peaks are found by a root find (:mod:`matcad.acoustics.peaks`), or with ``scan``
+    by the 601-point reference scan."""
     geometry = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
         f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume)))
     if np.any(np.asarray(loss_factor) < SELECT_LOSS):  # row by row, each following its Helmholtz branch
@@ -284,7 +204,8 @@ def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
             out[i] = _followed_ratio(*(float(g[i]) for g in rows[:6]),
                                      Modes(freqs[i], comps[i], float(static[i])), float(loss[i]), float(rows[6][i]))
         return float(out) if out.ndim == 0 else out
-    ratio = _peaks(tuple(geometry), wall, loss_factor) / _peaks(tuple(geometry), None, 0.0)
+    peaks = _scanned_peaks if scan else _peaks
+    ratio = peaks(tuple(geometry), wall, loss_factor) / peaks(tuple(geometry), None, 0.0)
     return float(ratio) if ratio.ndim == 0 else ratio
 
 
