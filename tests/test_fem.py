@@ -87,3 +87,19 @@ def test_predict_model_fem_in_json():
 def test_unflanged_mouth_is_a_clear_error():
     with pytest.raises(ValueError, match="mouth"):
         fem.mesh(_geom(mouth="unflanged"))
+
+
+
+def test_fem_solves_run_blas_on_one_thread():
+    # a multi-threaded BLAS inside SuperLU cost the baffled coupled FEM ~5x its CPU on 2 shared cores; the limit
+    # must reach scipy's own BLAS, which loads only with scipy.sparse.linalg (a fresh interpreter: nothing loaded)
+    import ast
+    import subprocess
+    import sys
+
+    code = ("from matcad.acoustics import fem\nwith fem.one_blas_thread():\n    import scipy.sparse.linalg\n"
+            "    from threadpoolctl import threadpool_info\n"
+            "    print([i['num_threads'] for i in threadpool_info() if i['user_api'] == 'blas'])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    threads = ast.literal_eval(out)
+    assert len(threads) >= 1 and set(threads) == {1}, out

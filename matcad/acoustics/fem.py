@@ -362,6 +362,16 @@ def in_cavity(g: FemGeometry, lay: Layout, r, z):
     return above | ((np.asarray(z) > g.neck_length - lay.groove_depth) & (np.asarray(r) > lay.groove_r[0] * (1 - 1e-9)))
 
 
+def one_blas_thread():
+    """A context in which BLAS runs on one thread. SuperLU hands its dense supernodes to BLAS; a multi-threaded
+    OpenBLAS on 2 shared cores then spent ~5x the CPU of one thread (coupled FEM, baffled mouth: 12.8 s vs 2.3 s
+    CPU for the same numbers; benchmarks/floors.py's fem row)."""
+    import scipy.sparse.linalg  # noqa: F401  (loads scipy's own BLAS, so that the limit reaches it)
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(limits=1, user_api="blas")
+
+
 def _eigs_near(a_mat, m_mat, sigma, count):
     from scipy.sparse.linalg import LinearOperator, eigs, splu
 
@@ -369,6 +379,27 @@ def _eigs_near(a_mat, m_mat, sigma, count):
     op = LinearOperator(a_mat.shape, matvec=lambda x: lu.solve(m_mat @ x), dtype=complex)
     nu, vecs = eigs(op, k=count, which="LM", tol=1e-12)
     return sigma + 1.0 / nu, vecs
+
+
+def _fixed_point(k_mat, c_mat, m_mat, m_cav, kappa, k, k_guess_per_mm, modes):
+    """:func:`solve`'s fixed-point iteration on k in the radiation term: (k, (k, cavity fraction, Q) of the best)."""
+    best = None
+    for _ in range(FIXED_POINT_ITERATIONS):
+        a_mat = (k_mat + (1j * k + kappa) * c_mat).astype(complex)
+        lam, vecs = _eigs_near(a_mat, m_mat, k * k, modes)
+        ks = np.sqrt(lam)
+        ks = np.where(ks.real < 0, -ks, ks)
+        energy = np.real(np.einsum("ij,ij->j", vecs.conj(), m_mat @ vecs))
+        fraction = np.real(np.einsum("ij,ij->j", vecs.conj(), m_cav @ vecs)) / energy
+        q = ks.real / (2 * np.abs(ks.imag) + 1e-300)
+        near = (ks.real > k_guess_per_mm / GUESS_WINDOW) & (ks.real < k_guess_per_mm * GUESS_WINDOW)
+        fraction = np.where(near & (q > MIN_Q), fraction, -np.inf)
+        i = int(np.argmax(fraction))
+        converged = abs(ks[i] - k) <= 1e-10 * abs(k)
+        k, best = ks[i], (ks[i], float(fraction[i]), float(q[i]))
+        if converged:
+            break
+    return k, best
 
 
 def solve(g: FemGeometry, k_guess_per_mm: float, level: int = DEFAULT_LEVEL, speed_of_sound_m_s: float = 343.0,
@@ -392,23 +423,8 @@ def solve(g: FemGeometry, k_guess_per_mm: float, level: int = DEFAULT_LEVEL, spe
     cavity = in_cavity(g, lay, *np.asarray(basis.global_coordinates())).astype(float)
     m_cav = asm(weighted_mass, basis, weight=cavity)
 
-    k = complex(k_guess_per_mm)
-    best = None
-    for _ in range(FIXED_POINT_ITERATIONS):
-        a_mat = (k_mat + (1j * k + kappa) * c_mat).astype(complex)
-        lam, vecs = _eigs_near(a_mat, m_mat, k * k, modes)
-        ks = np.sqrt(lam)
-        ks = np.where(ks.real < 0, -ks, ks)
-        energy = np.real(np.einsum("ij,ij->j", vecs.conj(), m_mat @ vecs))
-        fraction = np.real(np.einsum("ij,ij->j", vecs.conj(), m_cav @ vecs)) / energy
-        q = ks.real / (2 * np.abs(ks.imag) + 1e-300)
-        near = (ks.real > k_guess_per_mm / GUESS_WINDOW) & (ks.real < k_guess_per_mm * GUESS_WINDOW)
-        fraction = np.where(near & (q > MIN_Q), fraction, -np.inf)
-        i = int(np.argmax(fraction))
-        converged = abs(ks[i] - k) <= 1e-10 * abs(k)
-        k, best = ks[i], (ks[i], float(fraction[i]), float(q[i]))
-        if converged:
-            break
+    with one_blas_thread():
+        k, best = _fixed_point(k_mat, c_mat, m_mat, m_cav, kappa, complex(k_guess_per_mm), k_guess_per_mm, modes)
     k, fraction, q = best
     f = speed_of_sound_m_s * MM_PER_M * k.real / (2 * math.pi)
     return FemResult(f0_hz=float(f), q=q, k_per_mm=complex(k), cavity_energy_fraction=fraction, dofs=basis.N,

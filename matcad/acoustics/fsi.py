@@ -376,8 +376,9 @@ def solve(g: fem.FemGeometry, cap: Cap | None, f_guess_hz: float, level: int = f
     cm = coupled_mesh(g, ref, level)
     sys_ = _assemble(cm, g, ref)
     rho_a = air_density_t_mm3(c_m_s)
-    f0, q, calls = _peak(lambda f: _response(sys_, cap, f, c_m_s, rho_a), f_guess_hz)
-    modes = () if cap is None or not wall_modes else tuple(_wall_modes(sys_, cap, wall_modes))
+    with fem.one_blas_thread():  # multi-threaded BLAS in SuperLU cost ~5x the CPU with a baffled mouth
+        f0, q, calls = _peak(lambda f: _response(sys_, cap, f, c_m_s, rho_a), f_guess_hz)
+        modes = () if cap is None or not wall_modes else tuple(_wall_modes(sys_, cap, wall_modes))
     dofs = sys_.n_air + (0 if cap is None else sys_.n_u + sys_.n_pi)
     return CoupledResult(f0_hz=f0, q=q, wall_modes_hz=modes, dofs=dofs, level=level,
                          seconds=time.perf_counter() - t0, solves=calls)
