@@ -4,9 +4,13 @@ force per taxel over time. Frequencies Hz, times s, forces N.
 Assignment by band. Each taxel listens in its own band, given by the caller: the loaded band of
 :func:`matcad.prediction.bands.listening_bands` (its predicted unloaded band widened by the rise of f under load up
 to the spec's maximum force).
-The bands of a valid array are disjoint with a guard and clear of each other's 2f and 3f (the band rules), so a
-tone belongs to the taxel whose band holds it, and one :class:`matcad.loop.tracker.BandTracker` per band — all fed
-from the same spectra in one pass (:func:`matcad.loop.analyze.run_trackers`) — tracks every taxel at once. A louder
+The bands of a valid array are disjoint with a guard, so a tone belongs to the taxel whose band holds it, and one
+:class:`matcad.loop.tracker.BandTracker` per band — all fed from the same spectra in one pass
+(:func:`matcad.loop.analyze.run_trackers`) — tracks every taxel at once. A band may hold another taxel's 2f or 3f
+(the allocation interleaves bands between harmonics): each frame, every taxel's harmonics are predicted from its
+tone and discounted in the other bands before their ridges see them (:mod:`matcad.loop.overtones`), and
+:func:`discount_harmonics` checks the tracks afterwards. Frames that hold the room's tail of the old pitch just
+before a fast step are left out (:func:`room_tails`). A louder
 neighbour's tone lies in the neighbour's band: it is that taxel's tone, not a distractor of this one (the
 "stronger tone outside the band" report skips the other taxels' bands); a stronger tone outside every band is
 still reported, and a second line inside a taxel's own band is reported as before. A silent taxel does not stop
