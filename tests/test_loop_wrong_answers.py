@@ -129,9 +129,12 @@ def test_board_taxel_pressed_out_of_its_band(seed):
     assert abs(np.mean(a.track_hz[rest] - rec.truth_at(1, a.times_s[rest]))) < 1.0
 
 
-def test_board_overblown_taxel_is_reported():
-    """Deliberate fault caught: t1 overblowing out of its band for 1.2 s went silent with no word (7/10)."""
-    rec, tracks = _board("overblown-out", 0)
+@pytest.mark.parametrize("seed", [0, 5])
+def test_board_overblown_taxel_is_reported(seed):
+    """Deliberate fault caught: t1 overblowing out of its band for 1.2 s went silent with no word (7/10). Seed 5:
+    t1's voicing came and went before the jump (4 voiced frames, its line on the ridge for 9 more), and a dropout
+    counted on voiced frames only left the jump unwarned (benchmarks/wrong_answers.py: 1/10 unwarned)."""
+    rec, tracks = _board("overblown-out", seed)
     assert any("t1" in w and "overblown" in w for w in tracks[0].analysis.warnings), tracks[0].analysis.warnings
     assert not any("overblown" in w for t in tracks[1:] for w in t.analysis.warnings)
 

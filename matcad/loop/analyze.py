@@ -29,18 +29,21 @@ from __future__ import annotations
 import numpy as np
 
 from matcad.loop.analysis import Analysis
+from matcad.loop.overtones import Overtones
 from matcad.loop.spectrum import Framer
 from matcad.loop.tracker import BandTracker
 
 
 def run_trackers(blocks, fs: float, bands, on_frame=None) -> tuple[list[BandTracker], float, np.ndarray]:
     """Feed an iterable of sample blocks at ``fs`` (Hz) to one :class:`BandTracker` per band (Hz), in one pass:
-    (trackers, duration s, mean power spectrum). ``on_frame`` is called as (band index, time s, frequency Hz or
+    (trackers, duration s, mean power spectrum). With several bands, each frame's bins on a band's predicted
+    harmonics (:mod:`matcad.loop.overtones`) are discounted in the others. ``on_frame`` is called as (band index, time s, frequency Hz or
     NaN, excess dB) as frames become final."""
     framer = Framer(fs)
     trackers = [BandTracker(framer.freqs, fs, band,
                             None if on_frame is None else (lambda *a, k=k: on_frame(k, *a)))
                 for k, band in enumerate(bands)]
+    overtones = Overtones(framer.freqs, bands) if len(bands) > 1 else None
     total = np.zeros(len(framer.freqs))
     samples = 0
     for block in blocks:
@@ -48,8 +51,9 @@ def run_trackers(blocks, fs: float, bands, on_frame=None) -> tuple[list[BandTrac
         times, power = framer.feed(block)
         if len(times):
             total += power.sum(axis=0)
+            discount = overtones.mask(power) if overtones is not None else None
             for tr in trackers:
-                tr.push(times, power)
+                tr.push(times, power, discount)
     return trackers, samples / fs, total / max(1, framer.frames)
 
 

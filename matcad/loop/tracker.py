@@ -72,8 +72,10 @@ class BandTracker:
         self._emitted = 0  # frames whose voicing is final and reported
         self.band_peak_power = np.zeros(nb)
 
-    def push(self, times: np.ndarray, power: np.ndarray) -> None:
-        """Frames at ``times`` (s) with their power spectra (frames × bins)."""
+    def push(self, times: np.ndarray, power: np.ndarray, discount: np.ndarray | None = None) -> None:
+        """Frames at ``times`` (s) with their power spectra (frames × bins). ``discount`` (frames × bins, bool):
+        bins on another taxel's predicted harmonic (:mod:`matcad.loop.overtones`), treated as a mains comb's: no
+        emission for the ridge, no line, no excess."""
         if len(times) == 0:
             return
         b = self.bins
@@ -81,6 +83,10 @@ class BandTracker:
         level, excess, lines = levels(slab)
         band = slice(self.offset, self.offset + len(self.in_band))
         zone = mains_zone(lines, b.freqs[self.slab], b.df)
+        if discount is not None:
+            hidden = discount[:, self.slab][:, band]
+            excess[:, band] = np.where(hidden, 0.0, excess[:, band])
+            zone[:, band] |= hidden
         emit = np.where(zone[:, band], 0.0, np.clip(excess[:, band], 0.0, None))
         band_lines = np.where(zone[:, band], -np.inf, lines[:, band])
         self.band_peak_power += slab[:, band].sum(axis=0)
