@@ -121,3 +121,34 @@ def test_pressing_the_cap_raises_the_tube_pitch():
     volume = [x.cavity_volume_mm3 for x in p.loads]
     assert f[0] == pytest.approx(p.f0_hz) and f[0] < f[1] < f[2] and volume[0] > volume[1] > volume[2]
     assert np.all(np.diff([x.cap_depth_mm for x in p.loads]) < 0)
+
+
+@pytest.mark.parametrize("flow, level, words", [(3.5, "info", "lies in mode 1's window"),
+                                                (1.0, "error", "will not speak"), (12.0, "error", "overblows")])
+def test_check_holds_the_supply_jet_to_the_edge_tone_window(flow, level, words):
+    from matcad.prediction.tube import predict_tube
+    from matcad.rules import check
+    from matcad.spec import from_dict, to_dict
+
+    spec = load(TEMPLATE)
+    data = to_dict(spec)
+    data["tube"]["supply_flow_l_min"] = flow
+    spec = from_dict(data)
+    p = predict_tube(spec)
+    (finding,) = [f for f in check(spec, p) if f.id == "tube.edge_tone"]
+    u = flow / 60e3 / (spec.tube.windway_height * spec.tube.windway_width * 1e-6)
+    assert finding.level == level and words in finding.message and finding.value == pytest.approx(u, rel=1e-3)
+    assert (p.windows[0].u_min_m_s <= u <= p.windows[0].u_max_m_s) == (level == "info")
+
+
+def test_check_refuses_a_windway_the_printer_closes_and_warns_on_a_sagging_labium():
+    from matcad.rules import check
+    from matcad.spec import from_dict, to_dict
+
+    data = to_dict(load(TEMPLATE))
+    data["tube"].update(windway_height=0.3, edge_angle=40.0)
+    ids = {f.id: f.level for f in check(from_dict(data))}
+    assert ids["tube.windway"] == "error" and ids["tube.labium_overhang"] == "warning"
+    run = subprocess.run([sys.executable, "-m", "matcad", "check", str(TEMPLATE), "--set", "tube.windway_height=0.3"],
+                         capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 1 and "tube.windway" in run.stdout

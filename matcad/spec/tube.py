@@ -52,6 +52,9 @@ class Tube(Section):
     edge_angle: float = param("angle of the edge's bevel (labium) to the jet; recorders 10-30 deg", "deg", 20.0,
                               lo=5.0, hi=60.0, lo_open=False)
     wall: float = length_mm("printed tube wall thickness (>= 2 extrusion widths on FDM)", 1.2)
+    supply_flow_l_min: float = param("air flow into the windway (the MAT paper blew about 1.5 L/min through a "
+                                     "1-10 L/min meter); sets the jet speed U = Q / (h B) the edge-tone rule "
+                                     "checks", "L/min", 1.5, lo=0.01, hi=100.0, lo_open=False)
     block_length: float = param("length of the block the windway runs through, from the supply needle's seat "
                                 "to the windway exit", "mm", 8.0, lo=1.0, hi=100.0, lo_open=False)
 
