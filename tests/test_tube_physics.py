@@ -152,3 +152,18 @@ def test_check_refuses_a_windway_the_printer_closes_and_warns_on_a_sagging_labiu
     run = subprocess.run([sys.executable, "-m", "matcad", "check", str(TEMPLATE), "--set", "tube.windway_height=0.3"],
                          capture_output=True, text=True, cwd=ROOT, timeout=120)
     assert run.returncode == 1 and "tube.windway" in run.stdout
+
+
+def test_design_target_hz_solves_the_length_and_the_written_spec_predicts_it(tmp_path):
+    out = tmp_path / "design"
+    run = subprocess.run([sys.executable, "-m", "matcad", "design", str(TEMPLATE), "--target-hz", "5000", "--out",
+                          str(out)], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 0, run.stderr
+    written = out / "acoustac-tube-5000hz.toml"
+    predicted = subprocess.run([sys.executable, "-m", "matcad", "predict", str(written), "--json"],
+                               capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert json.loads(predicted.stdout)["f0_hz"] == pytest.approx(5000, abs=1e-3)
+    assert load(written).tube.length < load(TEMPLATE).tube.length  # higher pitch, shorter tube
+    far = subprocess.run([sys.executable, "-m", "matcad", "design", str(TEMPLATE), "--target-hz", "90000", "--out",
+                          str(tmp_path / "far")], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert far.returncode == 2 and "tube.length 2-1000 mm" in far.stderr and not (tmp_path / "far").exists()
