@@ -167,3 +167,14 @@ def test_design_target_hz_solves_the_length_and_the_written_spec_predicts_it(tmp
     far = subprocess.run([sys.executable, "-m", "matcad", "design", str(TEMPLATE), "--target-hz", "90000", "--out",
                           str(tmp_path / "far")], capture_output=True, text=True, cwd=ROOT, timeout=120)
     assert far.returncode == 2 and "tube.length 2-1000 mm" in far.stderr and not (tmp_path / "far").exists()
+
+
+def test_near_a_cap_mode_the_wall_root_is_found_by_scanning_and_is_a_true_root(td):
+    """At 16 mm the cap's mode pulls the fixed point around a pole of κ: the scanned root must still satisfy
+    f = line(κ(C_w(f))) and be reported with a cap-mode warning by predict."""
+    g = td.wall.dynamic_moduli_pa()[1]
+    near = dataclasses.replace(td, length=16.0)
+    f, kappa = T.with_wall_hz(near, g)
+    assert kappa == pytest.approx(T.compliance_length_mm(near, T.cap_compliance_mm3_pa(near, f, g)), rel=1e-9)
+    assert T.line_hz(near, kappa) == pytest.approx(f, rel=1e-9)
+    assert 0.5 < f / T.line_hz(near) < 1.5

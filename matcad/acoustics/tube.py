@@ -38,6 +38,7 @@ FLANGED = 0.8216
 is its piston approximation)."""
 WALL_FIXED_POINT_TOL = 1e-10
 WALL_FIXED_POINT_STEPS = 60
+WALL_SCAN_POINTS = 401
 
 
 @dataclass(frozen=True)
@@ -177,15 +178,37 @@ def cap_compliance_mm3_pa(td: TubeDesign, f_hz: float, shear_modulus_pa: float) 
 
 
 def with_wall_hz(td: TubeDesign, shear_modulus_pa: float, route=line_hz, mode: int = 1) -> tuple[float, float]:
-    """(f in Hz, κ in mm) of the tube with its silicone cap at the (dynamic) shear modulus (Pa): the fixed point
-    f = route(κ(C_w(f))), started from the rigid cap. Raises ValueError when it does not settle (a cap mode
-    hybridising with the tube's: docs/tube.md)."""
-    f = route(td, 0.0, mode=mode)
+    """(f in Hz, κ in mm) of the tube with its silicone cap at the (dynamic) shear modulus (Pa): a root of
+    h(f) = route(κ(C_w(f))) − f, by the fixed point f ← route(κ(C_w(f))) started from the rigid cap, and where that
+    does not settle (a cap mode near the tube's pulls κ through a pole) the sign change of h nearest the rigid f on
+    a grid of ±50 % (Brent), skipping the poles. Raises ValueError when h has no root there."""
+    f_rigid = f = route(td, 0.0, mode=mode)
     for _ in range(WALL_FIXED_POINT_STEPS):
         kappa = compliance_length_mm(td, cap_compliance_mm3_pa(td, f, shear_modulus_pa))
         f_new = route(td, kappa, mode=mode)
         if abs(f_new - f) <= WALL_FIXED_POINT_TOL * f:
             return f_new, kappa
         f = 0.5 * (f + f_new)
-    raise ValueError(f"the cap's compliance and the tube's resonance do not settle near {f:.0f} Hz (a cap mode "
-                     "near the tube's: two resonances compete)")
+    return _scanned_root(td, shear_modulus_pa, route, mode, f_rigid)
+
+
+def _scanned_root(td: TubeDesign, shear_modulus_pa: float, route, mode: int, f_rigid: float) -> tuple[float, float]:
+    from scipy.optimize import brentq
+
+    def h(f):
+        try:
+            return route(td, compliance_length_mm(td, cap_compliance_mm3_pa(td, f, shear_modulus_pa)), mode=mode) - f
+        except ValueError:  # κ beyond the line's bracket: no root here
+            return math.nan
+
+    grid = np.linspace(0.5 * f_rigid, 1.5 * f_rigid, WALL_SCAN_POINTS)
+    values = np.array([h(f) for f in grid])
+    jump_limit = 0.05 * f_rigid  # a sign change across a pole of κ jumps by far more than the grid's step
+    roots = [i for i in range(len(grid) - 1) if np.isfinite(values[i]) and np.isfinite(values[i + 1])
+             and values[i] * values[i + 1] < 0 and abs(values[i + 1] - values[i]) < jump_limit]
+    if not roots:
+        raise ValueError(f"the cap's compliance and the tube's resonance have no common root within +-50 % of "
+                         f"{f_rigid:.0f} Hz (a cap mode near the tube's: two resonances compete)")
+    i = min(roots, key=lambda j: abs(grid[j] - f_rigid))
+    f = brentq(h, grid[i], grid[i + 1], xtol=1e-9, rtol=1e-13)
+    return f, compliance_length_mm(td, cap_compliance_mm3_pa(td, f, shear_modulus_pa))
