@@ -68,3 +68,11 @@ def test_cli_exit_2_and_one_line_for_a_tube_spec_with_a_neck(tmp_path):
                          cwd=ROOT, timeout=120)
     assert run.returncode == 2 and "neck" in run.stderr and "does not apply to kind = 'tube'" in run.stderr
     assert "Traceback" not in run.stderr and run.stdout == ""
+
+
+@pytest.mark.parametrize("argv", [["sweep", "--vary", "tube.length=10:20:3"], ["infer"], ["coupon"]])
+def test_commands_for_mat_specs_only_refuse_a_tube_spec_with_exit_2(argv, tmp_path):
+    run = subprocess.run([sys.executable, "-m", "matcad", argv[0], str(TUBE), *argv[1:], "--out", str(tmp_path / "o")],
+                         capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 2 and "takes MAT specs only" in run.stderr and "Traceback" not in run.stderr
+    assert not (tmp_path / "o").exists()
