@@ -13,7 +13,9 @@ settings.load_profile("matcad")
 in the draw; benchmarks/fuzz.py explores at random (>= 10 000 specs) and turns what it finds into examples here."""
 
 ROOT = Path(__file__).resolve().parents[1]
-TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
+TUBE_TEMPLATES = [p for p in sorted((ROOT / "templates").glob("*.toml")) if 'kind = "tube"' in p.read_text(encoding="utf-8")]
+"""Fipple-tube templates (docs/tube.md): tested in tests/test_tube_*.py; the MAT kit's tests run on the others."""
+TEMPLATES = [p for p in sorted((ROOT / "templates").glob("*.toml")) if p not in TUBE_TEMPLATES]
 PAPER = ROOT / "templates" / "mat-paper.toml"
 BOARD_TEMPLATES = [p for p in TEMPLATES if "[[taxel]]" in p.read_text(encoding="utf-8") or "[array]" in p.read_text(
     encoding="utf-8")]

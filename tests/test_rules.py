@@ -92,9 +92,9 @@ def test_every_rule_module_is_registered_once():
     import pkgutil
 
     import matcad.rules
-    from matcad.rules.registry import PREDICTION_MODULES, SPEC_MODULES
+    from matcad.rules.registry import PREDICTION_MODULES, SPEC_MODULES, TUBE_MODULES
 
-    registered = [m.__name__ for m in SPEC_MODULES + PREDICTION_MODULES]
+    registered = [m.__name__ for m in SPEC_MODULES + PREDICTION_MODULES + TUBE_MODULES]
     declaring = sorted(name for _, name, _ in pkgutil.iter_modules(matcad.rules.__path__, "matcad.rules.")
                        if hasattr(importlib.import_module(name), "RULES"))
     assert sorted(registered) == declaring and len(set(registered)) == len(registered)

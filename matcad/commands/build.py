@@ -21,6 +21,8 @@ def run(args) -> int:
 
     spec = load_spec(args.spec, args)
     try:
+        if spec.kind == "tube":
+            return _tube(spec, args)
         result = build(spec, out_dir=args.out, force=args.force)
     except DesignRuleFailure as exc:
         if args.json:
@@ -30,4 +32,19 @@ def run(args) -> int:
             print(f"matcad: {exc.advice()}", file=sys.stderr)
         return EXIT_RULES
     print_json(result.to_dict()) if args.json else print(result.to_text(spec.name))
+    return EXIT_OK
+
+
+def _tube(spec, args) -> int:
+    """A fipple tube's kit (:mod:`matcad.tube_build`)."""
+    from matcad.tube_build import build_tube
+
+    folder, report = build_tube(spec, out_dir=args.out, force=args.force)
+    if args.json:
+        print_json({"out": str(folder), "files": sorted(p.name for p in folder.iterdir()),
+                    "f0_hz": report["prediction"]["f0_hz"], "band_hz": report["prediction"]["band_hz"]})
+    else:
+        print(f"{spec.name}: fipple tube kit in {folder}\n  f1 = {report['prediction']['f0_hz']:.0f} Hz, band "
+              f"{report['prediction']['band_hz'][0]:.0f}-{report['prediction']['band_hz'][1]:.0f} Hz\n  files: "
+              + ", ".join(sorted(p.name for p in folder.iterdir() if not p.name.startswith("."))))
     return EXIT_OK

@@ -33,9 +33,17 @@ def load_spec(path, args):
     from matcad.spec import load_spec as load, spec_notes
 
     spec, data = load(path, getattr(args, "set", None))
+    command = getattr(args, "command", None)
+    if spec.kind == "tube" and command not in TUBE_COMMANDS:
+        raise ValueError(f"matcad {command} takes MAT specs only; a kind = 'tube' spec goes to "
+                         f"{', '.join(TUBE_COMMANDS)} (docs/tube.md)")
     for text in spec_notes(spec, data):
         note(text)
     return spec
+
+
+TUBE_COMMANDS = ("predict", "check", "build", "design")
+"""The commands that take a ``kind = "tube"`` spec (docs/tube.md); the others refuse it with exit 2."""
 
 
 def force_n(text: str) -> float:

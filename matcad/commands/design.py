@@ -31,6 +31,8 @@ def solve(spec, args):
 
     from matcad.design.solve import CONTINUOUS, parse_vary
 
+    if spec.kind == "tube":
+        return _tube(spec, args)
     if (args.target_hz is None) == (args.taxels is None):
         raise ValueError("design needs either --target-hz F (one taxel) or --taxels N --band LO HI (an array)")
     if args.target_hz is not None:
@@ -49,6 +51,17 @@ def solve(spec, args):
         raise ValueError("--taxels needs --band LO HI (Hz)")
     return allocate(spec, args.taxels, *args.band, parse_vary(spec, args.vary or ["neck.diameter"], CONTINUOUS),
                     args.name)
+
+
+def _tube(spec, args):
+    """A tube spec: its length solved onto --target-hz (:mod:`matcad.design.tube`)."""
+    from matcad.design.tube import solve_tube
+
+    if args.target_hz is None or args.taxels is not None or args.band:
+        raise ValueError("a kind = 'tube' spec is designed with --target-hz F alone (--taxels/--band are MAT boards)")
+    if args.vary and list(args.vary) != ["tube.length"]:
+        raise ValueError(f"--vary {' '.join(args.vary)}: a tube design varies tube.length only")
+    return solve_tube(spec, args.target_hz, args.name or f"{spec.name}-{args.target_hz:.0f}hz")
 
 
 def run(args) -> int:

@@ -31,6 +31,8 @@ def run(args) -> int:
     forces = args.load or args.force_deprecated or ()
     from matcad.spec import is_array
 
+    if spec.kind == "tube":
+        return _tube(spec, forces, args)
     if is_array(spec):
         from matcad.prediction.board import predict_board
 
@@ -42,4 +44,16 @@ def run(args) -> int:
 
     result = predict(spec, forces_n=forces, model=args.model, fem_level=args.fem_level)
     print_json(result.to_dict()) if args.json else print(result.to_text(spec.name, design(spec)))
+    return EXIT_OK
+
+
+def _tube(spec, forces, args) -> int:
+    """A fipple tube's prediction (docs/tube.md): its own routes; --model and --fem-level are the MAT ladder's."""
+    if args.model or args.fem_level:
+        raise ValueError("--model and --fem-level choose among the MAT taxel's models; a kind = 'tube' spec has "
+                         "its own routes (docs/tube.md): leave them out")
+    from matcad.prediction.tube import predict_tube
+
+    result = predict_tube(spec, forces)
+    print_json(result.to_dict()) if args.json else print(result.to_text())
     return EXIT_OK

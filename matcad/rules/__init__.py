@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from matcad.rules.finding import LEVELS, Finding, findings_text, verdict_dict
-from matcad.rules.registry import PREDICTION_MODULES, SPEC_MODULES
+from matcad.rules.registry import PREDICTION_MODULES, SPEC_MODULES, TUBE_MODULES, TUBE_SPEC_RULES
 
 __all__ = ["Finding", "check", "errors", "findings_text", "verdict_dict"]
 
@@ -18,6 +18,8 @@ __all__ = ["Finding", "check", "errors", "findings_text", "verdict_dict"]
 def check(spec, prediction=None) -> list[Finding]:
     """Run every rule on ``spec``; ``prediction`` (:func:`matcad.prediction.predict` of a single-taxel spec) is computed when
     not given; a board's acoustic rules run on each taxel's own prediction."""
+    if spec.kind == "tube":
+        return _tube(spec, prediction)
     from matcad.prediction import predict
     from matcad.spec import taxel_spec, taxels
 
@@ -40,6 +42,17 @@ def check(spec, prediction=None) -> list[Finding]:
             for rule in module.RULES:
                 findings += [f if len(board) == 1 else replace(f, message=f"{taxel.name}: {f.message}")
                              for f in rule(one, p)]
+    order = {level: i for i, level in enumerate(LEVELS)}
+    return sorted(findings, key=lambda f: order[f.level])
+
+
+def _tube(spec, prediction=None) -> list[Finding]:
+    """A fipple tube's rules (:mod:`matcad.rules.tube`) and its cap's (the MAT cap and mold rules)."""
+    from matcad.prediction.tube import predict_tube
+
+    p = prediction or predict_tube(spec)
+    findings = [f for rule in TUBE_SPEC_RULES for f in rule(spec)]
+    findings += [f for module in TUBE_MODULES for rule in module.RULES for f in rule(spec, p)]
     order = {level: i for i, level in enumerate(LEVELS)}
     return sorted(findings, key=lambda f: order[f.level])
 

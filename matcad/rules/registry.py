@@ -8,10 +8,15 @@ here (docs/extending.md). A module of :data:`SPEC_MODULES` may also name, in ``T
 
 from __future__ import annotations
 
-from matcad.rules import acoustic, bands, board, laser, printing, stack
+from matcad.rules import acoustic, bands, board, laser, printing, stack, tube
 
 SPEC_MODULES = (laser, printing, stack, bands, board)
 """Modules whose ``RULES`` are functions of the spec: ``rule(spec) -> list[Finding]``."""
 PREDICTION_MODULES = (acoustic,)
 """Modules whose ``RULES`` judge one taxel's predicted sound: ``rule(taxel_spec, prediction) -> list[Finding]``,
 run on every taxel with its own prediction."""
+TUBE_MODULES = (tube,)
+"""Modules whose ``RULES`` judge a ``kind = "tube"`` spec: ``rule(spec, tube_prediction) -> list[Finding]``."""
+TUBE_SPEC_RULES = (printing.printable_walls, printing.key_clearance, printing.fill_and_vents, printing.cap_wall,
+                   printing.silicone_batch, printing.sla_inhibition)
+"""The MAT rules a tube spec also runs: its cap and the cap's mold are the MAT path's."""

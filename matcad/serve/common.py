@@ -42,4 +42,8 @@ def spec_of(payload: dict):
     data = payload.get("spec")
     if not isinstance(data, dict):
         raise ValueError('the request must be {"spec": {...}}')
-    return from_dict(data)
+    spec = from_dict(data)
+    if spec.kind == "tube":
+        raise ValueError("the design page edits MAT specs; a kind = 'tube' spec goes to matcad predict, check, build "
+                         "and design (docs/tube.md)")
+    return spec

@@ -18,6 +18,8 @@ def cross_checks(spec) -> None:
     """What no single table can check of a whole ``spec`` (a :class:`matcad.spec.model.Spec`): the reference's band
     and geometry, [array] or [[taxel]] but not both, unique taxel names, and every taxel's geometry. Raises
     SpecError naming the field that sets the bad value."""
+    if spec.kind == "tube":  # its tables are checked by matcad.spec.tube; the MAT stack is refused by from_dict
+        return
     if spec.reference is not None and not spec.reference.f0_tolerance_hz < spec.reference.f0_hz:
         raise SpecError("reference.f0_tolerance_hz", spec.reference.f0_tolerance_hz,
                         f"must be < reference.f0_hz = {spec.reference.f0_hz:g} Hz (a band in ln f needs f0 - tol > 0)")

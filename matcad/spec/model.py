@@ -17,6 +17,7 @@ from matcad.spec.checks import cross_checks
 from matcad.spec.drawn import filled
 from matcad.spec.fields import MISSING, SpecError, convert, did_you_mean, param, read_section
 from matcad.spec.measured import Measured
+from matcad.spec.tube import KINDS, TUBE_TABLES, Tube
 from matcad.spec.sections import (CAP_OUTER_PER_D, CAP_TOP_PER_D, MAX_TAXELS, Air, Array, Cavity, EndCap,
                                   Fasteners, Guide, Machine, Mechanics, Microphone, Mold, Mount, Neck, Needle,
                                   Outputs, Plate, Reference, Silicone, Spacer, TaxelEntry, Wall)
@@ -49,13 +50,17 @@ class Spec:
     array: Array | None = None
     taxel: tuple[TaxelEntry, ...] = ()
     measured: tuple[Measured, ...] = ()
+    tube: Tube | None = None
+    kind: str = param("taxel kind: 'mat' (the MAT paper's Helmholtz taxel) or 'tube' (an AcousTac fipple tube, "
+                      "the [tube] table; docs/tube.md)", default="mat", kind="choice", choices=KINDS)
 
     def __post_init__(self) -> None:
         name_meta = dict(dataclasses.fields(Spec)[0].metadata)
         object.__setattr__(self, "name", convert("name", self.name, name_meta))
+        object.__setattr__(self, "kind", convert("kind", self.kind, _kind_meta()))
         for section, cls in SECTIONS.items():
             value = getattr(self, section)
-            if value is None and section in REQUIRED_SECTIONS:
+            if value is None and section in required_sections(self.kind):
                 raise SpecError(section, MISSING, f"is required: add a [{section}] table")
             if value is not None and not isinstance(value, cls):
                 raise SpecError(section, value, f"must be a {cls.__name__} section")
@@ -70,15 +75,26 @@ SECTIONS: dict[str, type] = {
     "cavity": Cavity, "neck": Neck, "plate": Plate, "guide": Guide, "spacer": Spacer, "end_cap": EndCap,
     "fasteners": Fasteners, "needle": Needle, "mount": Mount, "mold": Mold, "machine": Machine,
     "outputs": Outputs, "air": Air, "wall": Wall, "microphone": Microphone, "silicone": Silicone,
-    "calibration": Calibration, "mechanics": Mechanics, "reference": Reference, "array": Array}
+    "calibration": Calibration, "mechanics": Mechanics, "reference": Reference, "array": Array, "tube": Tube}
 REQUIRED_SECTIONS = ("cavity", "neck")
+TUBE_REQUIRED = ("tube", "cavity")
+"""A tube spec's required tables (its cavity, the cap's, is filled from [tube] by :func:`from_dict`)."""
+
+
+def required_sections(kind: str) -> tuple[str, ...]:
+    """The tables a spec of taxel ``kind`` must have."""
+    return TUBE_REQUIRED if kind == "tube" else REQUIRED_SECTIONS
+
+
+def _kind_meta() -> dict:
+    return dict(next(f for f in dataclasses.fields(Spec) if f.name == "kind").metadata)
 ARRAY_TABLES: dict[str, type] = {"taxel": TaxelEntry, "measured": Measured}
 """Arrays of tables ([[taxel]], [[measured]]): key → the Section class of one entry."""
 
 
 def from_dict(data: dict) -> Spec:
     """Validate a parsed TOML document into a :class:`Spec` (lengths in mm). Raises SpecError."""
-    known = ["name", *SECTIONS, *ARRAY_TABLES]
+    known = ["name", "kind", *SECTIONS, *ARRAY_TABLES]
     for key in data:
         if key not in known:
             raise SpecError(key, data[key], did_you_mean(key, known))
@@ -86,17 +102,35 @@ def from_dict(data: dict) -> Spec:
     if "name" not in data:
         raise SpecError("name", MISSING, f"is required ({name_meta['doc']})")
     values: dict[str, Any] = {"name": convert("name", data["name"], name_meta)}
+    kind = values["kind"] = convert("kind", data.get("kind", "mat"), _kind_meta())
+    if kind == "tube":
+        data = _tube_data(data)
+    elif "tube" in data and data["tube"] is not None:
+        raise SpecError("tube", data["tube"], "applies only to kind = 'tube' (add kind = \"tube\", or remove [tube])")
     for section, cls in SECTIONS.items():
-        if section in data and data[section] is None and section not in REQUIRED_SECTIONS:
+        if section in data and data[section] is None and section not in required_sections(kind):
             continue
         if section in data:
             values[section] = read_section(cls, section, data[section])
-        elif section in REQUIRED_SECTIONS:
+        elif section in required_sections(kind):
             raise SpecError(section, MISSING, f"is required: add a [{section}] table")
     for key, cls in ARRAY_TABLES.items():
         if key in data:
             values[key] = _entries(key, cls, data[key])
     return _resolve_defaults(Spec(**values))  # Spec.__post_init__ runs the cross-field checks
+
+
+def _tube_data(data: dict) -> dict:
+    """A tube spec's document with its cap's cavity filled from [tube] (diameter = bore, length = cap depth). Raises
+    SpecError for a table that does not apply to a tube (the MAT neck-plate stack) or a missing [tube]."""
+    for key, value in data.items():
+        if key not in ("name", "kind", *TUBE_TABLES) and value is not None and value != []:
+            raise SpecError(key, value, f"does not apply to kind = 'tube' (a tube spec takes name, kind and "
+                                        f"{', '.join(f'[{t}]' for t in TUBE_TABLES)})")
+    if data.get("tube") is None:
+        raise SpecError("tube", MISSING, "is required for kind = 'tube': add a [tube] table (bore_diameter, length)")
+    tube = read_section(Tube, "tube", data["tube"])
+    return {**data, "cavity": {"diameter": tube.bore_diameter, "length": tube.cap_cavity_depth}}
 
 
 def _entries(key: str, cls: type, data: Any) -> tuple:
@@ -162,4 +196,7 @@ def to_dict(spec: Spec) -> dict:
         entries = data.pop(key)
         if entries:
             data[key] = list(entries)
-    return data
+    if spec.kind == "mat":  # a MAT spec reads back as it always did
+        del data["kind"], data["tube"]
+        return data
+    return {key: value for key, value in data.items() if key in ("name", "kind", *TUBE_TABLES)}

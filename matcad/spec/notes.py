@@ -44,7 +44,8 @@ def spec_notes(spec, data: dict | None = None) -> list[str]:
     if 0 < theta <= THETA_RADIANS_MAX:
         notes.append(f"needle.theta_deg = {theta:g}°: radians entered? did you mean {math.degrees(theta):.4g} (deg)?")
     dims = {"cavity.diameter": spec.cavity.diameter, "cavity.length": spec.cavity.length,
-            "neck.diameter": spec.neck.diameter, "neck.length": spec.neck.length}
+            "neck.diameter": spec.neck.diameter, "neck.length": spec.neck.length} if spec.kind == "mat" else \
+        {"tube.bore_diameter": spec.tube.bore_diameter, "tube.length": spec.tube.length}
     if all(v < METRES_MAX for v in dims.values()):
         meant = ", ".join(f"{k} = {v * 1000:g}" for k, v in dims.items())
         notes.append(f"every main dimension is below {METRES_MAX:g} mm: a spec in metres? lengths are mm; did you "

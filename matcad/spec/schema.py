@@ -18,6 +18,10 @@ def schema() -> list[dict]:
     rows.append({"key": "name", "unit": "", "default": None, "allowed": "A-Z a-z 0-9 . _ - (1-64)",
                  "required": True, "doc": name_meta["doc"], "kind": "name", "choices": [], "lo": None,
                  "hi": None, "lo_open": True, "required_in_table": True})
+    kind_meta = next(f for f in dataclasses.fields(Spec) if f.name == "kind").metadata
+    rows.append({"key": "kind", "unit": "", "default": "mat", "allowed": allowed_text(dict(kind_meta)),
+                 "required": False, "doc": kind_meta["doc"], "kind": "choice", "choices": list(kind_meta["choices"]),
+                 "lo": None, "hi": None, "lo_open": True, "required_in_table": False})
     tables = [*SECTIONS.items(), *((f"{key}[]", cls) for key, cls in ARRAY_TABLES.items())]
     tables += [(f"{name}.{f.name}", f.metadata["section"]) for name, cls in tables for f in dataclasses.fields(cls)
                if f.metadata["kind"] == "section"]  # sub-tables, e.g. taxel[].calibration

@@ -1,0 +1,84 @@
+"""`matcad build` of the tube template from a fresh interpreter, the kit read back from its files (docs/tube.md).
+Slow (the CAD kernel and the cap mold, ~25 s): `pytest -m slow tests/test_tube_build.py`."""
+
+import json
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from readback import section_circles
+
+ROOT = Path(__file__).resolve().parents[1]
+TEMPLATE = ROOT / "templates" / "acoustac-tube.toml"
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def kit(tmp_path_factory):
+    out = tmp_path_factory.mktemp("tube") / "kit"
+    run = subprocess.run([sys.executable, "-m", "matcad", "build", str(TEMPLATE), "--out", str(out)],
+                         capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert run.returncode == 0, run.stderr
+    from matcad.spec import load
+
+    return out, json.loads((out / "report.json").read_text()), load(TEMPLATE)
+
+
+def test_kit_files_and_prediction_read_back(kit):
+    out, report, spec = kit
+    names = {"tube.stl", "tube.step", "end_cap.stl", "end_cap_mold_base.stl", "end_cap_mold_lid.stl", "report.json",
+             "report.md", "preview_tube.png", "kit.zip"}
+    assert names <= {p.name for p in out.iterdir()}
+    assert report["kind"] == "tube" and report["spec"]["tube"]["bore_diameter"] == spec.tube.bore_diameter
+    predicted = subprocess.run([sys.executable, "-m", "matcad", "predict", str(TEMPLATE), "--json"],
+                               capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert json.loads(predicted.stdout)["f0_hz"] == report["prediction"]["f0_hz"]
+    with zipfile.ZipFile(out / "kit.zip") as archive:
+        assert {"tube.stl", "report.json", "end_cap.stl"} <= set(archive.namelist())
+
+
+def test_tube_mesh_dimensions_bore_window_and_print_pose(kit):
+    import trimesh
+
+    from matcad.parts.tube import SEAT_CONE_DEG, heights_mm
+
+    out, report, spec = kit
+    t = spec.tube
+    mesh = trimesh.load_mesh(out / "tube.stl")
+    z = heights_mm(spec)
+    assert mesh.is_watertight and mesh.body_count == 1
+    assert mesh.bounds[0][2] == pytest.approx(0, abs=1e-6) and mesh.bounds[1][2] == pytest.approx(z["top"], abs=1e-3)
+    bore_z = z["edge"] + 0.5 * (z["cone_start"] - z["edge"])
+    radii = sorted(c[2] for c in section_circles(mesh, bore_z))
+    assert radii == pytest.approx([t.bore_diameter / 2, t.bore_diameter / 2 + t.wall], abs=0.01)
+    window = mesh.section(plane_origin=[0, 0, t.block_length + t.edge_distance / 2], plane_normal=[0, 0, 1])
+    assert len(window.discrete) == 1  # the window opens the wall: one C-shaped loop, not two circles
+    # print pose: every downward face steeper than the FDM limit (30° from vertical, 1° slack) is one of the two
+    # bridges the design leaves, the needle seat's ceiling under the windway and the window's top at the edge
+    n, c, area = mesh.face_normals, mesh.triangles_center, mesh.area_faces
+    steep = (n[:, 2] < 0) & (np.degrees(np.arcsin(np.clip(-n[:, 2], 0, 1))) > SEAT_CONE_DEG + 1) & (c[:, 2] > 1e-3)
+    levels = np.unique(np.round(c[steep, 2], 2))
+    assert set(levels) <= {round(t.block_length / 2, 2), round(z["edge"], 2)}, levels
+    assert area[steep].sum() < 2 * t.windway_width * t.wall  # bridges, not a floor
+
+
+def test_the_cap_is_the_mat_cap_on_the_bore(kit):
+    import trimesh
+
+    out, report, spec = kit
+    cap = trimesh.load_mesh(out / "end_cap.stl")
+    radii = sorted(c[2] for c in section_circles(cap, cap.bounds[0][2] + 0.5 * spec.tube.cap_cavity_depth))
+    assert radii[0] == pytest.approx(spec.tube.bore_diameter / 2, abs=0.01)
+    assert radii[-1] == pytest.approx(spec.end_cap.outer_diameter / 2, abs=0.01)
+
+
+def test_build_refuses_a_supply_outside_the_edge_tone_window_and_writes_nothing(tmp_path):
+    out = tmp_path / "refused"
+    run = subprocess.run([sys.executable, "-m", "matcad", "build", str(TEMPLATE), "--out", str(out), "--set",
+                          "tube.supply_flow_l_min=1.0"], capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert run.returncode == 1 and "tube.edge_tone" in run.stdout and not out.exists()

@@ -1,0 +1,180 @@
+"""The fipple tube's air column (matcad.acoustics.tube) against its closed forms, an independent 1-D FEM and its
+own refinement; the cap's wall as a compliant termination; the edge-tone window (docs/tube.md)."""
+
+import dataclasses
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from matcad.acoustics import edgetone
+from matcad.acoustics import tube as T
+from matcad.spec import load
+
+ROOT = Path(__file__).resolve().parents[1]
+TEMPLATE = ROOT / "templates" / "acoustac-tube.toml"
+
+
+@pytest.fixture(scope="module")
+def td():
+    return T.tube_design(load(TEMPLATE))
+
+
+def test_rigid_cap_tends_to_the_quarter_wave_closed_form_as_the_third_power_of_k_delta(td):
+    """cot kℓ = kδ against f = c/4(ℓ + δ): relative error (kδ)³/3 to leading order, so halving the bore (δ ∝ a) divides
+    it by 8; a line that dropped δ, or used a length extension at the cap, fails."""
+    long_thin = dataclasses.replace(td, mouth="unflanged", length=200.0, cap_depth=1.0)
+    errors = []
+    for bore in (4.0, 2.0, 1.0):
+        t = dataclasses.replace(long_thin, bore_diameter=bore)
+        k_delta = 2 * math.pi * T.line_hz(t) / (T.speed_of_sound(t.air) * 1e3) * T.mouth_correction_mm(t)
+        error = T.line_hz(t) / T.closed_form_hz(t) - 1
+        assert 0 < error < k_delta**3  # the line's root lies a little above the length-extension estimate
+        errors.append(error)
+    assert errors[0] / errors[1] == pytest.approx(8, rel=0.03) and errors[1] / errors[2] == pytest.approx(8, rel=0.03)
+
+
+def test_levine_schwinger_and_flanged_corrections_and_the_fipple_window(td):
+    a = td.bore_diameter / 2
+    assert T.mouth_correction_mm(dataclasses.replace(td, mouth="unflanged")) == pytest.approx(0.6133 * a)
+    assert T.mouth_correction_mm(dataclasses.replace(td, mouth="flanged")) == pytest.approx(0.8216 * a)
+    a_m = math.sqrt(td.windway_width * td.edge_distance / math.pi)  # Rayleigh: K = 2 a_m, δ = S_p / K
+    assert T.mouth_correction_mm(td) == pytest.approx(math.pi * a**2 / (2 * a_m))
+    wider = dataclasses.replace(td, edge_distance=2 * td.edge_distance)  # a bigger window: less mass, higher f
+    assert T.line_hz(wider) > T.line_hz(td)
+
+
+@pytest.mark.parametrize("kappa", [0.0, 1.5, -1.5])
+def test_fem_converges_to_the_line_at_order_2_for_p1_and_4_for_p2(td, kappa):
+    exact = T.line_hz(td, kappa)
+    for order, rate in ((1, 4.0), (2, 16.0)):
+        errors = [abs(T.fem_hz(td, kappa, n, order) - exact) for n in (8, 16, 32)]
+        assert errors[0] / errors[1] == pytest.approx(rate, rel=0.1)
+        assert errors[1] / errors[2] == pytest.approx(rate, rel=0.1)
+    assert T.fem_hz(td, kappa, 64, 2) == pytest.approx(exact, rel=1e-9)
+    assert T.fem_hz(td, kappa, 64, 2, mode=2) == pytest.approx(T.line_hz(td, kappa, mode=2), rel=1e-7)
+
+
+def test_compliant_cap_is_extra_length_and_a_mass_like_cap_is_less(td):
+    rigid = T.line_hz(td)
+    assert T.line_hz(td, 1.0) < rigid < T.line_hz(td, -1.0)
+    for kappa in (0.05, -0.05):  # small κ: the closed form's length ℓ + δ + κ, to the rigid form's own error
+        shift_line = T.line_hz(td, kappa) / rigid
+        shift_closed = T.closed_form_hz(td, kappa) / T.closed_form_hz(td)
+        assert shift_line == pytest.approx(shift_closed, abs=2e-4)
+
+
+def test_stiff_cap_tends_to_the_rigid_line_and_the_wall_is_the_mat_wall_model(td):
+    f, kappa = T.with_wall_hz(td, 1e13)
+    assert f == pytest.approx(T.line_hz(td), rel=1e-8) and abs(kappa) < 1e-6
+    g = td.wall.dynamic_moduli_pa()[1]
+    f_line, kappa_line = T.with_wall_hz(td, g)
+    f_fem, kappa_fem = T.with_wall_hz(td, g, T.fem_hz)
+    assert f_fem == pytest.approx(f_line, rel=1e-4) and kappa_fem == pytest.approx(kappa_line, rel=1e-3)
+    c_w = T.cap_compliance_mm3_pa(td, f_line, g)  # the fixed point: κ is the cap's compliance at f itself
+    assert kappa_line == pytest.approx(T.compliance_length_mm(td, c_w), rel=1e-6)
+    static = T.cap_wall_modes(td, g).static_mm3_pa
+    assert T.cap_compliance_mm3_pa(td, 1.0, g) == pytest.approx(static, rel=1e-5)  # the wall's static limit
+
+
+def test_edge_tone_window_is_strouhal_bounded_and_the_next_mode_needs_a_faster_jet(td):
+    f1 = T.line_hz(td)
+    f2 = T.line_hz(td, mode=2)
+    # closed-open: odd modes; the mouth's mass shortens its length correction as arctan(kδ)/k < δ with rising k,
+    # so the overblown mode lies above 3 f1, below the ratio with no correction at the second mode
+    assert 3.0 < f2 / f1 < 3 * (td.column_mm + T.mouth_correction_mm(td)) / td.column_mm
+    w1 = edgetone.window(f1, 1, td.edge_distance, td.windway_height, td.windway_width)
+    w2 = edgetone.window(f2, 2, td.edge_distance, td.windway_height, td.windway_width)
+    for w in (w1, w2):
+        st = [w.f_hz * td.edge_distance * 1e-3 / u for u in (w.u_max_m_s, w.u_optimum_m_s, w.u_min_m_s)]
+        assert st == pytest.approx([*edgetone.ST_WINDOW[:1], edgetone.ST_OPTIMUM, edgetone.ST_WINDOW[1]])
+    assert w1.u_max_m_s < w2.u_optimum_m_s and not w1.speaks(w2.u_optimum_m_s) and w2.speaks(w2.u_optimum_m_s)
+    u = edgetone.jet_speed_m_s(w1.flow_optimum_l_min, td.windway_height, td.windway_width)
+    assert u == pytest.approx(w1.u_optimum_m_s)
+    assert w1.pressure_optimum_pa == pytest.approx(0.5 * 1.2 * u**2)
+
+
+def test_predict_json_of_the_tube_template_from_a_fresh_interpreter():
+    run = subprocess.run([sys.executable, "-m", "matcad", "predict", str(TEMPLATE), "--json"], capture_output=True,
+                         text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 0, run.stderr
+    out = json.loads(run.stdout)
+    routes = out["routes_hz"]
+    assert routes["1-D FEM P2 (rigid)"] == pytest.approx(routes["line (rigid)"], rel=1e-8)
+    assert routes["1-D FEM + cap wall"] == pytest.approx(routes["line + cap wall"], rel=1e-4)
+    assert out["band_hz"][0] < out["f0_hz"] < out["band_hz"][1]
+    assert 3000 < out["f0_hz"] < 5500  # the AcousTac range the MAT paper cites, for this 16 mm column
+    assert out["edge_tone"][0]["mode"] == 1 and out["edge_tone"][1]["u_min_m_s"] > out["edge_tone"][0]["u_optimum_m_s"]
+
+
+@pytest.mark.slow
+def test_pressing_the_cap_raises_the_tube_pitch():
+    """f(F) from the cap mechanics (FElupe, ~40 s): the cap's cavity shrinks, the column shortens, f rises."""
+    from matcad.prediction.tube import predict_tube
+
+    p = predict_tube(load(TEMPLATE), (0.0, 1.0, 2.0))
+    f = [x.f_hz for x in p.loads]
+    volume = [x.cavity_volume_mm3 for x in p.loads]
+    assert f[0] == pytest.approx(p.f0_hz) and f[0] < f[1] < f[2] and volume[0] > volume[1] > volume[2]
+    assert np.all(np.diff([x.cap_depth_mm for x in p.loads]) < 0)
+
+
+@pytest.mark.parametrize("flow, level, words", [(3.5, "info", "lies in mode 1's window"),
+                                                (1.0, "error", "will not speak"), (12.0, "error", "overblows")])
+def test_check_holds_the_supply_jet_to_the_edge_tone_window(flow, level, words):
+    from matcad.prediction.tube import predict_tube
+    from matcad.rules import check
+    from matcad.spec import from_dict, to_dict
+
+    spec = load(TEMPLATE)
+    data = to_dict(spec)
+    data["tube"]["supply_flow_l_min"] = flow
+    spec = from_dict(data)
+    p = predict_tube(spec)
+    (finding,) = [f for f in check(spec, p) if f.id == "tube.edge_tone"]
+    u = flow / 60e3 / (spec.tube.windway_height * spec.tube.windway_width * 1e-6)
+    assert finding.level == level and words in finding.message and finding.value == pytest.approx(u, rel=1e-3)
+    assert (p.windows[0].u_min_m_s <= u <= p.windows[0].u_max_m_s) == (level == "info")
+
+
+def test_check_refuses_a_windway_the_printer_closes_and_warns_on_a_sagging_labium():
+    from matcad.rules import check
+    from matcad.spec import from_dict, to_dict
+
+    data = to_dict(load(TEMPLATE))
+    data["tube"].update(windway_height=0.3, edge_angle=40.0)
+    ids = {f.id: f.level for f in check(from_dict(data))}
+    assert ids["tube.windway"] == "error" and ids["tube.labium_overhang"] == "warning"
+    run = subprocess.run([sys.executable, "-m", "matcad", "check", str(TEMPLATE), "--set", "tube.windway_height=0.3"],
+                         capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 1 and "tube.windway" in run.stdout
+
+
+def test_design_target_hz_solves_the_length_and_the_written_spec_predicts_it(tmp_path):
+    out = tmp_path / "design"
+    run = subprocess.run([sys.executable, "-m", "matcad", "design", str(TEMPLATE), "--target-hz", "5000", "--out",
+                          str(out)], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 0, run.stderr
+    written = out / "acoustac-tube-5000hz.toml"
+    predicted = subprocess.run([sys.executable, "-m", "matcad", "predict", str(written), "--json"],
+                               capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert json.loads(predicted.stdout)["f0_hz"] == pytest.approx(5000, abs=1e-3)
+    assert load(written).tube.length < load(TEMPLATE).tube.length  # higher pitch, shorter tube
+    far = subprocess.run([sys.executable, "-m", "matcad", "design", str(TEMPLATE), "--target-hz", "90000", "--out",
+                          str(tmp_path / "far")], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert far.returncode == 2 and "tube.length 2-1000 mm" in far.stderr and not (tmp_path / "far").exists()
+
+
+def test_near_a_cap_mode_the_wall_root_is_found_by_scanning_and_is_a_true_root(td):
+    """At 16 mm the cap's mode pulls the fixed point around a pole of κ: the scanned root must still satisfy
+    f = line(κ(C_w(f))) and be reported with a cap-mode warning by predict."""
+    g = td.wall.dynamic_moduli_pa()[1]
+    near = dataclasses.replace(td, length=16.0)
+    f, kappa = T.with_wall_hz(near, g)
+    assert kappa == pytest.approx(T.compliance_length_mm(near, T.cap_compliance_mm3_pa(near, f, g)), rel=1e-9)
+    assert T.line_hz(near, kappa) == pytest.approx(f, rel=1e-9)
+    assert 0.5 < f / T.line_hz(near) < 1.5
