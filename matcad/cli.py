@@ -240,9 +240,8 @@ def _parse(top, argv: list[str]):
 
 
 def _dispatch(args) -> int:
-    from matcad.errors import LoopError, OutputError
+    from matcad.errors import LoopError, OutputError, SpecError
     from matcad.output import WRITTEN
-    from matcad.spec import SpecError
 
     WRITTEN.clear()  # a new run in the same interpreter
     stdout = sys.stdout = _Stdout(sys.stdout)

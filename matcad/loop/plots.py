@@ -7,6 +7,10 @@ from __future__ import annotations
 import numpy as np
 
 PLOT_COLUMNS = 1200
+SPECTROGRAM_PX = (800, 320)
+"""Width of the spectrogram picture and height of each of its panels (px)."""
+SPECTROGRAM_BOX = (85, 35, 785, 315)
+"""The spectrogram's axes in the picture (left, top, right, bottom px): a reader can map a pixel to (s, Hz)."""
 
 
 class PlotPool:
@@ -42,37 +46,48 @@ class PlotPool:
 
 
 def plot(analysis, path, forces=None) -> None:
-    """Spectrogram of an :class:`matcad.loop.analysis.Analysis`'s band (dB, max-pooled in time) with the voiced
-    track and segments; with ``forces`` (per frame: force, low, high in N) a second panel of force against time."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Spectrogram of an :class:`matcad.loop.analysis.Analysis`'s band (dB, max-pooled in time, 'magma' from the
+    5th percentile to the loudest) with the voiced track (cyan) and segments (white, red when flagged); with
+    ``forces`` (per frame: force, low, high in N) a second panel of force against time. Drawn with
+    :mod:`matcad.canvas` (Pillow), not matplotlib: `analyze` stays near the cost of its tracker."""
+    from matcad.canvas import Canvas, colour_map
 
     rows = 2 if forces is not None else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(8, 3.2 * rows + 0.8), sharex=True, squeeze=False)
-    ax = axes[0, 0]
+    width, panel = SPECTROGRAM_PX
+    canvas = Canvas(width, panel * rows + 45)
+    t = analysis.plot_times_s
+    xlim = (float(t[0]), float(t[-1])) if len(t) > 1 and t[-1] > t[0] else (0.0, max(float(t[0]) if len(t) else 1.0, 1e-3))
     db = analysis.plot_db
-    ax.pcolormesh(analysis.plot_times_s, analysis.plot_freqs_hz, db, shading="nearest", cmap="magma",
-                  vmin=np.percentile(db, 5), vmax=db.max())
-    ax.plot(analysis.times_s, np.where(analysis.voiced, analysis.track_hz, np.nan), color="cyan", lw=1,
-            label="voiced track")
-    segs = analysis.segments
-    if segs:  # one call for all segments: a 60 min file has thousands
-        ax.hlines([s.mean_hz for s in segs], [s.start_s for s in segs], [s.end_s for s in segs],
-                  colors=["red" if s.flag else "white" for s in segs], lw=2)
-    ax.set(ylabel="frequency [Hz]",
-           title=f"mean {analysis.mean_hz:.2f} Hz over {100 * analysis.tone_fraction:.0f} % of frames (voiced), "
-                 f"{len(analysis.segments)} segments")
-    ax.legend(loc="upper right", fontsize=8)
+    freqs = analysis.plot_freqs_hz
+    ax = canvas.axes(SPECTROGRAM_BOX, xlim, (float(freqs[0]), float(freqs[-1])))
+    ax.image(colour_map(db[::-1], float(np.percentile(db, 5)), float(db.max())))
+    ax.line(analysis.times_s, np.where(analysis.voiced, analysis.track_hz, np.nan), "cyan", 1)
+    for s in analysis.segments:
+        ax.line([s.start_s, s.end_s], [s.mean_hz, s.mean_hz], "red" if s.flag else "white", 2)
+    ax.frame(ylabel="frequency [Hz]", xlabel="" if forces is not None else "time [s]",
+             title=f"mean {analysis.mean_hz:.2f} Hz over {100 * analysis.tone_fraction:.0f} % of frames (voiced), "
+                   f"{len(analysis.segments)} segments")
+    ax.legend([("voiced track", "cyan", "line"), ("segment (red: flagged)", "#888888", "line")])
     if forces is not None:
-        force, low, high = forces
-        bx = axes[1, 0]
-        bx.fill_between(analysis.times_s, low, high, alpha=0.3, label="95 % interval")
-        bx.plot(analysis.times_s, force, "k.", ms=2, label="force per voiced frame")
-        bx.set(ylabel="force [N]")
-        bx.legend(loc="upper right", fontsize=8)
-    save_time_figure(fig, axes, path)
+        force, low, high = (np.asarray(v, dtype=float) for v in forces)
+        ok = np.isfinite(low) & np.isfinite(high)
+        span = np.concatenate([low[ok], high[ok], force[np.isfinite(force)]]) if ok.any() else np.array([0.0, 1.0])
+        lo, hi = float(span.min()), float(span.max())
+        pad = 0.05 * (hi - lo) or 0.5
+        left, top, right, bottom = SPECTROGRAM_BOX
+        bx = canvas.axes((left, top + panel, right, bottom + panel), xlim, (lo - pad, hi + pad))
+        times = analysis.times_s
+        for run in np.split(np.arange(len(times)), np.flatnonzero(~ok) + 1):
+            run = run[ok[run]]
+            if len(run) > 1:
+                bx.polygon(list(zip(times[run], high[run])) + list(zip(times[run][::-1], low[run][::-1])),
+                           "#b5d0e8")
+        for x, f in zip(times, force):
+            if np.isfinite(f):
+                bx.marker(x, f, "o", "black", 1.2)
+        bx.frame(xlabel="time [s]", ylabel="force [N]", grid="y")
+        bx.legend([("95 % interval", "#b5d0e8", "bar"), ("force per voiced frame", "black", "o")])
+    canvas.save(path)
 
 
 def plot_board(tracks, path, readings=None) -> None:

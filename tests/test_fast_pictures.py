@@ -1,0 +1,80 @@
+"""The pictures and filters of the fast paths (issue 25): numpy filters give scipy.ndimage's numbers exactly; the
+spectrogram drawn without matplotlib still shows the track where it is (pixels read back and mapped to Hz)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PIL import Image
+from scipy.ndimage import maximum_filter1d, median_filter
+
+from matcad.loop.spectrum import running_max, running_median_rows
+
+
+@pytest.mark.parametrize("shape", [(5, 1), (5, 2), (3, 7), (31, 410), (2, 1000)])
+def test_numpy_filters_equal_scipy_ndimage(shape):
+    """running_max (reflect and constant edges) and running_median_rows against scipy.ndimage on random rows, with
+    -inf holes (the tracker's 'no line'). Catches an off-by-one window, a wrong edge mode, an even-width slip."""
+    r = np.random.default_rng(sum(shape))
+    x = r.standard_normal(shape)
+    x[x > 1.2] = -np.inf
+    for size in (3, 5, 7, 9):
+        assert np.array_equal(running_max(x, size), maximum_filter1d(x, size, axis=1))
+        u = (x > 0).astype(np.uint8)
+        assert np.array_equal(running_max(u, size, "constant"), maximum_filter1d(u, size, axis=1, mode="constant"))
+    p = np.abs(r.standard_normal(shape))
+    for width in (3, 63):
+        half = width // 2
+        padded = np.pad(p, ((0, 0), (half, half)), mode="edge")
+        ref = median_filter(padded.ravel(), size=width, mode="nearest").reshape(padded.shape)[:, half:-half]
+        assert np.array_equal(running_median_rows(p, width), ref)
+
+
+def test_spectrogram_shows_the_track_where_it_is(tmp_path):
+    """analyze's spectrogram.png read back: its size, the magma image filling the axes, and the cyan track's pixels
+    mapped through the axes back to Hz within 1.5 % of the band of the tracked frequency at their time. Catches
+    a flipped image or axis, a track drawn in the wrong place, a blank picture."""
+    from matcad.loop.analyze import analyze
+    from matcad.loop.plots import SPECTROGRAM_BOX, SPECTROGRAM_PX, plot
+
+    fs = 44100
+    t = np.arange(int(4.0 * fs)) / fs
+    x = 0.3 * np.sin(2 * np.pi * (4700 * t - 40 / (2 * np.pi * 0.5) * np.cos(2 * np.pi * 0.5 * t)))
+    x += 0.02 * np.random.default_rng(0).standard_normal(len(t))
+    a = analyze(x, fs, (3900.0, 5600.0))
+    plot(a, tmp_path / "s.png")
+    rgb = np.asarray(Image.open(tmp_path / "s.png").convert("RGB")).astype(int)
+    assert rgb.shape[1] == SPECTROGRAM_PX[0] and rgb.shape[0] > SPECTROGRAM_PX[1]
+    left, top, right, bottom = SPECTROGRAM_BOX
+    inside = rgb[top + 2:bottom - 2, left + 2:right - 2]
+    assert (inside.sum(axis=2) < 200).mean() > 0.2  # mostly dark magma background, not white
+    cyan = (rgb[..., 0] < 60) & (rgb[..., 1] > 200) & (rgb[..., 2] > 200)
+    ys, xs = np.nonzero(cyan[top:bottom, left:right])
+    assert len(xs) > 100
+    f0, f1 = a.plot_freqs_hz[0], a.plot_freqs_hz[-1]
+    t0, t1 = a.plot_times_s[0], a.plot_times_s[-1]
+    hz = f1 - (ys + 0.5) / (bottom - top) * (f1 - f0)
+    sec = t0 + (xs + 0.5) / (right - left) * (t1 - t0)
+    voiced = a.voiced & np.isfinite(a.track_hz)
+    expected = np.interp(sec, a.times_s[voiced], a.track_hz[voiced])
+    assert np.median(np.abs(hz - expected)) < 0.015 * (f1 - f0)
+
+
+def test_spectrogram_with_forces_has_a_second_panel(tmp_path):
+    """With forces, the picture grows by one panel and draws the force points (black) in it."""
+    from matcad.loop.analyze import analyze
+    from matcad.loop.plots import SPECTROGRAM_BOX, SPECTROGRAM_PX, plot
+
+    fs = 44100
+    t = np.arange(int(2.0 * fs)) / fs
+    a = analyze(0.3 * np.sin(2 * np.pi * 4700 * t), fs, (3900.0, 5600.0))
+    n = len(a.times_s)
+    force = np.linspace(1, 5, n)
+    plot(a, tmp_path / "f.png", forces=(force, force - 0.5, force + 0.5))
+    rgb = np.asarray(Image.open(tmp_path / "f.png").convert("RGB")).astype(int)
+    assert rgb.shape[0] == 2 * SPECTROGRAM_PX[1] + 45
+    left, top, right, bottom = SPECTROGRAM_BOX
+    panel = rgb[top + SPECTROGRAM_PX[1] + 2:bottom + SPECTROGRAM_PX[1] - 2, left + 2:right - 2]
+    black = panel.sum(axis=2) < 60
+    ys, xs = np.nonzero(black)
+    assert len(xs) > 20 and np.corrcoef(xs, -ys)[0, 1] > 0.9  # force rises with time: points go up to the right
