@@ -1,12 +1,13 @@
 """Charts as PNG without the plotting stack: a Pillow canvas with axes in data units, ticks, text, lines, bars,
 markers, images and a legend. The commands that draw a picture on their fast path (`analyze`'s spectrogram, a
 laser-only `build`'s previews and plots) use it instead of matplotlib, whose import alone costs several times
-numpy's. Deterministic: no timestamps, the font embedded in Pillow, same data → same bytes. Pixels; data units are
+numpy's. Deterministic: no timestamps, one font file (:func:`font`), same data → same bytes. Pixels; data units are
 whatever the chart's axes say.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 
 MAGMA = ((0.0, (0, 0, 4)), (0.13, (28, 16, 68)), (0.25, (79, 18, 123)), (0.38, (129, 37, 129)),
@@ -20,13 +21,39 @@ _FONTS: dict = {}
 
 
 def font(size: float):
-    """Pillow's embedded font at ``size`` px (its bitmap font where Pillow has no FreeType)."""
+    """DejaVu Sans at ``size`` px: the TrueType file matplotlib ships (found without importing matplotlib; the same
+    face its figures used, with ×, Ø, –, θ, ≤), else Pillow's embedded font (which lacks those: they are spelled
+    in ASCII then, see :func:`ascii_text`)."""
     from PIL import ImageFont
 
     size = round(size)
     if size not in _FONTS:
-        _FONTS[size] = ImageFont.load_default(size)
+        path = dejavu_path()
+        _FONTS[size] = ImageFont.truetype(path, size) if path else ImageFont.load_default(size)
     return _FONTS[size]
+
+
+@functools.cache
+def dejavu_path() -> str | None:
+    """matplotlib's DejaVuSans.ttf (a dependency: always there after the README's set-up), or None."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.find_spec("matplotlib")
+    for folder in (spec.submodule_search_locations or []) if spec else []:
+        ttf = Path(folder) / "mpl-data" / "fonts" / "ttf" / "DejaVuSans.ttf"
+        if ttf.is_file():
+            return str(ttf)
+    return None
+
+
+ASCII = {"×": "x", "Ø": "dia ", "–": "-", "θ": "theta", "≤": "<=", "≥": ">=", "µ": "u", "Δ": "d", "²": "^2",
+         "³": "^3"}
+
+
+def ascii_text(s: str) -> str:
+    """``s`` as the fallback font can draw it (no DejaVu): :data:`ASCII`'s spellings."""
+    return s if dejavu_path() else "".join(ASCII.get(ch, ch) for ch in s)
 
 
 def nice_ticks(lo: float, hi: float, count: int = 6) -> list[float]:
@@ -67,11 +94,11 @@ class Canvas:
 
     def text(self, x, y, s: str, size: float = 11, colour="black", anchor: str = "la") -> None:
         """``s`` at pixel (x, y); ``anchor`` as Pillow's (l/m/r, a/m/s/d), lines split on newlines."""
-        self.draw.multiline_text((x, y), s, fill=colour, font=font(size), anchor=anchor, align="center"
+        self.draw.multiline_text((x, y), ascii_text(s), fill=colour, font=font(size), anchor=anchor, align="center"
                                  if anchor[0] == "m" else "left")
 
     def text_width(self, s: str, size: float = 11) -> float:
-        return self.draw.textlength(s, font=font(size))
+        return self.draw.textlength(ascii_text(s), font=font(size))
 
     def vertical_text(self, x, y, s: str, size: float = 11, colour="black") -> None:
         """``s`` turned 90° (read bottom to top), centred at pixel (x, y)."""
@@ -80,7 +107,7 @@ class Canvas:
         w = int(self.text_width(s, size)) + 4
         h = int(size * 1.4) + 2
         tile = Image.new("RGB", (w, h), "white")
-        ImageDraw.Draw(tile).text((w / 2, h / 2), s, fill=colour, font=font(size), anchor="mm")
+        ImageDraw.Draw(tile).text((w / 2, h / 2), ascii_text(s), fill=colour, font=font(size), anchor="mm")
         tile = tile.transpose(Image.Transpose.ROTATE_90)
         self.image.paste(tile, (int(x - h / 2), int(y - w / 2)))
 

@@ -78,3 +78,50 @@ def test_spectrogram_with_forces_has_a_second_panel(tmp_path):
     black = panel.sum(axis=2) < 60
     ys, xs = np.nonzero(black)
     assert len(xs) > 20 and np.corrcoef(xs, -ys)[0, 1] > 0.9  # force rises with time: points go up to the right
+
+
+@pytest.mark.parametrize("height", [0.6, 1.0, 2.5, 4.0, 6.0])
+def test_engraving_table_draws_what_matplotlib_draws(height):
+    """glyphs.json (outlines and spacing tabulated from matplotlib) gives the same outlines as matplotlib's own
+    TextPath for labels and random printable text, to 1e-9 mm, at every height (taller than GLYPH_TABLE_MAX_MM
+    matplotlib draws them). Catches a stale table, a kerning pair applied to the wrong glyph, a scale or baseline
+    slip, a table limit set where the table no longer holds."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextPath
+
+    from matcad.parts.flat import CAP_HEIGHT_PER_SIZE, Engraving, engraving_outlines
+
+    r = np.random.default_rng(round(10 * height))
+    chars = [chr(c) for c in range(33, 127)]
+    texts = ["PLATE d2.1", "t1", "AVATAR To Wa", "neck 2.10 mm", "Ty.,;:", "1/4-20 UNC"]
+    texts += ["".join(r.choice(chars + [" "], 12)) for _ in range(20)]
+    for text in texts:
+        got = engraving_outlines(Engraving(1.5, -2.0, height, text))
+        path = TextPath((0.0, 0.0), text, size=height / CAP_HEIGHT_PER_SIZE, prop=FontProperties(family="DejaVu Sans"))
+        want = [[(1.5 + float(x), -2.0 + float(y)) for x, y in poly[:-1]]
+                for poly in path.to_polygons(closed_only=True) if len(poly) > 3]
+        assert [len(p) for p in got] == [len(p) for p in want], text
+        assert np.allclose(np.concatenate(got), np.concatenate(want), atol=1e-9, rtol=0), text
+
+
+def test_analyze_loads_neither_matplotlib_nor_scipy_ndimage(tmp_path):
+    """`analyze --band` in a fresh interpreter: the spectrogram is written and neither the plotting stack nor
+    scipy.ndimage (nor the spec package: --band needs no spec) is loaded (issue 25: analyze near its tracker)."""
+    import subprocess
+    import sys
+    import wave
+
+    fs = 44100
+    t = np.arange(int(1.0 * fs)) / fs
+    rec = tmp_path / "tone.wav"
+    with wave.open(str(rec), "wb") as w:
+        w.setnchannels(1)
+        w.setsampwidth(2)
+        w.setframerate(fs)
+        w.writeframes(np.round(0.3 * np.sin(2 * np.pi * 4700 * t) * 30000).astype("<i2").tobytes())
+    code = ("import sys; from matcad.cli import main; rc = main(['analyze', %r, '--band', '3900', '5600', '--out', %r]);"
+            " assert rc == 0; bad = [m for m in ('matplotlib', 'scipy.ndimage', 'matcad.spec') if m in sys.modules];"
+            " assert not bad, bad" % (str(rec), str(tmp_path / "a")))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "a" / "spectrogram.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -160,47 +160,36 @@ def printed_preview(name: str, stl: Path, path: Path) -> dict:
     return {"part": name, "file": path.name, "caption": f"{name}: isometric and {caption}"}
 
 
-def _rounded_rect(x0, y0, x1, y1, r):
-    from matplotlib.patches import FancyBboxPatch
-
-    r = max(0.0, min(r, (x1 - x0) / 2, (y1 - y0) / 2))
-    return FancyBboxPatch((x0 + r, y0 + r), x1 - x0 - 2 * r, y1 - y0 - 2 * r, boxstyle=f"round,pad={r}",
-                          fill=False, edgecolor=FLAT_COLOURS["outline"], linewidth=1.0)
-
-
 def flat_preview(plan, path: Path) -> dict:
-    """The laser cut plan of one part (kerf-compensated, as in its DXF) with each hole's finished size (mm)."""
-    from matplotlib.patches import Circle, Rectangle
+    """The laser cut plan of one part (kerf-compensated, as in its DXF) with each hole's finished size (mm), drawn
+    with :mod:`matcad.canvas` at one scale across and up (no matplotlib on a laser-only build's path)."""
+    from matcad.canvas import Canvas
 
     flat = plan.flat
     x0, y0, x1, y1 = plan.extents
     aspect = (y1 - y0 + 4) / max(x1 - x0 + 4, 1e-9)
-    width_in = 6.0
-    with figure(path, width_in, max(2.2, min(6.0, width_in * aspect + 0.8))) as fig:
-        ax = fig.add_subplot(1, 1, 1)
-        for outline in plan.outlines:
-            ax.add_patch(_rounded_rect(*outline))
-        labelled = set()
-        for c in plan.circles:
-            ax.add_patch(Circle((c.x, c.y), c.diameter / 2, fill=False, edgecolor=FLAT_COLOURS["hole"],
-                                linewidth=1.0))
-            if (c.purpose, c.finished_diameter) not in labelled and c.x <= plan.outlines[0][2]:
-                labelled.add((c.purpose, c.finished_diameter))
-                ax.annotate(f"{c.purpose} Ø{c.finished_diameter:g}", (c.x, c.y + c.diameter / 2), fontsize=7,
-                            xytext=(0, 4), textcoords="offset points", ha="center", color="#102080")
-        for t in plan.texts:
-            ax.text(t.x, t.y, t.text, fontsize=7, color=FLAT_COLOURS["engrave"])
-        if plan.reference_square:
-            sx, sy, side = plan.reference_square
-            ax.add_patch(Rectangle((sx, sy), side, side, fill=False, edgecolor=FLAT_COLOURS["reference"],
-                                   linewidth=0.8, linestyle="--"))
-            ax.text(sx + side / 2, sy + side / 2, f"{side:g} mm\nreference", fontsize=6, ha="center",
-                    va="center", color=FLAT_COLOURS["reference"])
-        ax.set_xlim(x0 - 2, x1 + 2)
-        ax.set_ylim(y0 - 2, y1 + 2)
-        ax.set_aspect("equal")
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("y [mm]")
-        ax.set_title(f"{flat.name}: {flat.quantity} × {flat.width:g} × {flat.depth:g} mm from "
-                     f"{flat.thickness:g} mm sheet (cut lines, kerf {plan.kerf:g} mm)", fontsize=9)
+    width = 660
+    height = round(max(242, min(660, 600 * aspect + 88)))
+    canvas = Canvas(width, height)
+    ax = canvas.axes((70, 34, width - 16, height - 50), (x0 - 2, x1 + 2), (y0 - 2, y1 + 2), equal=True)
+    for ox0, oy0, ox1, oy1, r in plan.outlines:
+        ax.rounded(ox0, oy0, ox1, oy1, r, FLAT_COLOURS["outline"], 1)
+    labelled = set()
+    for c in plan.circles:
+        ax.circle(c.x, c.y, c.diameter / 2, FLAT_COLOURS["hole"], 1)
+        if (c.purpose, c.finished_diameter) not in labelled and c.x <= plan.outlines[0][2]:
+            labelled.add((c.purpose, c.finished_diameter))
+            canvas.text(ax.x(c.x), ax.y(c.y + c.diameter / 2) - 4, f"{c.purpose} Ø{c.finished_diameter:g}", 9,
+                        "#102080", anchor="md")
+    for t in plan.texts:
+        ax.text(t.x, t.y, t.text, 9, FLAT_COLOURS["engrave"], anchor="ls")
+    if plan.reference_square:
+        sx, sy, side = plan.reference_square
+        ax.line([sx, sx + side, sx + side, sx, sx], [sy, sy, sy + side, sy + side, sy], FLAT_COLOURS["reference"],
+                1, dash=3)
+        ax.text(sx + side / 2, sy + side / 2, f"{side:g} mm\nreference", 8, FLAT_COLOURS["reference"], anchor="mm")
+    ax.frame(xlabel="x [mm]", ylabel="y [mm]", size=10,
+             title=f"{flat.name}: {flat.quantity} × {flat.width:g} × {flat.depth:g} mm from {flat.thickness:g} mm "
+                   f"sheet (cut lines, kerf {plan.kerf:g} mm)")
+    canvas.save(path)
     return {"part": flat.name, "file": path.name, "caption": f"{flat.name}: laser cut plan"}
