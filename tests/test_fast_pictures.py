@@ -125,3 +125,30 @@ def test_analyze_loads_neither_matplotlib_nor_scipy_ndimage(tmp_path):
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "a" / "spectrogram.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("template", ["mat-laser-only.toml", "mat-paper.toml", "mat-array-4.toml"])
+def test_dxf_writer_writes_ezdxfs_bytes(template, tmp_path):
+    """write_dxf (no ezdxf import) against ezdxf itself: the same bytes for every laser part and nested sheet of a
+    template, and the template document rebuilt from ezdxf equals the shipped one. Catches a group code or float
+    format slip, a handle off by one, an ezdxf upgrade that changes its document (rebuild the template:
+    benchmarks/dxf_template.py)."""
+    from pathlib import Path
+
+    from matcad.export.dxf_svg import TEMPLATE, dxf_template, write_dxf, write_dxf_ezdxf
+    from matcad.export.sheets import sheet_plans
+    from matcad.parts.catalogue import laser_parts
+    from matcad.parts.flat import cut_plan
+    from matcad.spec import load
+
+    root = Path(__file__).resolve().parents[1] / "templates"
+    spec = load(root / template)
+    plans = [cut_plan(f, spec.outputs.reference_square) for f in laser_parts(spec)]
+    plans += list(sheet_plans(plans, spec.outputs.reference_square).values())
+    assert plans
+    for plan in plans:
+        write_dxf(plan, tmp_path / "fast.dxf")
+        write_dxf_ezdxf(plan, tmp_path / "ezdxf.dxf")
+        assert (tmp_path / "fast.dxf").read_bytes() == (tmp_path / "ezdxf.dxf").read_bytes(), plan.flat.name
+    with_hole = next(p for p in plans if p.circles)
+    assert dxf_template(with_hole, tmp_path) == TEMPLATE.read_text(encoding="utf-8")
