@@ -73,6 +73,12 @@ def tick_label(v: float, ticks: list[float]) -> str:
     return f"{v + 0.0:.{digits}f}"
 
 
+def tint(colour: str, alpha: float) -> tuple[int, int, int]:
+    """``colour`` (#rrggbb) laid over white at opacity ``alpha``."""
+    rgb = (int(colour[k:k + 2], 16) for k in (1, 3, 5))
+    return tuple(round(255 - alpha * (255 - c)) for c in rgb)
+
+
 def colour_map(values, lo: float, hi: float, stops=MAGMA):
     """RGB (uint8, values' shape × 3) of ``values`` scaled from ``lo`` to ``hi`` on the colour map ``stops``."""
     import numpy as np
@@ -147,11 +153,18 @@ class Axes:
         """Pixels per x unit."""
         return (self.box[2] - self.box[0]) / (self.xlim[1] - self.xlim[0])
 
-    def image(self, rgb) -> None:
-        """An RGB array (rows from the top of the box down) stretched over the whole box."""
+    def image(self, rgb, extent=None) -> None:
+        """An RGB array (rows from the top down) stretched over the whole box, or over ``extent`` (x0, x1, y0, y1 in
+        data units, clipped to the box)."""
         from PIL import Image
 
         left, top, right, bottom = (round(v) for v in self.box)
+        if extent is not None:
+            x0, x1, y0, y1 = extent
+            left, right = max(left, round(self.x(x0))), min(right, round(self.x(x1)))
+            top, bottom = max(top, round(self.y(y1))), min(bottom, round(self.y(y0)))
+            if right <= left or bottom <= top:
+                return
         tile = Image.fromarray(rgb, "RGB").resize((right - left, bottom - top), Image.Resampling.NEAREST)
         self.c.image.paste(tile, (left, top))
 
