@@ -195,13 +195,13 @@ def _write_solids(spec, folder: Path) -> dict[str, dict]:
     """STL + STEP per printed part, assembly.step and section.svg; returns the STL read-back checks."""
     from matcad.export.mesh import write_step
 
-    checks = {f"{name}.stl": write_printed_part(name, solid, spec, folder)
-              for name, solid in printed_parts(spec).items()}
+    made = printed_parts(spec)
+    checks = {f"{name}.stl": write_printed_part(name, solid, spec, folder) for name, solid in made.items()}
     if spec.outputs.assembly:
         from matcad.parts.assembly import assembled_parts, assembly
         from matcad.render.section import write_section_svg
 
-        parts = assembled_parts(spec)
+        parts = assembled_parts(spec, made)  # the cap and the mount as already made, not built twice
         write_step(assembly(spec, parts), folder / "assembly.step")
         write_section_svg(spec, folder / "section.svg", parts)
     return checks
