@@ -163,9 +163,9 @@ def printed_preview(name: str, stl: Path, path: Path, mesh=None) -> dict:
     from matcad.canvas import Canvas
 
     if mesh is None:
-        import trimesh
+        from matcad.export.mesh import load_stl
 
-        mesh = trimesh.load_mesh(stl, file_type="stl")
+        mesh = load_stl(stl)  # as read back by the build's mesh checks: not read again
     caption, elev, azim = face_view(name)
     plane = section_plane(name)
     size = np.ptp(np.asarray(mesh.vertices), axis=0)
