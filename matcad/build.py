@@ -161,8 +161,7 @@ def write_print_job(spec, folder: Path, meshes: dict) -> dict | None:
     """The printer's 3MF (:mod:`matcad.export.threemf`) from the printed STLs just written (their print poses),
     each with its print profile; an FDM mold base with the pause for its captive nuts; one file per bed load.
     Returns the printer and each file's objects and pauses; None without printed parts."""
-    import trimesh
-
+    from matcad.export.mesh import load_stl
     from matcad.export.threemf import PrintPart, plates, write_3mf
     from matcad.parts.print_profile import profile
     from matcad.report.fabrication import PRINT_FILE
@@ -173,7 +172,7 @@ def write_print_job(spec, folder: Path, meshes: dict) -> dict | None:
         if not checks["printed"]:
             continue
         name = Path(stl).stem
-        mesh = trimesh.load_mesh(folder / stl, file_type="stl")
+        mesh = load_stl(folder / stl)  # read once by the mesh checks
         pause = None
         if name == "end_cap_mold_base" and printer == "fdm":
             from matcad.parts.mold_layout import layout
@@ -195,13 +194,13 @@ def _write_solids(spec, folder: Path) -> dict[str, dict]:
     """STL + STEP per printed part, assembly.step and section.svg; returns the STL read-back checks."""
     from matcad.export.mesh import write_step
 
-    checks = {f"{name}.stl": write_printed_part(name, solid, spec, folder)
-              for name, solid in printed_parts(spec).items()}
+    made = printed_parts(spec)
+    checks = {f"{name}.stl": write_printed_part(name, solid, spec, folder) for name, solid in made.items()}
     if spec.outputs.assembly:
         from matcad.parts.assembly import assembled_parts, assembly
         from matcad.render.section import write_section_svg
 
-        parts = assembled_parts(spec)
+        parts = assembled_parts(spec, made)  # the cap and the mount as already made, not built twice
         write_step(assembly(spec, parts), folder / "assembly.step")
         write_section_svg(spec, folder / "section.svg", parts)
     return checks

@@ -187,7 +187,8 @@ def main(argv: list[str] | None = None) -> int:
         _private_caches()
         from matcad.commands import parser
 
-        args = _parse(parser(), sys.argv[1:] if argv is None else [str(a) for a in argv])
+        argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+        args = _parse(parser(argv[0] if argv else None), argv)  # the command's own parser; any other: the whole
         return _dispatch(args)
     except KeyboardInterrupt:
         return _interrupted(args)
@@ -240,9 +241,8 @@ def _parse(top, argv: list[str]):
 
 
 def _dispatch(args) -> int:
-    from matcad.errors import LoopError, OutputError
+    from matcad.errors import LoopError, OutputError, SpecError
     from matcad.output import WRITTEN
-    from matcad.spec import SpecError
 
     WRITTEN.clear()  # a new run in the same interpreter
     stdout = sys.stdout = _Stdout(sys.stdout)

@@ -41,3 +41,25 @@ class InputError(ValueError):
 class LoopError(Exception):
     """Measured data cannot give a trustworthy answer (no tone, a tone at a band edge, degenerate calibration data,
     a force outside the calibrated range): exit code 1 with the reason."""
+
+
+class _Missing:
+    """The ``value`` of a SpecError about a table or field that is not there at all (no ``= None`` in messages)."""
+
+    def __repr__(self) -> str:
+        return "(missing)"
+
+
+MISSING = _Missing()
+
+
+class SpecError(ValueError):
+    """Bad spec input. ``field`` is the dotted spec key, ``value`` what was given (:data:`MISSING` when nothing
+    was), ``allowed`` the rule."""
+
+    def __init__(self, field_name: str, value, allowed: str):
+        self.field = field_name
+        self.value = value
+        self.allowed = allowed
+        given = "" if value is MISSING else f" = {shorten(value)}"
+        super().__init__(f"{field_name}{given}: {allowed}")

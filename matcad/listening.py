@@ -22,6 +22,8 @@ ZERO_PAD = 2
 """The FFT is this many window lengths long (bins of fs / (ZERO_PAD · window))."""
 EXCLUDE_BINS = 6
 """Bins either side of a line that belong to it (Hann main lobe is ±4 bins at 2× padding)."""
+FREQUENCY_KHZ_MAX = 100.0
+"""Taxel tones are kHz; frequencies all below 100 "Hz" read as kHz (a unit slip: spec notes, `analyze --band`)."""
 EDGE_BINS = 2
 """A ridge within this many bins of a band's edge is refused as hugging it (the tone probably lies outside)."""
 

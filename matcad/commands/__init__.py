@@ -39,16 +39,19 @@ def out_path(text: str) -> Path:
     return Path(os.path.abspath(text))
 
 
-def parser() -> argparse.ArgumentParser:
-    """The whole command line: every registered command with its arguments, ``run`` as its ``func``."""
+def parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The whole command line: every registered command with its arguments, ``run`` as its ``func``; with ``only``
+    (a command's name: the one being run) just that command's, which parses its arguments alike and skips
+    building the other thirteen (a few tens of ms on every run)."""
     import matcad
     from matcad.errors import EXIT_CODES
 
     top = argparse.ArgumentParser(prog="matcad", description=matcad.__doc__,
-                                  epilog="exit codes: " + "; ".join(f"{k} {v}" for k, v in EXIT_CODES.items()))
+                                  epilog="exit codes: " + "; ".join(f"{k} {v}" for k, v in EXIT_CODES.items()),
+                                  usage=f"matcad [-h] [--version] {{{','.join(COMMANDS)}}} ..." if only else None)
     top.add_argument("--version", action="version", version=f"matcad {matcad.__version__}")
     sub = top.add_subparsers(dest="command", required=True)
-    for name in COMMANDS:
+    for name in (only,) if only in COMMANDS else COMMANDS:
         module = command(name)
         cmd = sub.add_parser(name, help=module.HELP)
         cmd.set_defaults(func=module.run)

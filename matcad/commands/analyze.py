@@ -27,7 +27,7 @@ def band(args, spec) -> tuple[float, float]:
         lo, hi = args.band
         if not (0 <= lo < hi):
             raise ValueError(f"--band {lo:g} {hi:g} invalid, must be 0 <= LO < HI (Hz)")
-        from matcad.spec.notes import FREQUENCY_KHZ_MAX
+        from matcad.listening import FREQUENCY_KHZ_MAX
 
         if hi < FREQUENCY_KHZ_MAX:  # a taxel sings at kHz; a band below 100 Hz is a band typed in kHz
             raise ValueError(f"--band {lo:g} {hi:g} invalid: the band is in Hz and lies below {FREQUENCY_KHZ_MAX:g} "
@@ -43,10 +43,11 @@ def band(args, spec) -> tuple[float, float]:
 
 def run(args) -> int:
     spec = load_spec(args.spec, args) if args.spec else None
-    from matcad.spec import is_array
+    if spec is not None:
+        from matcad.spec import is_array
 
-    if spec is not None and is_array(spec):
-        return _board(args, spec)
+        if is_array(spec):
+            return _board(args, spec)
     from matcad.loop import outputs
     from matcad.loop.analyze import analyze_stream
     from matcad.loop.plots import plot

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 
@@ -74,11 +75,23 @@ def write_step(shape, path: Path) -> None:
         path.write_text(fixed, encoding="utf-8")
 
 
-def mesh_checks(path: Path) -> dict:
-    """Read an STL back: watertight, is_volume, bodies, volume (mm³), triangle count."""
+def load_stl(path: Path):
+    """The STL at ``path`` as a trimesh mesh (vertices merged), read once per file version (path, size, mtime):
+    the read-back checks, the preview and the print job of one build share it. Do not modify the mesh."""
+    st = Path(path).stat()
+    return _load_stl(str(path), st.st_size, st.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=32)
+def _load_stl(path: str, size: int, mtime_ns: int):
     import trimesh
 
-    mesh = trimesh.load_mesh(str(path), file_type="stl")
+    return trimesh.load_mesh(path, file_type="stl")
+
+
+def mesh_checks(path: Path) -> dict:
+    """Read an STL back: watertight, is_volume, bodies, volume (mm³), triangle count."""
+    mesh = load_stl(path)
     bodies = mesh.split(only_watertight=False)
     return {"watertight": bool(mesh.is_watertight), "is_volume": bool(mesh.is_volume),
             "bodies": len(bodies), "volume_mm3": float(mesh.volume), "triangles": int(len(mesh.faces))}

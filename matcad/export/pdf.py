@@ -1,7 +1,7 @@
 """The kit's sheets on paper at 1:1 (sheets_1to1.pdf): one page per nested sheet (:mod:`matcad.export.sheets`),
 every cut and engraving at its real size, with a 10 mm reference square and a 50 mm scale bar, to check on paper
 that a printer, a PDF viewer or the laser's software keeps the scale, and to lay real parts on the drawing before
-cutting. Units mm; matplotlib's PDF backend, figures sized in inches so one drawing unit is one millimetre.
+cutting. Units mm; written directly as PDF operators (pt = mm · 72 / 25.4), no plotting library.
 """
 
 from __future__ import annotations
@@ -49,65 +49,135 @@ def _rounded_outline(x0, y0, x1, y1, r, steps: int = 12) -> list[tuple[float, fl
     return pts
 
 
-def _draw_page(fig, plan: CutPlan, page: tuple[float, float, str]) -> None:
-    from matplotlib.patches import Circle, PathPatch, Polygon, Rectangle
-    from matplotlib.path import Path as MplPath
+class _Page:
+    """One page's content stream in PDF operators; coordinates in mm from the page's bottom left (drawn in pt)."""
 
+    K = 72.0 / MM_PER_INCH
+
+    def __init__(self):
+        self.ops: list[str] = []
+
+    def _xy(self, x: float, y: float) -> str:
+        return f"{x * self.K:.3f} {y * self.K:.3f}"
+
+    def colour(self, hexcolour: str, fill: bool = False) -> None:
+        r, g, b = (int(hexcolour[k:k + 2], 16) / 255 for k in (1, 3, 5))
+        self.ops.append(f"{r:.4g} {g:.4g} {b:.4g} {'rg' if fill else 'RG'}")
+
+    def width(self, pt: float) -> None:
+        self.ops.append(f"{pt:g} w")
+
+    def path(self, points, close: bool = True) -> None:
+        self.ops.append(f"{self._xy(*points[0])} m " + " ".join(f"{self._xy(*p)} l" for p in points[1:])
+                        + (" h" if close else ""))
+
+    def circle(self, cx: float, cy: float, r: float) -> None:
+        """Four Bézier quarters (the usual 0.5523 handle: within 0.03 % of the radius)."""
+        k = 0.5522847498 * r
+        quarters = (((cx + r, cy + k), (cx + k, cy + r), (cx, cy + r)), ((cx - k, cy + r), (cx - r, cy + k), (cx - r, cy)),
+                    ((cx - r, cy - k), (cx - k, cy - r), (cx, cy - r)), ((cx + k, cy - r), (cx + r, cy - k), (cx + r, cy)))
+        self.ops.append(f"{self._xy(cx + r, cy)} m " + " ".join(" ".join(self._xy(*p) for p in q) + " c"
+                                                                 for q in quarters) + " h")
+
+    def stroke(self) -> None:
+        self.ops.append("S")
+
+    def fill_even_odd(self) -> None:
+        self.ops.append("f*")
+
+    def text(self, x: float, y: float, s: str, size_pt: float, hexcolour: str = "#000000", align: str = "left",
+             top: bool = True) -> None:
+        """``s`` in Helvetica at ``size_pt``; (x, y) its left (centre, with ``align='center'``) and its top (else
+        its middle) in mm; one line per newline."""
+        self.colour(hexcolour, fill=True)
+        lead = 1.2 * size_pt / self.K
+        lines = s.split("\n")
+        y0 = y - 0.8 * size_pt / self.K if top else y - 0.35 * size_pt / self.K + (len(lines) - 1) * lead / 2
+        for k, line in enumerate(lines):
+            x0 = x - (0.5 * size_pt * 0.55 * len(line) / self.K if align == "center" else 0.0)
+            data = line.encode("cp1252", "replace").replace(b"\\", b"\\\\").replace(b"(", b"\\(").replace(b")", b"\\)")
+            self.ops.append(f"BT /F1 {size_pt:g} Tf {self._xy(x0, y0 - k * lead)} Td (" + data.decode("latin-1")
+                            + ") Tj ET")
+
+    def stream(self) -> bytes:
+        return ("\n".join(self.ops) + "\n").encode("latin-1")
+
+
+def _draw_page(plan: CutPlan, page: tuple[float, float, str]) -> bytes:
+    """One sheet's page: outlines, holes, engravings, reference square, title, instruction and scale bar."""
     pw, ph, name = page
-    ax = fig.add_axes((0, 0, 1, 1))
-    ax.set_xlim(0, pw)
-    ax.set_ylim(0, ph)
-    ax.set_axis_off()
+    pg = _Page()
     x0, y0, x1, y1 = plan.extents
     dx, dy = MARGIN_MM - x0, ph - MARGIN_MM - HEADER_MM - y1  # the sheet's top left under the header
     colour = {layer: stroke for layer, (_, stroke, _) in LAYERS.items()}
+    pg.width(LINE_PT)
+    pg.colour(colour["CUT_OUTER"])
     for ox0, oy0, ox1, oy1, r in plan.outlines:
-        ax.add_patch(Polygon([(x + dx, y + dy) for x, y in _rounded_outline(ox0, oy0, ox1, oy1, r)], closed=True,
-                             fill=False, edgecolor=colour["CUT_OUTER"], linewidth=LINE_PT))
+        pg.path([(x + dx, y + dy) for x, y in _rounded_outline(ox0, oy0, ox1, oy1, r)])
+        pg.stroke()
+    pg.colour(colour["CUT_INNER"])
     for c in plan.circles:
-        ax.add_patch(Circle((c.x + dx, c.y + dy), c.diameter / 2, fill=False, edgecolor=colour["CUT_INNER"],
-                            linewidth=LINE_PT))
-    for t in plan.texts:
-        loops = engraving_outlines(t)
-        vertices = [(x + dx, y + dy) for loop in loops for x, y in loop + loop[:1]]
-        codes = [code for loop in loops for code in [MplPath.MOVETO] + [MplPath.LINETO] * (len(loop) - 1)
-                 + [MplPath.CLOSEPOLY]]
-        ax.add_patch(PathPatch(MplPath(vertices, codes), facecolor=colour["ENGRAVE"], edgecolor="none"))
+        pg.circle(c.x + dx, c.y + dy, c.diameter / 2)
+        pg.stroke()
+    if plan.texts:
+        pg.colour(colour["ENGRAVE"], fill=True)
+        for t in plan.texts:
+            for loop in engraving_outlines(t):
+                pg.path([(x + dx, y + dy) for x, y in loop])
+            pg.fill_even_odd()
     if plan.reference_square:
         sx, sy, side = plan.reference_square
-        ax.add_patch(Rectangle((sx + dx, sy + dy), side, side, fill=False, edgecolor=colour["REFERENCE"],
-                               linewidth=LINE_PT))
-        ax.text(sx + dx + side / 2, sy + dy - 1.5, f"{side:g} mm", ha="center", va="top", fontsize=6,
-                color=colour["REFERENCE"])
+        pg.colour(colour["REFERENCE"])
+        pg.path([(sx + dx, sy + dy), (sx + dx + side, sy + dy), (sx + dx + side, sy + dy + side),
+                 (sx + dx, sy + dy + side)])
+        pg.stroke()
+        pg.text(sx + dx + side / 2, sy + dy - 1.5, f"{side:g} mm", 6, colour["REFERENCE"], align="center")
     top = ph - MARGIN_MM
-    ax.text(MARGIN_MM, top, f"{plan.flat.name}: {plan.flat.thickness:g} mm acrylic ({plan.flat.thickness_status}), "
-            f"kerf {plan.kerf:g} mm compensated ({name} page)", ha="left", va="top", fontsize=8)
-    ax.text(MARGIN_MM, top - 4.5, f"parts: {', '.join(plan.parts) or plan.flat.name}", ha="left", va="top",
-            fontsize=7)
-    ax.text(MARGIN_MM, top - 8.5, INSTRUCTION, ha="left", va="top", fontsize=6.5, wrap=True)
+    pg.text(MARGIN_MM, top, f"{plan.flat.name}: {plan.flat.thickness:g} mm acrylic ({plan.flat.thickness_status}), "
+            f"kerf {plan.kerf:g} mm compensated ({name} page)", 8)
+    pg.text(MARGIN_MM, top - 4.5, f"parts: {', '.join(plan.parts) or plan.flat.name}", 7)
+    pg.text(MARGIN_MM, top - 8.5, INSTRUCTION, 6.5)
     bar_y = top - 17
-    ax.plot([MARGIN_MM, MARGIN_MM + SCALE_BAR_MM], [bar_y, bar_y], color="black", linewidth=1.0,
-            solid_capstyle="butt")
+    pg.colour("#000000")
+    pg.width(1.0)
+    pg.path([(MARGIN_MM, bar_y), (MARGIN_MM + SCALE_BAR_MM, bar_y)], close=False)
+    pg.stroke()
+    pg.width(LINE_PT)
     for k in range(int(SCALE_BAR_MM / 10) + 1):
         x = MARGIN_MM + 10 * k
-        ax.plot([x, x], [bar_y, bar_y + 2], color="black", linewidth=LINE_PT)
-    ax.text(MARGIN_MM + SCALE_BAR_MM + 2, bar_y, f"{SCALE_BAR_MM:g} mm", ha="left", va="center", fontsize=7)
+        pg.path([(x, bar_y), (x, bar_y + 2)], close=False)
+        pg.stroke()
+    pg.text(MARGIN_MM + SCALE_BAR_MM + 2, bar_y, f"{SCALE_BAR_MM:g} mm", 7, top=False)
+    return pg.stream()
 
 
 def write_scale_pdf(plans: list[CutPlan], path: Path) -> list[dict]:
     """One page per sheet plan at 1:1, byte-for-byte reproducible (no dates, no producer); returns each page's
-    sheet, page size (mm) and name."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.backends.backend_pdf import PdfPages
-    from matplotlib.figure import Figure
+    sheet, page size (mm) and name. Written directly (PDF 1.4: vector paths, Helvetica in WinAnsi encoding, each
+    page's content deflated): no plotting library on the laser path."""
+    import zlib
 
-    pages = []
-    with PdfPages(path, metadata={"Creator": None, "Producer": None, "CreationDate": None}) as pdf:
-        for plan in plans:
-            page = page_size_mm(plan)
-            fig = Figure(figsize=(page[0] / MM_PER_INCH, page[1] / MM_PER_INCH))
-            FigureCanvasAgg(fig)
-            _draw_page(fig, plan, page)
-            pdf.savefig(fig)
-            pages.append({"sheet": plan.flat.name, "width_mm": page[0], "height_mm": page[1], "page": page[2]})
+    pages, objects = [], [b"", b"", b"<< /Type /Font /Subtype /Type1 /BaseFont /Helvetica /Encoding /WinAnsiEncoding >>"]
+    kids = []
+    for plan in plans:
+        page = page_size_mm(plan)
+        content = zlib.compress(_draw_page(plan, page), 6)
+        objects.append(b"<< /Length %d /Filter /FlateDecode >>\nstream\n" % len(content) + content + b"\nendstream")
+        w, h = page[0] * _Page.K, page[1] * _Page.K
+        objects.append(f"<< /Type /Page /Parent 2 0 R /MediaBox [0 0 {w:.3f} {h:.3f}] /Resources << /Font << /F1 3 0 R "
+                       f">> >> /Contents {len(objects)} 0 R >>".encode())
+        kids.append(f"{len(objects)} 0 R")
+        pages.append({"sheet": plan.flat.name, "width_mm": page[0], "height_mm": page[1], "page": page[2]})
+    objects[0] = b"<< /Type /Catalog /Pages 2 0 R >>"
+    objects[1] = f"<< /Type /Pages /Kids [{' '.join(kids)}] /Count {len(kids)} >>".encode()
+    out = bytearray(b"%PDF-1.4\n%\xe2\xe3\xcf\xd3\n")
+    offsets = []
+    for k, body in enumerate(objects, start=1):
+        offsets.append(len(out))
+        out += b"%d 0 obj\n" % k + body + b"\nendobj\n"
+    xref = len(out)
+    out += b"xref\n0 %d\n0000000000 65535 f \n" % (len(objects) + 1)
+    out += b"".join(b"%010d 00000 n \n" % o for o in offsets)
+    out += b"trailer\n<< /Size %d /Root 1 0 R >>\nstartxref\n%d\n%%%%EOF\n" % (len(objects) + 1, xref)
+    Path(path).write_bytes(bytes(out))
     return pages

@@ -25,9 +25,9 @@ def mains_comb(lines: np.ndarray, freqs: np.ndarray, df: float) -> np.ndarray:
     """Lines (frames × bins at ``freqs`` Hz, spacing ``df`` Hz; dB, −inf where none) that sit on a mains grid m·S
     (S = 50, 60, 100, 120 Hz) which hosts lines at ≥ COMB_GRID_FRACTION of its places in the frame, unless
     COMB_LEVEL_DB above the grid's median line."""
-    from scipy.ndimage import maximum_filter1d
+    from matcad.loop.spectrum import running_max
 
-    near = maximum_filter1d(lines, 3, axis=1)
+    near = running_max(lines, 3)
     f0 = freqs[0]
     members = np.zeros(lines.shape, dtype=bool)
     for spacing in COMB_SPACINGS_HZ:
@@ -50,10 +50,9 @@ def mains_comb(lines: np.ndarray, freqs: np.ndarray, df: float) -> np.ndarray:
 
 def mains_zone(lines: np.ndarray, freqs: np.ndarray, df: float) -> np.ndarray:
     """Bins (frames × bins) within ±COMB_ZONE_BINS of a :func:`mains_comb` line: removed before tracking."""
-    from scipy.ndimage import maximum_filter1d
+    from matcad.loop.spectrum import running_max
 
-    return maximum_filter1d(mains_comb(lines, freqs, df).astype(np.uint8), 2 * COMB_ZONE_BINS + 1,
-                            axis=1).astype(bool)
+    return running_max(mains_comb(lines, freqs, df).astype(np.uint8), 2 * COMB_ZONE_BINS + 1).astype(bool)
 
 
 def in_harmonic_comb(lines: np.ndarray, p: np.ndarray, df: float) -> np.ndarray:
@@ -63,7 +62,7 @@ def in_harmonic_comb(lines: np.ndarray, p: np.ndarray, df: float) -> np.ndarray:
     harmonics), or lines ≥ 6 dB within ±1 bin at 5 of ±Δ … ±4Δ (a wider comb of weaker, partly smeared harmonics).
     Each neighbour must also be within COMB_LEVEL_DB of the line. A taxel's own skirt (jet noise through the
     resonator, ~±100 Hz) reaches ±Δ, not ±3Δ."""
-    from scipy.ndimage import maximum_filter1d
+    from matcad.loop.spectrum import running_max
 
     k, n = lines.shape
     rows = np.arange(k)
@@ -72,8 +71,7 @@ def in_harmonic_comb(lines: np.ndarray, p: np.ndarray, df: float) -> np.ndarray:
     found = np.zeros(k, dtype=bool)
     for orders, hits, tolerance, line_db in HARMONIC_TESTS:
         need = np.maximum(line_db, level - COMB_LEVEL_DB)
-        near = maximum_filter1d((lines >= need[:, None]).astype(np.uint8), 2 * tolerance + 1, axis=1,
-                                mode="constant") > 0
+        near = running_max((lines >= need[:, None]).astype(np.uint8), 2 * tolerance + 1, "constant") > 0
         at = p[:, None, None] + np.array(orders)[None, :, None] * d[None, None, :]
         hit = near[rows[:, None, None], np.clip(at, 0, n - 1)] & (at >= 0) & (at < n)
         found |= np.any(hit.sum(axis=1) >= hits, axis=1)

@@ -1,12 +1,16 @@
 """Pictures of the recording loop: the band's spectrogram kept while tracking (max-pooled in time, bounded memory)
 and the figures drawn from it — one taxel's track and segments, a board's taxels, forces against time. PNG;
-frequencies Hz, times s, forces N. matplotlib is imported only when a figure is drawn."""
+frequencies Hz, times s, forces N. Drawn with matcad.canvas (Pillow): no plotting stack on the loop's path."""
 
 from __future__ import annotations
 
 import numpy as np
 
 PLOT_COLUMNS = 1200
+SPECTROGRAM_PX = (800, 320)
+"""Width of the spectrogram picture and height of each of its panels (px)."""
+SPECTROGRAM_BOX = (85, 35, 785, 315)
+"""The spectrogram's axes in the picture (left, top, right, bottom px): a reader can map a pixel to (s, Hz)."""
 
 
 class PlotPool:
@@ -42,90 +46,109 @@ class PlotPool:
 
 
 def plot(analysis, path, forces=None) -> None:
-    """Spectrogram of an :class:`matcad.loop.analysis.Analysis`'s band (dB, max-pooled in time) with the voiced
-    track and segments; with ``forces`` (per frame: force, low, high in N) a second panel of force against time."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Spectrogram of an :class:`matcad.loop.analysis.Analysis`'s band (dB, max-pooled in time, 'magma' from the
+    5th percentile to the loudest) with the voiced track (cyan) and segments (white, red when flagged); with
+    ``forces`` (per frame: force, low, high in N) a second panel of force against time. Drawn with
+    :mod:`matcad.canvas` (Pillow), not matplotlib: `analyze` stays near the cost of its tracker."""
+    from matcad.canvas import Canvas, colour_map
 
     rows = 2 if forces is not None else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(8, 3.2 * rows + 0.8), sharex=True, squeeze=False)
-    ax = axes[0, 0]
+    width, panel = SPECTROGRAM_PX
+    canvas = Canvas(width, panel * rows + 45)
+    t = analysis.plot_times_s
+    xlim = (float(t[0]), float(t[-1])) if len(t) > 1 and t[-1] > t[0] else (0.0, max(float(t[0]) if len(t) else 1.0, 1e-3))
     db = analysis.plot_db
-    ax.pcolormesh(analysis.plot_times_s, analysis.plot_freqs_hz, db, shading="nearest", cmap="magma",
-                  vmin=np.percentile(db, 5), vmax=db.max())
-    ax.plot(analysis.times_s, np.where(analysis.voiced, analysis.track_hz, np.nan), color="cyan", lw=1,
-            label="voiced track")
-    segs = analysis.segments
-    if segs:  # one call for all segments: a 60 min file has thousands
-        ax.hlines([s.mean_hz for s in segs], [s.start_s for s in segs], [s.end_s for s in segs],
-                  colors=["red" if s.flag else "white" for s in segs], lw=2)
-    ax.set(ylabel="frequency [Hz]",
-           title=f"mean {analysis.mean_hz:.2f} Hz over {100 * analysis.tone_fraction:.0f} % of frames (voiced), "
-                 f"{len(analysis.segments)} segments")
-    ax.legend(loc="upper right", fontsize=8)
+    freqs = analysis.plot_freqs_hz
+    ax = canvas.axes(SPECTROGRAM_BOX, xlim, (float(freqs[0]), float(freqs[-1])))
+    ax.image(colour_map(db[::-1], float(np.percentile(db, 5)), float(db.max())))
+    ax.line(analysis.times_s, np.where(analysis.voiced, analysis.track_hz, np.nan), "cyan", 1)
+    for s in analysis.segments:
+        ax.line([s.start_s, s.end_s], [s.mean_hz, s.mean_hz], "red" if s.flag else "white", 2)
+    ax.frame(ylabel="frequency [Hz]", xlabel="" if forces is not None else "time [s]",
+             title=f"mean {analysis.mean_hz:.2f} Hz over {100 * analysis.tone_fraction:.0f} % of frames (voiced), "
+                   f"{len(analysis.segments)} segments")
+    ax.legend([("voiced track", "cyan", "line"), ("segment (red: flagged)", "#888888", "line")])
     if forces is not None:
-        force, low, high = forces
-        bx = axes[1, 0]
-        bx.fill_between(analysis.times_s, low, high, alpha=0.3, label="95 % interval")
-        bx.plot(analysis.times_s, force, "k.", ms=2, label="force per voiced frame")
-        bx.set(ylabel="force [N]")
-        bx.legend(loc="upper right", fontsize=8)
-    save_time_figure(fig, axes, path)
+        force, low, high = (np.asarray(v, dtype=float) for v in forces)
+        ok = np.isfinite(low) & np.isfinite(high)
+        span = np.concatenate([low[ok], high[ok], force[np.isfinite(force)]]) if ok.any() else np.array([0.0, 1.0])
+        lo, hi = float(span.min()), float(span.max())
+        pad = 0.05 * (hi - lo) or 0.5
+        left, top, right, bottom = SPECTROGRAM_BOX
+        bx = canvas.axes((left, top + panel, right, bottom + panel), xlim, (lo - pad, hi + pad))
+        times = analysis.times_s
+        for run in np.split(np.arange(len(times)), np.flatnonzero(~ok) + 1):
+            run = run[ok[run]]
+            if len(run) > 1:
+                bx.polygon(list(zip(times[run], high[run])) + list(zip(times[run][::-1], low[run][::-1])),
+                           "#b5d0e8")
+        for x, f in zip(times, force):
+            if np.isfinite(f):
+                bx.marker(x, f, "o", "black", 1.2)
+        bx.frame(xlabel="time [s]", ylabel="force [N]", grid="y")
+        bx.legend([("95 % interval", "#b5d0e8", "bar"), ("force per voiced frame", "black", "o")])
+    canvas.save(path)
 
 
 def plot_board(tracks, path, readings=None) -> None:
-    """One figure: every taxel's band (:class:`matcad.loop.board.TaxelTrack`) as spectrogram (dB) with its voiced
-    track, a colour and a label per taxel; with ``readings`` ({name: Reading}) a second panel of force against
-    time, one line and 95 % band per taxel."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """One figure: every taxel's band (:class:`matcad.loop.board.TaxelTrack`) as spectrogram (dB, grey) with its
+    voiced track, a colour and a label per taxel; with ``readings`` ({name: Reading}) a second panel of force
+    against time, one line and 95 % band per taxel. Drawn with :mod:`matcad.canvas` (no matplotlib)."""
+    from matcad.canvas import GREYS_R, TAB10, Canvas, colour_map, tint
 
     rows = 2 if readings else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(9, 3.6 * rows + 0.8), sharex=True, squeeze=False)
-    ax = axes[0, 0]
+    width, panel = 900, 360
+    canvas = Canvas(width, panel * rows + 45)
+    box = (85, 35, width - 15, panel - 5)
     present = [t for t in tracks if t.analysis is not None]
-    levels = np.concatenate([t.analysis.plot_db.ravel() for t in present])
-    vmin, vmax = np.percentile(levels, 5), levels.max()
-    colours = plt.get_cmap("tab10")
+    levels = np.concatenate([t.analysis.plot_db.ravel() for t in present]) if present else np.zeros(1)
+    vmin, vmax = float(np.percentile(levels, 5)), float(levels.max())
+    times = np.concatenate([t.analysis.plot_times_s for t in present]) if present else np.array([0.0, 1.0])
+    xlim = (float(times.min()), float(times.max()) if times.max() > times.min() else float(times.min()) + 1.0)
+    lo, hi = min(t.band_hz[0] for t in tracks), max(t.band_hz[1] for t in tracks)
+    ax = canvas.axes(box, xlim, (lo, hi))
+    legend = []
     for k, t in enumerate(tracks):
-        colour = colours(k % 10)
-        ax.axhspan(*t.band_hz, color=colour, alpha=0.08, lw=0)
+        colour = TAB10[k % 10]
+        ax.rect(xlim[0], t.band_hz[0], xlim[1], t.band_hz[1], fill=tint(colour, 0.08))
         if t.analysis is None:
-            ax.text(0.01, np.mean(t.band_hz), f"{t.name}: no tone", color=colour, fontsize=8,
-                    transform=ax.get_yaxis_transform())
+            ax.text(xlim[0] + 0.01 * (xlim[1] - xlim[0]), float(np.mean(t.band_hz)), f"{t.name}: no tone", 10,
+                    colour, anchor="lm")
             continue
         a = t.analysis
-        ax.pcolormesh(a.plot_times_s, a.plot_freqs_hz, a.plot_db, shading="nearest", cmap="gray_r", vmin=vmin,
-                      vmax=vmax)
-        ax.plot(a.times_s, np.where(a.voiced, a.track_hz, np.nan), color=colour, lw=1.2,
-                label=f"{t.name}: {a.mean_hz:.0f} Hz, tone {100 * a.tone_fraction:.0f} %")
-    ax.set(ylabel="frequency [Hz]", title=f"{len(tracks)} taxels, one band each")
-    ax.legend(loc="upper right", fontsize=7)
+        ax.image(colour_map(a.plot_db[::-1], vmin, vmax, GREYS_R),
+                 (float(a.plot_times_s[0]), float(a.plot_times_s[-1]), float(a.plot_freqs_hz[0]),
+                  float(a.plot_freqs_hz[-1])))
+    for k, t in enumerate(tracks):
+        if t.analysis is not None:
+            a, colour = t.analysis, TAB10[k % 10]
+            ax.line(a.times_s, np.where(a.voiced, a.track_hz, np.nan), colour, 2)
+            legend.append((f"{t.name}: {a.mean_hz:.0f} Hz, tone {100 * a.tone_fraction:.0f} %", colour, "line"))
+    ax.frame(ylabel="frequency [Hz]", xlabel="" if readings else "time [s]",
+             title=f"{len(tracks)} taxels, one band each")
+    ax.legend(legend, 9)
     if readings:
-        bx = axes[1, 0]
-        for k, t in enumerate(tracks):
-            r = readings.get(t.name)
-            if r is None or t.analysis is None:
-                continue
-            colour = colours(k % 10)
-            times = t.analysis.times_s
-            bx.fill_between(times, r.frames_interval_n[:, 0], r.frames_interval_n[:, 1], color=colour, alpha=0.25,
-                            lw=0)
-            bx.plot(times, r.frames_n, color=colour, lw=1, label=t.name)
-        bx.set(ylabel="force [N]")
-        bx.legend(loc="upper right", fontsize=7)
-    save_time_figure(fig, axes, path)
+        shown = [(k, t, readings[t.name]) for k, t in enumerate(tracks)
+                 if readings.get(t.name) is not None and t.analysis is not None]
+        values = np.concatenate([np.ravel(r.frames_interval_n) for _, _, r in shown] +
+                                [np.ravel(r.frames_n) for _, _, r in shown]) if shown else np.array([0.0, 1.0])
+        values = values[np.isfinite(values)] if np.isfinite(values).any() else np.array([0.0, 1.0])
+        flo, fhi = float(values.min()), float(values.max())
+        pad = 0.05 * (fhi - flo) or 0.5
+        bx = canvas.axes((box[0], box[1] + panel, box[2], box[3] + panel), xlim, (flo - pad, fhi + pad))
+        for k, t, r in shown:
+            colour, times = TAB10[k % 10], t.analysis.times_s
+            low, high = np.asarray(r.frames_interval_n[:, 0], float), np.asarray(r.frames_interval_n[:, 1], float)
+            ok = np.isfinite(low) & np.isfinite(high)
+            for run in np.split(np.arange(len(times)), np.flatnonzero(~ok) + 1):
+                run = run[ok[run]]
+                if len(run) > 1:
+                    bx.polygon(list(zip(times[run], high[run])) + list(zip(times[run][::-1], low[run][::-1])),
+                               tint(colour, 0.25))
+        for k, t, r in shown:
+            bx.line(t.analysis.times_s, np.asarray(r.frames_n, float), TAB10[k % 10], 1)
+        bx.frame(xlabel="time [s]", ylabel="force [N]", grid="y")
+        bx.legend([(t.name, TAB10[k % 10], "line") for k, t, _ in shown], 9)
+    canvas.save(path)
 
 
-def save_time_figure(fig, axes, path) -> None:
-    """Label the shared time axis (s) of a column of panels and write the figure as PNG (100 dpi)."""
-    import matplotlib.pyplot as plt
-
-    axes[-1, 0].set(xlabel="time [s]")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)

@@ -59,25 +59,44 @@ class Framer:
 
 def running_median_rows(rows: np.ndarray, width: int) -> np.ndarray:
     """Median over ``width`` (odd) neighbouring columns of each row, edges continued by their end values (the
-    same numbers as scipy's median_filter(size=(1, width), mode='nearest')). The rows are laid end to end, each
-    padded by its own edge values, and filtered in one 1-D pass: ~15× faster than the 2-D filter."""
-    from scipy.ndimage import median_filter
+    same numbers as scipy's median_filter(size=(1, width), mode='nearest')), in numpy: the middle of each window
+    partitioned, a few rows at a time (bounded memory). scipy.ndimage is not imported: its import alone costs
+    ~0.3 s, several times the tracker's own work on a 10 s recording."""
+    from numpy.lib.stride_tricks import sliding_window_view
 
     half = width // 2
     padded = np.pad(rows, ((0, 0), (half, half)), mode="edge")
-    return median_filter(padded.ravel(), size=width, mode="nearest").reshape(padded.shape)[:, half:-half]
+    out = np.empty(rows.shape, dtype=np.result_type(rows.dtype, np.float64))
+    step = max(1, 200_000 // max(1, rows.shape[1] * width))
+    for i in range(0, rows.shape[0], step):
+        out[i:i + step] = np.partition(sliding_window_view(padded[i:i + step], width, axis=1), half, axis=-1)[..., half]
+    return out
+
+
+def running_max(x: np.ndarray, size: int, mode: str = "reflect") -> np.ndarray:
+    """Maximum over ``size`` (odd) neighbouring columns of each row of ``x`` (the same numbers as scipy's
+    maximum_filter1d(x, size, axis=1, mode=mode)): ``mode`` 'reflect' (edges mirrored, d c b a | a b c d) or
+    'constant' (zeros beyond the edges)."""
+    half = size // 2
+    if mode == "constant":
+        padded = np.pad(x, ((0, 0), (half, half)), mode="constant", constant_values=0)
+    else:
+        padded = np.pad(x, ((0, 0), (half, half)), mode="symmetric")
+    n = x.shape[1]
+    out = padded[:, :n].copy()
+    for k in range(1, size):
+        np.maximum(out, padded[:, k:k + n], out=out)
+    return out
 
 
 def levels(power: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per frame and bin of ``power`` (frames × bins, PSD): (level dB, excess over the running-median floor of
     FLOOR_BINS dB, lines: the excess where a bin is a local maximum ≥ LINE_DB over the floor, else −inf)."""
-    from scipy.ndimage import maximum_filter1d
-
     tiny = np.finfo(float).tiny
     floor = running_median_rows(power, FLOOR_BINS)
     excess = 10 * np.log10((power + tiny) / (floor + tiny))
     level = 10 * np.log10(power + tiny)
-    is_max = (excess >= maximum_filter1d(excess, 3, axis=1)) & (excess >= LINE_DB)
+    is_max = (excess >= running_max(excess, 3)) & (excess >= LINE_DB)
     return level, excess, np.where(is_max, excess, -np.inf)
 
 

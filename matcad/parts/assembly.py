@@ -35,14 +35,21 @@ def drilled(plate, neck_diameters: tuple[float, ...]):
     return dataclasses.replace(plate, holes=holes)
 
 
-def assembled_parts(spec) -> dict[str, object]:
+def assembled_parts(spec, made: dict | None = None) -> dict[str, object]:
     """Name → solid in the assembly frame (mm). Spacers are numbered when laser-cut; a board's caps and needles
-    are named after their taxels (end_cap_t1, needle_t1, ...)."""
+    are named after their taxels (end_cap_t1, needle_t1, ...). ``made``: solids the build already made in their
+    design frame (:func:`matcad.parts.catalogue.printed_parts`): a single taxel's cap and the needle mount are
+    placed from those (moved copies) instead of being built again."""
     from build123d import Pos
 
     from matcad.spec import taxel_spec, taxels
 
+    made = made or {}
     board = taxels(spec)
+
+    def reuse(name, build):
+        return Pos(0, 0, 0) * made[name] if name in made else build()
+
     plate_t = spec.neck.length
     parts = {
         "neck_plate": flat_solid(drilled(neck_plate(spec), tuple(t.neck.diameter for t in board))),
@@ -50,11 +57,11 @@ def assembled_parts(spec) -> dict[str, object]:
         "guide_clamp": flat_solid(guide(spec, "clamp"), clamp_seat_z_mm(spec)),
     }
     if len(board) == 1:
-        parts |= {"end_cap": Pos(0, 0, plate_t) * end_cap(spec), "needle_mount": needle_mount(spec),
-                  "needle": needle(spec)}
+        parts |= {"end_cap": Pos(0, 0, plate_t) * reuse("end_cap", lambda: end_cap(spec)),
+                  "needle_mount": reuse("needle_mount", lambda: needle_mount(spec)), "needle": needle(spec)}
     else:
         parts |= {f"end_cap_{t.name}": Pos(t.x, t.y, plate_t) * end_cap(taxel_spec(spec, t)) for t in board}
-        parts["needle_mount"] = needle_mount(spec)
+        parts["needle_mount"] = reuse("needle_mount", lambda: needle_mount(spec))
         parts |= {f"needle_{t.name}": taxel_needle(t) for t in board}
     if spec.spacer.style == "laser":
         one = spacer(spec)

@@ -7,7 +7,9 @@ compensation per feature, so exporters draw it and the report declares it.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
+from pathlib import Path
 
 REFERENCE_SQUARE_MM = 10.0
 
@@ -49,18 +51,47 @@ CAP_HEIGHT_PER_SIZE = 0.729
 """DejaVu Sans capital height / font size: an Engraving's height is its capital height."""
 
 
+GLYPH_TABLE_MAX_MM = 4.0
+"""Tallest engraving drawn from glyphs.json: matplotlib flattens a glyph's curves into more points once it is larger
+(from ~6 mm capitals), so taller text goes to matplotlib; up to here the table gives matplotlib's points exactly
+(tests/test_fast_pictures.py)."""
+
+
 def engraving_outlines(t) -> list[list[tuple[float, float]]]:
     """An :class:`~matcad.parts.flat.Engraving` as closed glyph outlines (mm): the text converted to polygons
     with DejaVu Sans (shipped with matplotlib, so every machine draws the same shapes), baseline at (t.x, t.y),
     capitals t.height tall. Lasers engrave or score the outlines, printed parts recess them
-    (:func:`matcad.parts.solid.engraved`); no font is needed on the laser's or printer's computer."""
+    (:func:`matcad.parts.solid.engraved`); no font is needed on the laser's or printer's computer. Printable ASCII
+    comes from glyphs.json (matplotlib's outlines and spacing, tabulated by benchmarks/glyph_table.py: no
+    matplotlib import on a laser-only build) up to :data:`GLYPH_TABLE_MAX_MM` tall; any other text is laid out
+    by matplotlib itself."""
+    size = t.height / CAP_HEIGHT_PER_SIZE
+    table = glyph_table()
+    glyphs, pairs = table["glyphs"], table["pairs"]
+    if (t.height <= GLYPH_TABLE_MAX_MM and all(c in glyphs for c in t.text)
+            and not any(j in t.text for j in table["joined"])):
+        out, x = [], 0.0
+        for k, c in enumerate(t.text):
+            if k:
+                prev = t.text[k - 1]
+                x += pairs.get(prev + c, glyphs[prev]["advance"])
+            out += [[(t.x + (gx + x) * size, t.y + gy * size) for gx, gy in poly] for poly in glyphs[c]["polygons"]]
+        return out
     from matplotlib.font_manager import FontProperties
     from matplotlib.textpath import TextPath
 
-    path = TextPath((0.0, 0.0), t.text, size=t.height / CAP_HEIGHT_PER_SIZE,
-                    prop=FontProperties(family="DejaVu Sans"))
+    path = TextPath((0.0, 0.0), t.text, size=size, prop=FontProperties(family="DejaVu Sans"))
     return [[(t.x + float(x), t.y + float(y)) for x, y in poly[:-1]]
             for poly in path.to_polygons(closed_only=True) if len(poly) > 3]
+
+
+@functools.cache
+def glyph_table() -> dict:
+    """glyphs.json: per printable ASCII character its outlines at font size 1 and its advance; kerned pairs'
+    spacing; pairs the shaper joins (those texts go to matplotlib)."""
+    import json
+
+    return json.loads((Path(__file__).parent / "glyphs.json").read_text(encoding="utf-8"))
 
 
 def _inside(point, poly) -> bool:

@@ -134,18 +134,29 @@ def _ring(radius: float, count: int, phase_deg: float, skip_first: bool) -> tupl
     return tuple((radius, phase_deg + k * step) for k in range(1 if skip_first else 0, count))
 
 
-def base_face_reach_mm(r0: float, r1: float, openings: list[tuple[float, float, float]], samples: int = 48) -> float:
+def base_face_reach_mm(r0: float, r1: float, openings: list[tuple[float, float, float]], samples: int = 48,
+                       every: int = 1) -> float:
     """Farthest point of the base-face annulus r0 … r1 (cavity edge … flange edge) from the edge of the nearest
-    opening, openings given as (radius, angle deg, hole radius); sampled on a polar grid (mm)."""
+    opening, openings given as (radius, angle deg, hole radius); sampled on a polar grid (mm). ``every`` > 1 takes
+    every so many grid points only: a lower bound of the full grid's value (its maximum over fewer points)."""
     import numpy as np
 
-    r, a = np.meshgrid(np.linspace(r0, r1, samples + 1), np.linspace(0, 2 * np.pi, 4 * samples, endpoint=False))
-    x, y = (r * np.cos(a)).ravel(), (r * np.sin(a)).ravel()
+    x, y = _polar_grid(r0, r1, samples)
+    x, y = x[::every], y[::every]
     gap = np.full(x.shape, np.inf)
     for radius, angle, hole in openings:
         cx, cy = radius * math.cos(math.radians(angle)), radius * math.sin(math.radians(angle))
-        gap = np.minimum(gap, np.maximum(0.0, np.hypot(x - cx, y - cy) - hole))
-    return float(gap.max())
+        gap = np.minimum(gap, np.sqrt((x - cx) ** 2 + (y - cy) ** 2) - hole)  # sqrt, not hypot: 6x faster
+    return float(max(0.0, gap.max()))
+
+
+@functools.lru_cache(maxsize=16)
+def _polar_grid(r0: float, r1: float, samples: int):
+    """The sample points (x, y, mm) of :func:`base_face_reach_mm`'s annulus, made once per annulus."""
+    import numpy as np
+
+    r, a = np.meshgrid(np.linspace(r0, r1, samples + 1), np.linspace(0, 2 * np.pi, 4 * samples, endpoint=False))
+    return (r * np.cos(a)).ravel(), (r * np.sin(a)).ravel()
 
 
 def _fits(radius: float, count: int, hole: float) -> bool:
@@ -166,7 +177,7 @@ def _plan(cavity_d: float, outer_d: float, flange_d: float, tip_r: float, fill_p
     r_in, r_out = (cavity_d + outer_d) / 4, (outer_d + flange_d) / 4
     fill = [(r_in, 0.0, fill_port / 2)]
     reach_tip = tip_r  # the end face's centre to its rim, where the pin's side rises to the base face
-    best = None
+    tried = []
     for n_in in range(1, MAX_VENTS_PER_RING + 1):
         if not _fits(r_in, n_in, max(vent, fill_port)):
             break
@@ -175,13 +186,20 @@ def _plan(cavity_d: float, outer_d: float, flange_d: float, tip_r: float, fill_p
                 break
             inner = _ring(r_in, n_in, 0.0, skip_first=True)
             outer = _ring(r_out, n_out, 180.0 / n_out, skip_first=False)
-            reach = base_face_reach_mm(cavity_d / 2, flange_d / 2, fill + [(r, a, vent / 2) for r, a in inner + outer])
-            if best is None or reach < best.reach_base_mm - 1e-9:
-                best = VentPlan(inner, outer, reach, reach_tip, False)
-            if reach <= vent_reach:
-                return VentPlan(inner, outer, reach, reach_tip, reach_tip <= vent_reach)
+            openings = fill + [(r, a, vent / 2) for r, a in inner + outer]
+            tried.append((inner, outer, openings))
+            # a fifth of the grid first: its reach is a lower bound, so above vent_reach the rings fail for sure
+            if base_face_reach_mm(cavity_d / 2, flange_d / 2, openings, every=5) <= vent_reach:
+                reach = base_face_reach_mm(cavity_d / 2, flange_d / 2, openings)
+                if reach <= vent_reach:
+                    return VentPlan(inner, outer, reach, reach_tip, reach_tip <= vent_reach)
             if n_out * n_in > 4 * MAX_VENTS_PER_RING:
                 break
+    best = None  # no rings reach everywhere: the ones that come nearest (the first of equals), on the full grid
+    for inner, outer, openings in tried:
+        reach = base_face_reach_mm(cavity_d / 2, flange_d / 2, openings)
+        if best is None or reach < best.reach_base_mm - 1e-9:
+            best = VentPlan(inner, outer, reach, reach_tip, False)
     if best is None:  # not even the first rings fit: only the fill port vents the base face
         best = VentPlan((), (), base_face_reach_mm(cavity_d / 2, flange_d / 2, fill), reach_tip, False)
     return best

@@ -5,8 +5,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from matcad.render.figure import figure
-
 BANDS_PNG = "plot_taxel_bands.png"
 
 
@@ -39,39 +37,42 @@ def band_chart(d: dict, path: Path) -> dict:
     span = hi - lo
     lo, hi = lo - 0.05 * span, hi + 0.05 * span
     g = d["guard_hz"]
-    with figure(path, 7.6, 1.4 + 0.45 * len(rows)) as fig:
-        ax = fig.add_subplot(1, 1, 1)
-        harmonic_drawn = False
-        for y, t in enumerate(reversed(rows)):
-            (ul, uh), (ll, lh) = t["unloaded_hz"], t["loaded_hz"]
-            ax.barh(y, uh - ul, left=ul, height=0.5, color="#5b8fc7", label="unloaded band" if y == 0 else None)
-            ax.barh(y, lh - uh, left=uh, height=0.5, color="#e08a3c",
-                    label=f"rise to {d['max_force_n']:g} N" if y == 0 else None)
-            if ll < ul:
-                ax.barh(y, ul - ll, left=ll, height=0.5, color="#e08a3c")
-            for edge, width in ((ll - g, g), (lh, g)):
-                ax.barh(y, width, left=edge, height=0.5, color="none", edgecolor="#777777", hatch="////",
-                        linewidth=0.0, label="guard" if y == 0 and edge < ll else None)
-            ax.plot([t["f0_hz"]], [y], marker="|", markersize=12, color="black")
-            for n in d["harmonics"]:
-                a, b = max(n * ll, lo), min(n * lh, hi)
-                if a < b:  # only where it falls on the chart, i.e. near the bands
-                    ax.barh(y - 0.32, b - a, left=a, height=0.14, color="#9b59b6", alpha=0.6,
-                            label=None if harmonic_drawn else "harmonics of the loaded band")
-                    ax.text(a, y - 0.32, f" {n}f", fontsize=6, va="center")
-                    harmonic_drawn = True
-        for c in d["conflicts"]:  # where the two (guarded) bands meet
-            a, b = sorted((max(c["band_hz"][0], c["other_hz"][0]), min(c["band_hz"][1], c["other_hz"][1])))
-            ax.axvspan(a - g / 2, b + g / 2, color="#d62728", alpha=0.25,
-                       label="conflict" if c is d["conflicts"][0] else None)
-        ax.set_yticks(range(len(rows)), [f"{t['name']} ({t['f0_hz']:.0f} Hz)" for t in reversed(rows)], fontsize=8)
-        ax.set_xlim(lo, hi)
-        ax.set_ylim(-0.8, len(rows) - 0.4)
-        ax.set_xlabel("frequency [Hz]")
-        verdict = f"{len(d['conflicts'])} conflict(s)" if d["conflicts"] else "disjoint"
-        ax.set_title(f"{len(rows)} taxel band(s), guard {g:.0f} Hz, max force {d['max_force_n']:g} N: {verdict}",
-                     fontsize=9, color="#b00000" if d["conflicts"] else "black")
-        ax.grid(axis="x", alpha=0.3)
-        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    from matcad.canvas import Canvas
+
+    names = [f"{t['name']} ({t['f0_hz']:.0f} Hz)" for t in reversed(rows)]
+    canvas = Canvas(836, 154 + 50 * len(rows))
+    left = 24 + max(canvas.text_width(n, 10) for n in names)
+    legend = [("unloaded band", "#5b8fc7", "bar"), (f"rise to {d['max_force_n']:g} N", "#e08a3c", "bar"),
+              ("guard", "#777777", "hatch")]
+    right = 836 - 16 - max(canvas.text_width(label, 9) for label in
+                           [e[0] for e in legend] + ["harmonics of the loaded band"]) - 34
+    ax = canvas.axes((left, 34, right, 100 + 50 * len(rows)), (lo, hi), (-0.8, len(rows) - 0.4))
+    harmonic_drawn = False
+    for y, t in enumerate(reversed(rows)):
+        (ul, uh), (ll, lh) = t["unloaded_hz"], t["loaded_hz"]
+        ax.rect(ul, y - 0.25, uh, y + 0.25, fill="#5b8fc7")
+        ax.rect(uh, y - 0.25, lh, y + 0.25, fill="#e08a3c")
+        if ll < ul:
+            ax.rect(ll, y - 0.25, ul, y + 0.25, fill="#e08a3c")
+        for edge, width in ((ll - g, g), (lh, g)):
+            ax.rect(max(edge, lo), y - 0.25, min(edge + width, hi), y + 0.25, hatch="#777777")
+        ax.marker(t["f0_hz"], y, "|", "black", 6)
+        for n in d["harmonics"]:
+            a, b = max(n * ll, lo), min(n * lh, hi)
+            if a < b:  # only where it falls on the chart, i.e. near the bands
+                ax.rect(a, y - 0.39, b, y - 0.25, fill="#c39bd3")
+                ax.text(a, y - 0.32, f" {n}f", 8, anchor="lm")
+                harmonic_drawn = True
+    for c in d["conflicts"]:  # where the two (guarded) bands meet
+        a, b = sorted((max(c["band_hz"][0], c["other_hz"][0]), min(c["band_hz"][1], c["other_hz"][1])))
+        ax.rect(max(a - g / 2, lo), ax.ylim[0], min(b + g / 2, hi), ax.ylim[1], outline="#d62728", width=3)
+    verdict = f"{len(d['conflicts'])} conflict(s)" if d["conflicts"] else "disjoint"
+    ax.frame(xlabel="frequency [Hz]", yticks=list(enumerate(names)), grid="x", size=11,
+             title=f"{len(rows)} taxel band(s), guard {g:.0f} Hz, max force {d['max_force_n']:g} N: {verdict}",
+             title_colour="#b00000" if d["conflicts"] else "black")
+    legend += [("harmonics of the loaded band", "#c39bd3", "bar")] if harmonic_drawn else []
+    legend += [("conflict", "#d62728", "line")] if d["conflicts"] else []
+    ax.legend(legend, outside=True)
+    canvas.save(path)
     return {"part": "prediction", "file": path.name,
             "caption": "taxel bands: unloaded (blue), loaded rise (orange), guard (hatched), harmonics (purple)"}

@@ -7,53 +7,65 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from matcad.render.figure import figure
-
 BAND_PNG = "plot_band.png"
 LOAD_PNG = "plot_load.png"
 
 
 def band_plot(p: dict, path: Path) -> dict:
-    """Every model's f0, the chosen band, and each budget line's shift (Hz) as a bar from f0."""
+    """Every model's f0 (dot; cross when invalid), the chosen band (orange) and each budget line's shift (Hz) as a
+    bar from f0 (blue), f0 dotted; drawn with :mod:`matcad.canvas` (no matplotlib on the build's path)."""
+    from matcad.canvas import Canvas
+
     lines = p["budget"]
     f0, (lo, hi) = p["f0_hz"], p["band_hz"]
-    with figure(path, 7.2, 1.2 + 0.32 * (len(lines) + len(p["models"]) + 1)) as fig:
-        ax = fig.add_subplot(1, 1, 1)
-        labels, y = [], 0
-        for b in reversed(lines):
-            ax.barh(y, b["high_hz"] - b["low_hz"], left=f0 + b["low_hz"], color="#8fb8e0", height=0.6)
-            labels.append(b["source"])
-            y += 1
-        ax.barh(y, hi - lo, left=lo, color="#e08a3c", height=0.7)
-        labels.append("band (root-sum-square)")
+    labels = [b["source"] for b in reversed(lines)] + ["band (root-sum-square)"]
+    labels += [f"{name}{' (chosen)' if name == p['model'] else ''}{'' if m['valid'] else ' (invalid)'}"
+               for name, m in p["models"].items()]
+    xs = [lo, hi, f0] + [f0 + b["low_hz"] for b in lines] + [f0 + b["high_hz"] for b in lines]
+    xs += [m["f0_hz"] for m in p["models"].values() if m["f0_hz"] is not None]
+    span = max(xs) - min(xs) or 1.0
+    xlim = (min(xs) - 0.06 * span, max(xs) + 0.06 * span)
+    canvas = Canvas(792, 90 + 26 * len(labels))
+    left = 24 + max(canvas.text_width(label, 10) for label in labels)
+    ax = canvas.axes((left, 34, 776, 40 + 26 * len(labels)), xlim, (-0.6, len(labels) - 0.4))
+    y = 0
+    for b in reversed(lines):
+        ax.rect(f0 + b["low_hz"], y - 0.3, f0 + b["high_hz"], y + 0.3, fill="#8fb8e0")
         y += 1
-        for name, m in p["models"].items():
-            ax.plot([m["f0_hz"]], [y], marker="o" if m["valid"] else "x", color="black")
-            labels.append(f"{name}{' (chosen)' if name == p['model'] else ''}{'' if m['valid'] else ' (invalid)'}")
-            y += 1
-        ax.axvline(f0, color="#333333", linewidth=0.8, linestyle=":")
-        ax.set_yticks(range(len(labels)), labels, fontsize=8)
-        ax.set_xlabel("frequency [Hz]")
-        ax.set_title(f"f0 = {f0:.0f} Hz ({p['model']}), band {lo:.0f}–{hi:.0f} Hz", fontsize=10)
-        ax.grid(axis="x", alpha=0.3)
+    ax.rect(lo, y - 0.35, hi, y + 0.35, fill="#e08a3c")
+    y += 1
+    for m in p["models"].values():
+        if m["f0_hz"] is not None:
+            ax.marker(m["f0_hz"], y, "o" if m["valid"] else "x", "black")
+        y += 1
+    ax.line([f0, f0], list(ax.ylim), "#333333", 1, dash=3)
+    ax.frame(xlabel="frequency [Hz]", title=f"f0 = {f0:.0f} Hz ({p['model']}), band {lo:.0f}–{hi:.0f} Hz",
+             yticks=list(enumerate(labels)), grid="x")
+    canvas.save(path)
     return {"part": "prediction", "file": path.name, "caption": "models, band and uncertainty budget"}
 
 
 def load_plot(p: dict, path: Path) -> dict | None:
     """f(F) from the prediction's load curve, one line per source (Eq. 5 calibration, cap mechanics) (N, Hz);
     None when no point has a value."""
+    from matcad.canvas import TAB10, Canvas
+
     points = [pt for pt in p.get("load_curve", ()) if pt["f_hz"] is not None]
     if not points:
         return None
     sources = list(dict.fromkeys(pt.get("source", "Eq. 5") for pt in points))
-    with figure(path, 6.4, 3.6) as fig:
-        ax = fig.add_subplot(1, 1, 1)
-        for source in sources:
-            mine = [pt for pt in points if pt.get("source", "Eq. 5") == source]
-            ax.plot([pt["force_n"] for pt in mine], [pt["f_hz"] for pt in mine], marker=".", label=source)
-        ax.set_xlabel("normal force F [N]")
-        ax.set_ylabel("f [Hz]")
-        ax.set_title("load curve f(F)", fontsize=9)
-        ax.legend(fontsize=7)
-        ax.grid(alpha=0.3)
+    fs = [pt["f_hz"] for pt in points]
+    forces = [pt["force_n"] for pt in points]
+    fpad = 0.05 * (max(fs) - min(fs)) or 1.0
+    xpad = 0.05 * (max(forces) - min(forces)) or 0.5
+    canvas = Canvas(704, 396)
+    ax = canvas.axes((80, 30, 690, 340), (min(forces) - xpad, max(forces) + xpad), (min(fs) - fpad, max(fs) + fpad))
+    for k, source in enumerate(sources):
+        mine = [pt for pt in points if pt.get("source", "Eq. 5") == source]
+        ax.line([pt["force_n"] for pt in mine], [pt["f_hz"] for pt in mine], TAB10[k % 10], 2)
+        for pt in mine:
+            ax.marker(pt["force_n"], pt["f_hz"], "o", TAB10[k % 10], 2)
+    ax.frame(xlabel="normal force F [N]", ylabel="f [Hz]", title="load curve f(F)", grid="xy")
+    ax.legend([(source, TAB10[k % 10], "line") for k, source in enumerate(sources)])
+    canvas.save(path)
     return {"part": "prediction", "file": path.name, "caption": "load curve f(F): " + "; ".join(sources)}

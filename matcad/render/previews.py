@@ -15,8 +15,6 @@ from pathlib import Path
 
 import numpy as np
 
-from matcad.render.figure import figure
-
 ISOMETRIC = (35.264, -45.0)
 """(elevation, azimuth) in degrees of the isometric view: elevation atan(1/√2)."""
 LIGHT = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
@@ -65,26 +63,6 @@ def feature_edges(mesh, angle_deg: float = EDGE_ANGLE_DEG) -> np.ndarray:
     return np.asarray(mesh.vertices[mesh.face_adjacency_edges[crease]], dtype=float)
 
 
-def _mesh_axes(ax, mesh, elev: float, azim: float, title: str) -> int:
-    """The mesh shaded and its feature edges drawn, seen from (elev, azim); returns the edges drawn."""
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
-
-    triangles = np.asarray(mesh.triangles, dtype=float)
-    edges = feature_edges(mesh)
-    ax.add_collection3d(Poly3DCollection(triangles, facecolors=_shaded(triangles), edgecolors="none"))
-    ax.add_collection3d(Line3DCollection(edges, colors=EDGE_RGB, linewidths=0.5))
-    lo, hi = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(np.maximum(hi - lo, 1e-6 * max(hi - lo)), zoom=0.9)  # a long part seen from above stays whole
-    ax.view_init(elev=elev, azim=azim)
-    ax.set_proj_type("ortho")
-    ax.set_title(textwrap.fill(title, 48), fontsize=8)
-    ax.set_axis_off()
-    return len(edges)
-
-
 def bore_plane_y(mesh) -> float:
     """y of the plane through the inclined bore nearest y = 0: the middle of the y span of the faces whose normal
     leans neither horizontal nor vertical (a bore at θ to the bed), bores told apart by 1 mm gaps in y (mm); 0 when
@@ -106,101 +84,136 @@ def section_loops(mesh, y0: float) -> list[list[tuple[float, float]]]:
     return [[(float(x), float(z)) for x, _, z in loop[:-1]] for loop in section.discrete if len(loop) > 3]
 
 
-def _section_axes(ax, mesh, y0: float, title: str) -> int:
-    """The section at y = ``y0`` filled (material) with its holes left open, axes in mm; returns the loops."""
-    from matplotlib.patches import PathPatch
-    from matplotlib.path import Path as MplPath
+PREVIEW_PX = (792, 374)
+"""A printed part's preview: two panels side by side (px)."""
 
+
+def view_basis(elev: float, azim: float):
+    """(right, up, toward the viewer) unit vectors of an orthographic view from elevation ``elev`` and azimuth
+    ``azim`` (degrees, as matplotlib's 3-D axes: azimuth about z from +x, elevation above the x-y plane)."""
+    e, a = np.radians(elev), np.radians(azim)
+    toward = np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+    right = np.array([-np.sin(a), np.cos(a), 0.0])
+    return right, np.cross(toward, right), toward
+
+
+def _mesh_panel(canvas, box, mesh, elev: float, azim: float, title: str) -> int:
+    """The mesh seen from (elev, azim), orthographic, true proportions, in the pixel ``box``: faces shaded
+    (:func:`_shaded`) and painted far to near, the feature edges drawn over them; returns the edges drawn."""
+    triangles = np.asarray(mesh.triangles, dtype=float)
+    edges = feature_edges(mesh)
+    right, up, toward = view_basis(elev, azim)
+    pts = triangles.reshape(-1, 3)
+    u, v = pts @ right, pts @ up
+    left, top, rgt, bottom = box
+    span = max(np.ptp(u), np.ptp(v), 1e-9)
+    k = 0.9 * min((rgt - left) / max(np.ptp(u), 1e-9 * span), (bottom - top - 24) / max(np.ptp(v), 1e-9 * span))
+    cx, cy = (left + rgt) / 2, (top + 24 + bottom) / 2
+    mu, mv = (u.max() + u.min()) / 2, (v.max() + v.min()) / 2
+    px = (cx + k * (u - mu)).reshape(-1, 3)
+    py = (cy - k * (v - mv)).reshape(-1, 3)
+    colours = (_shaded(triangles) * 255).round().astype(int)
+    facing = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]) @ toward >= 0
+    draw = canvas.draw
+    for i in np.argsort((triangles @ toward).mean(axis=1), kind="stable"):
+        if facing[i]:
+            draw.polygon(list(zip(px[i], py[i])), fill=tuple(colours[i]))
+    edge = tuple(round(255 * c) for c in EDGE_RGB)
+    eu, ev = edges @ right, edges @ up
+    for (u0, u1), (v0, v1) in zip(eu, ev):
+        draw.line([(cx + k * (u0 - mu), cy - k * (v0 - mv)), (cx + k * (u1 - mu), cy - k * (v1 - mv))], fill=edge)
+    canvas.text((left + rgt) / 2, top + 2, textwrap.fill(title, 48), 10, anchor="ma")
+    return len(edges)
+
+
+def _section_panel(canvas, box, mesh, y0: float, title: str) -> int:
+    """The section at y = ``y0`` filled (material) with its holes left open, axes in mm; returns the loops."""
     from matcad.parts.flat import even_odd_faces
 
     loops = section_loops(mesh, y0)
-
-    def ring(points, ccw):
-        area = sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(points, points[1:] + points[:1]))
-        return points if (area > 0) == ccw else points[::-1]
-
-    for outer, inner in even_odd_faces(loops):
-        rings = [ring(outer, True)] + [ring(hole, False) for hole in inner]
-        vertices = [p for r in rings for p in r + r[:1]]
-        codes = [c for r in rings for c in [MplPath.MOVETO] + [MplPath.LINETO] * (len(r) - 1) + [MplPath.CLOSEPOLY]]
-        ax.add_patch(PathPatch(MplPath(vertices, codes), facecolor=BASE_RGB, edgecolor=EDGE_RGB, linewidth=0.6))
     pts = np.array([p for loop in loops for p in loop]).reshape(-1, 2)
-    if len(pts):
-        pad = 0.05 * float(np.ptp(pts, axis=0).max())
-        ax.set_xlim(pts[:, 0].min() - pad, pts[:, 0].max() + pad)
-        ax.set_ylim(pts[:, 1].min() - pad, pts[:, 1].max() + pad)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [mm]", fontsize=7)
-    ax.set_ylabel("z [mm] (as printed)", fontsize=7)
-    ax.tick_params(labelsize=6)
-    ax.set_title(textwrap.fill(title, 48), fontsize=8)
+    if not len(pts):
+        return 0
+    pad = 0.05 * float(np.ptp(pts, axis=0).max())
+    xlim = (pts[:, 0].min() - pad, pts[:, 0].max() + pad)
+    ylim = (pts[:, 1].min() - pad, pts[:, 1].max() + pad)
+    left, top, right, bottom = box
+    ax = canvas.axes((left + 50, top + 34, right - 8, bottom - 40), xlim, ylim, equal=True)
+    base = tuple(round(255 * c) for c in BASE_RGB)
+    edge = tuple(round(255 * c) for c in EDGE_RGB)
+
+    def area(loop):
+        return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(loop, loop[1:] + loop[:1]))) / 2
+
+    for outer, holes in sorted(even_odd_faces(loops), key=lambda region: -area(region[0])):  # islands in holes last
+        ax.polygon(outer, base)
+        for hole in holes:
+            ax.polygon(hole, "white")
+    for loop in loops:
+        ax.line([x for x, _ in loop + loop[:1]], [z for _, z in loop + loop[:1]], edge, 1)
+    ax.frame(xlabel="x [mm]", ylabel="z [mm] (as printed)", title=textwrap.fill(title, 48), size=9)
     return len(loops)
 
 
-def printed_preview(name: str, stl: Path, path: Path) -> dict:
+def printed_preview(name: str, stl: Path, path: Path, mesh=None) -> dict:
     """Isometric view and the face or section that matters of the STL ``stl``, side by side in ``path`` (PNG):
     shaded, with the feature edges drawn, so holes, pockets and bores show; a part whose registry entry names a
-    section is cut through it (the cap through its axis, the mount through a needle bore)."""
-    import trimesh
+    section is cut through it (the cap through its axis, the mount through a needle bore). ``mesh``: the STL
+    already loaded (trimesh), else it is read. Drawn with :mod:`matcad.canvas` (no matplotlib)."""
+    from matcad.canvas import Canvas
 
-    mesh = trimesh.load_mesh(stl, file_type="stl")
+    if mesh is None:
+        from matcad.export.mesh import load_stl
+
+        mesh = load_stl(stl)  # as read back by the build's mesh checks: not read again
     caption, elev, azim = face_view(name)
     plane = section_plane(name)
     size = np.ptp(np.asarray(mesh.vertices), axis=0)
-    with figure(path, 7.2, 3.4) as fig:
-        _mesh_axes(fig.add_subplot(1, 2, 1, projection="3d"), mesh, *ISOMETRIC, "isometric")
-        if plane:
-            y0 = bore_plane_y(mesh) if plane == "bore" else 0.0
-            caption = f"{caption} (y = {y0 + 0.0:.2f} mm)"
-            _section_axes(fig.add_subplot(1, 2, 2), mesh, y0, caption)
-        else:
-            _mesh_axes(fig.add_subplot(1, 2, 2, projection="3d"), mesh, elev, azim, caption)
-        fig.suptitle(f"{name}: {size[0]:.1f} × {size[1]:.1f} × {size[2]:.1f} mm, {len(mesh.faces)} triangles",
-                     fontsize=10)
+    w, h = PREVIEW_PX
+    canvas = Canvas(w, h)
+    _mesh_panel(canvas, (8, 30, w / 2 - 4, h - 8), mesh, *ISOMETRIC, "isometric")
+    if plane:
+        y0 = bore_plane_y(mesh) if plane == "bore" else 0.0
+        caption = f"{caption} (y = {y0 + 0.0:.2f} mm)"
+        _section_panel(canvas, (w / 2 + 4, 30, w - 8, h - 8), mesh, y0, caption)
+    else:
+        _mesh_panel(canvas, (w / 2 + 4, 30, w - 8, h - 8), mesh, elev, azim, caption)
+    canvas.text(w / 2, 6, f"{name}: {size[0]:.1f} × {size[1]:.1f} × {size[2]:.1f} mm, {len(mesh.faces)} triangles",
+                12, anchor="ma")
+    canvas.save(path)
     return {"part": name, "file": path.name, "caption": f"{name}: isometric and {caption}"}
 
 
-def _rounded_rect(x0, y0, x1, y1, r):
-    from matplotlib.patches import FancyBboxPatch
-
-    r = max(0.0, min(r, (x1 - x0) / 2, (y1 - y0) / 2))
-    return FancyBboxPatch((x0 + r, y0 + r), x1 - x0 - 2 * r, y1 - y0 - 2 * r, boxstyle=f"round,pad={r}",
-                          fill=False, edgecolor=FLAT_COLOURS["outline"], linewidth=1.0)
-
-
 def flat_preview(plan, path: Path) -> dict:
-    """The laser cut plan of one part (kerf-compensated, as in its DXF) with each hole's finished size (mm)."""
-    from matplotlib.patches import Circle, Rectangle
+    """The laser cut plan of one part (kerf-compensated, as in its DXF) with each hole's finished size (mm), drawn
+    with :mod:`matcad.canvas` at one scale across and up (no matplotlib on a laser-only build's path)."""
+    from matcad.canvas import Canvas
 
     flat = plan.flat
     x0, y0, x1, y1 = plan.extents
     aspect = (y1 - y0 + 4) / max(x1 - x0 + 4, 1e-9)
-    width_in = 6.0
-    with figure(path, width_in, max(2.2, min(6.0, width_in * aspect + 0.8))) as fig:
-        ax = fig.add_subplot(1, 1, 1)
-        for outline in plan.outlines:
-            ax.add_patch(_rounded_rect(*outline))
-        labelled = set()
-        for c in plan.circles:
-            ax.add_patch(Circle((c.x, c.y), c.diameter / 2, fill=False, edgecolor=FLAT_COLOURS["hole"],
-                                linewidth=1.0))
-            if (c.purpose, c.finished_diameter) not in labelled and c.x <= plan.outlines[0][2]:
-                labelled.add((c.purpose, c.finished_diameter))
-                ax.annotate(f"{c.purpose} Ø{c.finished_diameter:g}", (c.x, c.y + c.diameter / 2), fontsize=7,
-                            xytext=(0, 4), textcoords="offset points", ha="center", color="#102080")
-        for t in plan.texts:
-            ax.text(t.x, t.y, t.text, fontsize=7, color=FLAT_COLOURS["engrave"])
-        if plan.reference_square:
-            sx, sy, side = plan.reference_square
-            ax.add_patch(Rectangle((sx, sy), side, side, fill=False, edgecolor=FLAT_COLOURS["reference"],
-                                   linewidth=0.8, linestyle="--"))
-            ax.text(sx + side / 2, sy + side / 2, f"{side:g} mm\nreference", fontsize=6, ha="center",
-                    va="center", color=FLAT_COLOURS["reference"])
-        ax.set_xlim(x0 - 2, x1 + 2)
-        ax.set_ylim(y0 - 2, y1 + 2)
-        ax.set_aspect("equal")
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("y [mm]")
-        ax.set_title(f"{flat.name}: {flat.quantity} × {flat.width:g} × {flat.depth:g} mm from "
-                     f"{flat.thickness:g} mm sheet (cut lines, kerf {plan.kerf:g} mm)", fontsize=9)
+    width = 660
+    height = round(max(242, min(660, 600 * aspect + 88)))
+    canvas = Canvas(width, height)
+    ax = canvas.axes((70, 34, width - 16, height - 50), (x0 - 2, x1 + 2), (y0 - 2, y1 + 2), equal=True)
+    for ox0, oy0, ox1, oy1, r in plan.outlines:
+        ax.rounded(ox0, oy0, ox1, oy1, r, FLAT_COLOURS["outline"], 1)
+    labelled = set()
+    for c in plan.circles:
+        ax.circle(c.x, c.y, c.diameter / 2, FLAT_COLOURS["hole"], 1)
+        if (c.purpose, c.finished_diameter) not in labelled and c.x <= plan.outlines[0][2]:
+            labelled.add((c.purpose, c.finished_diameter))
+            canvas.text(ax.x(c.x), ax.y(c.y + c.diameter / 2) - 4, f"{c.purpose} Ø{c.finished_diameter:g}", 9,
+                        "#102080", anchor="md")
+    for t in plan.texts:
+        ax.text(t.x, t.y, t.text, 9, FLAT_COLOURS["engrave"], anchor="ls")
+    if plan.reference_square:
+        sx, sy, side = plan.reference_square
+        ax.line([sx, sx + side, sx + side, sx, sx], [sy, sy, sy + side, sy + side, sy], FLAT_COLOURS["reference"],
+                1, dash=3)
+        ax.text(sx + side / 2, sy + side / 2, f"{side:g} mm\nreference", 8, FLAT_COLOURS["reference"], anchor="mm")
+    ax.frame(xlabel="x [mm]", ylabel="y [mm]", size=10,
+             title=f"{flat.name}: {flat.quantity} × {flat.width:g} × {flat.depth:g} mm from {flat.thickness:g} mm "
+                   f"sheet (cut lines, kerf {plan.kerf:g} mm)")
+    canvas.save(path)
     return {"part": flat.name, "file": path.name, "caption": f"{flat.name}: laser cut plan"}

@@ -16,34 +16,12 @@ import sys
 from dataclasses import field
 from typing import Any, ClassVar
 
-from matcad.errors import shorten
+from matcad.errors import MISSING, SpecError, shorten  # defined at the base: the CLI catches SpecError without loading the spec
 
 LENGTH_MIN_MM = 1e-3
 LENGTH_MAX_MM = 1e5
 VECTOR_MAX = 10_000
 """Most values a list field (a measured series) may hold."""
-
-
-class _Missing:
-    """The ``value`` of a SpecError about a table or field that is not there at all (no ``= None`` in messages)."""
-
-    def __repr__(self) -> str:
-        return "(missing)"
-
-
-MISSING: Any = _Missing()
-
-
-class SpecError(ValueError):
-    """Bad spec input. ``field`` is the dotted spec key, ``value`` what was given (:data:`MISSING` when nothing
-    was), ``allowed`` the rule."""
-
-    def __init__(self, field_name: str, value: Any, allowed: str):
-        self.field = field_name
-        self.value = value
-        self.allowed = allowed
-        given = "" if value is MISSING else f" = {shorten(value)}"
-        super().__init__(f"{field_name}{given}: {allowed}")
 
 
 def param(doc: str, unit: str = "", default: Any = dataclasses.MISSING, *, kind: str = "number",

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 
+from matcad.listening import FREQUENCY_KHZ_MAX  # kHz-slip threshold, with the listening band (`analyze --band`)
+
 SILICONE_G_MAX_MPA = 50.0
 """Cast silicones are 0.05-5 MPa in shear; above 50 MPa the value was almost surely typed in kPa."""
 AIR_TEMPERATURE_MAX_C = 150.0
@@ -24,8 +26,6 @@ fractions (cavity 1/8 x 3/16 in, neck sheet 1/4 in), and a taxel under 1 mm woul
 band (the paper's in "mm": f0 ~ 142 kHz)."""
 MM_PER_INCH = 25.4
 SAMPLE_RATE_KHZ_MAX = 400.0
-FREQUENCY_KHZ_MAX = 100.0
-"""Taxel tones are kHz; frequencies all below 100 "Hz" read as kHz."""
 FREQUENCY_KHZ_MIN = 0.02
 """...unless even in kHz they would lie below hearing (20 Hz): then no unit slip explains them, and no note."""
 
