@@ -91,7 +91,11 @@ class BuildResult:
                   f"{t['loaded_hz'][0]:.0f}-{t['loaded_hz'][1]:.0f} Hz" for t in board or ()]
         lines.append((f"{len(board)} taxels" if board else f"f0 = {p.f0_hz:.0f} Hz ({p.model}), band "
                       f"{p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz") + f"; verdict {self.report['verdict']}")
-        lines.append(findings_text([f for f in self.findings if f.level != "info"]))
+        found = findings_text([f for f in self.findings if f.level != "info"])
+        lines += [found] if found else []
+        first = next((f for f in ("report.html", "report.md", "report.json") if f in self.files), None)
+        if first:  # the last line: where a person starts reading the kit
+            lines.append(f"open first: {self.out_dir / first}")
         return "\n".join(lines)
 
 
@@ -242,8 +246,18 @@ def board_report(spec, board, predictions) -> list[dict]:
              "prediction": p.to_dict()} for t, p in zip(board, predictions)]
 
 
-def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:
-    """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
+BUILD_STAGES = 8
+"""The stages :func:`build` reports to its ``progress`` callback: predictions, rules and bands, laser parts, sheets,
+solids, print job, figures, report and archive."""
+
+
+def build(spec, out_dir: Path | None = None, force: bool = False, progress=None) -> BuildResult:
+    """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``.
+    ``progress(stages done, stages)`` (:mod:`matcad.progress`) is told as each of :data:`BUILD_STAGES` ends."""
+    def stage(k: int) -> None:
+        if progress is not None:
+            progress(k, BUILD_STAGES)
+
     from matcad.parts.mold_layout import layout
     from matcad.render.bands import BANDS_PNG, band_chart
     from matcad.render.kit import render_figures
@@ -253,20 +267,27 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
     board = taxels(spec)
     predictions = [predict(taxel_spec(spec, t)) for t in board]
     prediction = predictions[0]
+    stage(1)
     findings = check(spec, prediction if len(board) == 1 else None)
     failure = DesignRuleFailure(findings, forced=force)
     if failure.blocking:
         raise failure
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
     bands = board_bands(spec)
+    stage(2)
     with staged_output(target) as tmp:
         flats = laser_parts(spec)
         plans = [cut_plan(flat, spec.outputs.reference_square) for flat in flats]
         holes = _write_laser(plans, tmp)
+        stage(3)
         sheets = write_sheets(plans, spec, tmp)
+        stage(4)
         meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
+        stage(5)
         job = write_print_job(spec, tmp, meshes) if meshes else None
+        stage(6)
         figures = render_figures(spec, prediction, tmp, meshes, plans) + [band_chart(bands, tmp / BANDS_PNG)]
+        stage(7)
         mold = layout(spec) if spec.outputs.end_cap_mold else None
         report = make_report(spec, prediction, findings, holes, meshes, tmp, flats=flats, mold=mold, job=job) | {
             "figures": figures, "bands": bands, "sheets": sheets, "print_job": job}
@@ -274,6 +295,7 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
             report["taxels"] = board_report(spec, board, predictions)
         write_report(report, tmp)
         write_archive(tmp, KIT_ARCHIVE)
+        stage(8)
     files = tuple(sorted(p.name for p in target.iterdir() if p.name != MANIFEST))
     return BuildResult(target, files, tuple(findings), prediction, report)
 
