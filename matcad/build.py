@@ -89,8 +89,12 @@ class BuildResult:
         lines += [f"{t['name']} at ({t['x_mm']:g}, {t['y_mm']:g}) mm: f0 = {t['f0_hz']:.0f} Hz ({t['model']}), band "
                   f"{t['unloaded_hz'][0]:.0f}-{t['unloaded_hz'][1]:.0f} Hz, loaded to {t['max_force_n']:g} N "
                   f"{t['loaded_hz'][0]:.0f}-{t['loaded_hz'][1]:.0f} Hz" for t in board or ()]
+        from matcad.render.plots import chosen_model_status
+
+        status = "" if board else chosen_model_status(self.report["prediction"])
         lines.append((f"{len(board)} taxels" if board else f"f0 = {p.f0_hz:.0f} Hz ({p.model}), band "
-                      f"{p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz") + f"; verdict {self.report['verdict']}")
+                      f"{p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz") + f"; verdict {self.report['verdict']}"
+                     + (f" (design rules); {status}" if status else ""))
         found = findings_text([f for f in self.findings if f.level != "info"])
         lines += [found] if found else []
         first = next((f for f in ("report.html", "report.md", "report.json") if f in self.files), None)
@@ -327,5 +331,30 @@ def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
                  "printed_holes": [{"purpose": h.purpose, "x_mm": h.x, "y_mm": h.y, "diameter_mm": h.diameter,
                                     "theta_deg": spec.needle.theta_deg if h.purpose == "needle" else 90.0}
                                    for h in printed_coupon_holes(spec)]}
-        (tmp / "report.json").write_text(json.dumps(table, indent=2) + "\n", encoding="utf-8")
+        table["figures"] = coupon_previews(spec, coupons, tmp)
+        write_coupon_report(table, tmp)
     return target, table
+
+
+def coupon_previews(spec, coupons, folder: Path) -> list[dict]:
+    """The coupons' pictures: each laser sheet's cut plan and the printed coupon (the needle mounts are the same
+    block with other bores)."""
+    from matcad.render.previews import flat_preview, preview_name, printed_preview
+
+    figures = [flat_preview(cut_plan(flat, spec.outputs.reference_square), folder / preview_name(flat.name))
+               for flat in coupons]
+    return figures + [printed_preview("coupon_printed", folder / "coupon_printed.stl",
+                                      folder / preview_name("coupon_printed"))]
+
+
+def write_coupon_report(table: dict, folder: Path) -> None:
+    """report.json, report.md and report.html of a coupon kit (:mod:`matcad.report.coupon`)."""
+    import json
+
+    from matcad.report.coupon import coupon_markdown
+    from matcad.report.page import render_html
+
+    text = coupon_markdown(table)
+    (folder / "report.json").write_text(json.dumps(table, indent=2) + "\n", encoding="utf-8")
+    (folder / "report.md").write_text(text, encoding="utf-8")
+    (folder / "report.html").write_text(render_html(text, f"{table['name']} coupons"), encoding="utf-8")

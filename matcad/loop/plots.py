@@ -7,6 +7,11 @@ from __future__ import annotations
 import numpy as np
 
 PLOT_COLUMNS = 1200
+OVERVIEW_S = 60.0
+"""A recording longer than this (s) gets an overview panel above its spectrogram: at 10 min the spectrogram alone
+is a strip of hundreds of segments."""
+OVERVIEW_WINDOWS = 60
+"""The overview's time windows: the median voiced frequency (and force) per window, with its spread."""
 
 
 class PlotPool:
@@ -49,9 +54,12 @@ def plot(analysis, path, forces=None) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    rows = 2 if forces is not None else 1
+    long = len(analysis.times_s) > 0 and analysis.times_s[-1] > OVERVIEW_S
+    rows = 1 + (forces is not None) + long
     fig, axes = plt.subplots(rows, 1, figsize=(8, 3.2 * rows + 0.8), sharex=True, squeeze=False)
-    ax = axes[0, 0]
+    if long:
+        overview(axes[0, 0], analysis, None if forces is None else forces[0])
+    ax = axes[int(long), 0]
     db = analysis.plot_db
     ax.pcolormesh(analysis.plot_times_s, analysis.plot_freqs_hz, db, shading="nearest", cmap="magma",
                   vmin=np.percentile(db, 5), vmax=db.max())
@@ -67,12 +75,53 @@ def plot(analysis, path, forces=None) -> None:
     ax.legend(loc="upper right", fontsize=8)
     if forces is not None:
         force, low, high = forces
-        bx = axes[1, 0]
+        bx = axes[1 + int(long), 0]
         bx.fill_between(analysis.times_s, low, high, alpha=0.3, label="95 % interval")
         bx.plot(analysis.times_s, force, "k.", ms=2, label="force per voiced frame")
         bx.set(ylabel="force [N]")
         bx.legend(loc="upper right", fontsize=8)
     save_time_figure(fig, axes, path)
+
+
+def _windowed(times, values, edges):
+    """Per window of ``edges`` (s): the 10th, 50th and 90th percentile of the finite ``values`` (NaN if none)."""
+    out = np.full((len(edges) - 1, 3), np.nan)
+    which = np.digitize(times, edges) - 1
+    for k in range(len(edges) - 1):
+        v = values[(which == k) & np.isfinite(values)]
+        if len(v):
+            out[k] = np.percentile(v, [10, 50, 90])
+    return out
+
+
+def overview(ax, analysis, force=None) -> None:
+    """The overview of a long recording on ``ax``: per window (:data:`OVERVIEW_WINDOWS`) the median voiced
+    frequency with its 10-90 % spread on an axis from 0 Hz, with ``force`` (per frame, N) the median force on a
+    second axis from 0 N, and a summary of the segments and values in the title."""
+    times = analysis.times_s
+    edges = np.linspace(0.0, float(times[-1]), OVERVIEW_WINDOWS + 1)
+    mids = (edges[:-1] + edges[1:]) / 2
+    hz = _windowed(times, np.where(analysis.voiced, analysis.track_hz, np.nan), edges)
+    ax.fill_between(mids, hz[:, 0], hz[:, 2], color="#5b8fc7", alpha=0.3, lw=0)
+    ax.plot(mids, hz[:, 1], color="#1f4e8c", marker=".", lw=1, label="median voiced frequency (10-90 %)")
+    ax.set_ylim(0, 1.15 * max(np.nanmax(hz[:, 2]) if np.isfinite(hz).any() else 1.0, analysis.band_hz[1]))
+    ax.set(ylabel="frequency [Hz]")
+    means = np.array([s.mean_hz for s in analysis.segments])
+    summary = (f"{len(means)} segments, means {means.min():.0f}-{means.max():.0f} Hz (median {np.median(means):.0f})"
+               if len(means) else "no steady segment")
+    if force is not None:
+        fx = ax.twinx()
+        f = _windowed(times, np.asarray(force, dtype=float), edges)
+        fx.plot(mids, f[:, 1], color="#c0392b", marker=".", lw=1, label="median force")
+        top = np.nanmax(f[:, 2]) if np.isfinite(f).any() else 1.0
+        fx.set_ylim(0, 1.15 * max(top, 1e-3))
+        fx.set_ylabel("force [N]", color="#c0392b")
+        finite = np.asarray(force, dtype=float)[np.isfinite(force)]
+        if len(finite):
+            summary += f"; force {finite.min():.2f}-{finite.max():.2f} N (median {np.median(finite):.2f})"
+        fx.legend(loc="lower right", fontsize=8)
+    ax.set_title(f"overview of {times[-1]:.0f} s: {summary}", fontsize=9)
+    ax.legend(loc="lower left", fontsize=8)
 
 
 def plot_board(tracks, path, readings=None) -> None:
@@ -126,6 +175,7 @@ def save_time_figure(fig, axes, path) -> None:
     import matplotlib.pyplot as plt
 
     axes[-1, 0].set(xlabel="time [s]")
+    axes[-1, 0].set_xlim(left=0.0)  # the recording starts at 0 s, not at its first frame
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)

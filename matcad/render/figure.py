@@ -17,4 +17,5 @@ def figure(path: Path, width_in: float, height_in: float, **subplot_kw):
     fig = Figure(figsize=(width_in, height_in), dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
     yield fig
-    fig.savefig(path, format="png", dpi=DPI, metadata={"Software": None})
+    # tight: a title or label longer than the figure widens the picture instead of being clipped at its edge
+    fig.savefig(path, format="png", dpi=DPI, metadata={"Software": None}, bbox_inches="tight", pad_inches=0.06)

@@ -13,6 +13,17 @@ BAND_PNG = "plot_band.png"
 LOAD_PNG = "plot_load.png"
 
 
+def chosen_model_status(p: dict) -> str:
+    """'' when the prediction's chosen model holds for this design; else "chosen model NAME invalid (failed
+    checks)". The one phrase the report's headline, the build's verdict line and the band chart share, so that a
+    headline never says "pass" while the chart marks the chosen model invalid."""
+    m = p.get("models", {}).get(p.get("model"))
+    if m is None or m.get("valid", True):
+        return ""
+    failed = ", ".join(k for k, ok in m.get("checks", {}).items() if not ok)
+    return f"chosen model {p['model']} invalid" + (f" ({failed})" if failed else "")
+
+
 def band_plot(p: dict, path: Path) -> dict:
     """Every model's f0, the chosen band, and each budget line's shift (Hz) as a bar from f0."""
     lines = p["budget"]
@@ -34,7 +45,9 @@ def band_plot(p: dict, path: Path) -> dict:
         ax.axvline(f0, color="#333333", linewidth=0.8, linestyle=":")
         ax.set_yticks(range(len(labels)), labels, fontsize=8)
         ax.set_xlabel("frequency [Hz]")
-        ax.set_title(f"f0 = {f0:.0f} Hz ({p['model']}), band {lo:.0f}–{hi:.0f} Hz", fontsize=10)
+        status = chosen_model_status(p)
+        ax.set_title(f"f0 = {f0:.0f} Hz ({p['model']}), band {lo:.0f}–{hi:.0f} Hz" + (f"\n{status}" if status else ""),
+                     fontsize=10, color="#a03000" if status else "black")
         ax.grid(axis="x", alpha=0.3)
     return {"part": "prediction", "file": path.name, "caption": "models, band and uncertainty budget"}
 

@@ -181,13 +181,20 @@ def flat_preview(plan, path: Path) -> dict:
         for outline in plan.outlines:
             ax.add_patch(_rounded_rect(*outline))
         labelled = set()
+        sizes: dict = {}
+        for c in plan.circles:
+            sizes.setdefault(c.purpose, set()).add(c.finished_diameter)
         for c in plan.circles:
             ax.add_patch(Circle((c.x, c.y), c.diameter / 2, fill=False, edgecolor=FLAT_COLOURS["hole"],
                                 linewidth=1.0))
-            if (c.purpose, c.finished_diameter) not in labelled and c.x <= plan.outlines[0][2]:
-                labelled.add((c.purpose, c.finished_diameter))
-                ax.annotate(f"{c.purpose} Ø{c.finished_diameter:g}", (c.x, c.y + c.diameter / 2), fontsize=7,
-                            xytext=(0, 4), textcoords="offset points", ha="center", color="#102080")
+            graded = len(sizes[c.purpose]) > 2  # a coupon's row of sizes: one label per row, the sizes engraved
+            key = c.purpose if graded else (c.purpose, c.finished_diameter)
+            if key not in labelled and c.x <= plan.outlines[0][2]:
+                labelled.add(key)
+                text = (f"{c.purpose} Ø{min(sizes[c.purpose]):g}–{max(sizes[c.purpose]):g}" if graded
+                        else f"{c.purpose} Ø{c.finished_diameter:g}")
+                ax.annotate(text, (c.x, c.y + c.diameter / 2), fontsize=7, xytext=(0, 4), textcoords="offset points",
+                            ha="left" if graded else "center", color="#102080")
         for t in plan.texts:
             ax.text(t.x, t.y, t.text, fontsize=7, color=FLAT_COLOURS["engrave"])
         if plan.reference_square:
