@@ -75,3 +75,30 @@ def test_segment_list_is_summarised_past_twelve():
     lines = analysis(40).segments_text()
     assert len(lines) == 1 + 2 * SEGMENTS_END + 1
     assert "30 more segments" in lines[SEGMENTS_END + 1] and "1505.00-1534.00 Hz" in lines[SEGMENTS_END + 1]
+
+
+def test_overview_axes_start_at_zero(tmp_path):
+    """The overview's frequency and force axes start at 0 (Hz, N) and the time axis at 0 s, whatever the first
+    frame's time; its title sums up the segments and the forces."""
+    from types import SimpleNamespace
+
+    from matplotlib.figure import Figure
+
+    from matcad.loop.plots import overview, save_time_figure
+    from matcad.loop.segments import Segment
+
+    times = np.arange(0.05, 90.0, 0.1)
+    track = 1500.0 + 50.0 * np.sin(times / 7.0)
+    a = SimpleNamespace(times_s=times, voiced=np.ones(times.size, bool), track_hz=track, band_hz=(1300.0, 1800.0),
+                        segments=(Segment(1.0, 2.0, 10, 1510.0, 1510.0, 0.1), Segment(5.0, 6.0, 10, 1540.0, 1540.0, 0.1)))
+    fig = Figure()
+    axes = np.array([[fig.add_subplot(1, 1, 1)]])
+    overview(axes[0, 0], a, force=2.0 + np.cos(times / 5.0))
+    ax = axes[0, 0]
+    twin = [other for other in fig.axes if other is not ax][0]
+    assert ax.get_ylim()[0] == 0.0 and ax.get_ylim()[1] > track.max() and twin.get_ylim()[0] == 0.0
+    assert "2 segments, means 1510-1540 Hz" in ax.get_title() and "force 1.00-3.00 N" in ax.get_title()
+    import matplotlib.pyplot  # noqa: F401 - save_time_figure closes through pyplot
+
+    save_time_figure(fig, axes, tmp_path / "o.png")
+    assert ax.get_xlim()[0] == 0.0

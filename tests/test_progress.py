@@ -70,9 +70,12 @@ def test_sweep_draws_progress_on_a_terminal_and_erases_it(tmp_path):
     assert "matcad: sweep" not in out and "8 variants" in out  # the command's own output stays clean
 
 
-def test_sweep_piped_or_json_prints_no_progress(tmp_path):
+def test_sweep_piped_prints_no_progress(tmp_path):
     code, out, err = piped(*SWEEP, "--out", tmp_path / "a")
     assert code == 0 and ERASE not in err and "variants (" not in err
+
+
+def test_sweep_json_on_a_terminal_prints_no_progress(tmp_path):
     code, out, tty = run_on_pty(*SWEEP, "--out", tmp_path / "b", "--json")
     assert code == 0, tty
     assert ERASE not in tty and "variants (" not in tty
