@@ -102,3 +102,25 @@ def test_overview_axes_start_at_zero(tmp_path):
 
     save_time_figure(fig, axes, tmp_path / "o.png")
     assert ax.get_xlim()[0] == 0.0
+
+
+def test_a_long_title_widens_the_picture_instead_of_being_clipped(tmp_path):
+    """A laser part with a long name: its cut plan's title is wider than the 6 in figure. Saved to the drawn
+    extent, the PNG grows and its outer ring stays blank (saved at the figure size, the title ran off the right
+    edge: 4 dark pixels in the last column, the start of the name cut away)."""
+    import dataclasses
+
+    from matcad import spec as spec_mod
+    from matcad.parts.coupon import coupon_sheets, laser_coupon
+    from matcad.parts.flat import cut_plan
+    from matcad.render.figure import DPI
+    from matcad.render.previews import flat_preview
+
+    spec = spec_mod.load(LASER)
+    flat = dataclasses.replace(laser_coupon(spec, coupon_sheets(spec)[1]),
+                               name="coupon_guide_with_a_long_descriptive_name")
+    flat_preview(cut_plan(flat, True), tmp_path / "p.png")
+    image = mpimg.imread(tmp_path / "p.png")[..., :3]
+    dark = (image < 0.85).any(axis=2)
+    assert image.shape[1] > 6.0 * DPI  # wider than the figure: the whole title is in
+    assert not (dark[0].any() or dark[-1].any() or dark[:, 0].any() or dark[:, -1].any())

@@ -212,3 +212,17 @@ def test_headline_and_band_chart_agree_on_an_invalid_chosen_model(kit, tmp_path)
     finally:
         matplotlib.axes.Axes.set_title = real_title
     assert any(status in t for t in titles)
+
+
+def test_no_picture_is_clipped_at_its_edge(kit):
+    """Every PNG of the kit has a blank outer ring of pixels: no caption, title or label runs off the picture
+    (figures are saved to their drawn extent, matcad.render.figure)."""
+    import matplotlib.image as mpimg
+
+    _, out, report = kit
+    for fig in report["figures"]:
+        if not fig["file"].endswith(".png"):
+            continue
+        dark = (mpimg.imread(out / fig["file"])[..., :3] < 0.85).any(axis=2)
+        ring = {"top": dark[0].sum(), "bottom": dark[-1].sum(), "left": dark[:, 0].sum(), "right": dark[:, -1].sum()}
+        assert not any(ring.values()), f"{fig['file']}: ink at the edge {ring}"
