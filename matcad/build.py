@@ -89,9 +89,17 @@ class BuildResult:
         lines += [f"{t['name']} at ({t['x_mm']:g}, {t['y_mm']:g}) mm: f0 = {t['f0_hz']:.0f} Hz ({t['model']}), band "
                   f"{t['unloaded_hz'][0]:.0f}-{t['unloaded_hz'][1]:.0f} Hz, loaded to {t['max_force_n']:g} N "
                   f"{t['loaded_hz'][0]:.0f}-{t['loaded_hz'][1]:.0f} Hz" for t in board or ()]
+        from matcad.render.plots import chosen_model_status
+
+        status = "" if board else chosen_model_status(self.report["prediction"])
         lines.append((f"{len(board)} taxels" if board else f"f0 = {p.f0_hz:.0f} Hz ({p.model}), band "
-                      f"{p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz") + f"; verdict {self.report['verdict']}")
-        lines.append(findings_text([f for f in self.findings if f.level != "info"]))
+                      f"{p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz") + f"; verdict {self.report['verdict']}"
+                     + (f" (design rules); {status}" if status else ""))
+        found = findings_text([f for f in self.findings if f.level != "info"])
+        lines += [found] if found else []
+        first = next((f for f in ("report.html", "report.md", "report.json") if f in self.files), None)
+        if first:  # the last line: where a person starts reading the kit
+            lines.append(f"open first: {self.out_dir / first}")
         return "\n".join(lines)
 
 
@@ -241,8 +249,18 @@ def board_report(spec, board, predictions) -> list[dict]:
              "prediction": p.to_dict()} for t, p in zip(board, predictions)]
 
 
-def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult:
-    """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``."""
+BUILD_STAGES = 8
+"""The stages :func:`build` reports to its ``progress`` callback: predictions, rules and bands, laser parts, sheets,
+solids, print job, figures, report and archive."""
+
+
+def build(spec, out_dir: Path | None = None, force: bool = False, progress=None) -> BuildResult:
+    """Build ``spec`` into ``out_dir`` (default out/<name>). Raises DesignRuleFailure unless ``force``.
+    ``progress(stages done, stages)`` (:mod:`matcad.progress`) is told as each of :data:`BUILD_STAGES` ends."""
+    def stage(k: int) -> None:
+        if progress is not None:
+            progress(k, BUILD_STAGES)
+
     from matcad.parts.mold_layout import layout
     from matcad.render.bands import BANDS_PNG, band_chart
     from matcad.render.kit import render_figures
@@ -252,20 +270,27 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
     board = taxels(spec)
     predictions = [predict(taxel_spec(spec, t)) for t in board]
     prediction = predictions[0]
+    stage(1)
     findings = check(spec, prediction if len(board) == 1 else None)
     failure = DesignRuleFailure(findings, forced=force)
     if failure.blocking:
         raise failure
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
     bands = board_bands(spec)
+    stage(2)
     with staged_output(target) as tmp:
         flats = laser_parts(spec)
         plans = [cut_plan(flat, spec.outputs.reference_square) for flat in flats]
         holes = _write_laser(plans, tmp)
+        stage(3)
         sheets = write_sheets(plans, spec, tmp)
+        stage(4)
         meshes = _write_solids(spec, tmp) if needs_cad_kernel(spec) else {}
+        stage(5)
         job = write_print_job(spec, tmp, meshes) if meshes else None
+        stage(6)
         figures = render_figures(spec, prediction, tmp, meshes, plans) + [band_chart(bands, tmp / BANDS_PNG)]
+        stage(7)
         mold = layout(spec) if spec.outputs.end_cap_mold else None
         report = make_report(spec, prediction, findings, holes, meshes, tmp, flats=flats, mold=mold, job=job) | {
             "figures": figures, "bands": bands, "sheets": sheets, "print_job": job}
@@ -273,6 +298,7 @@ def build(spec, out_dir: Path | None = None, force: bool = False) -> BuildResult
             report["taxels"] = board_report(spec, board, predictions)
         write_report(report, tmp)
         write_archive(tmp, KIT_ARCHIVE)
+        stage(8)
     files = tuple(sorted(p.name for p in target.iterdir() if p.name != MANIFEST))
     return BuildResult(target, files, tuple(findings), prediction, report)
 
@@ -304,5 +330,30 @@ def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
                  "printed_holes": [{"purpose": h.purpose, "x_mm": h.x, "y_mm": h.y, "diameter_mm": h.diameter,
                                     "theta_deg": spec.needle.theta_deg if h.purpose == "needle" else 90.0}
                                    for h in printed_coupon_holes(spec)]}
-        (tmp / "report.json").write_text(json.dumps(table, indent=2) + "\n", encoding="utf-8")
+        table["figures"] = coupon_previews(spec, coupons, tmp)
+        write_coupon_report(table, tmp)
     return target, table
+
+
+def coupon_previews(spec, coupons, folder: Path) -> list[dict]:
+    """The coupons' pictures: each laser sheet's cut plan and the printed coupon (the needle mounts are the same
+    block with other bores)."""
+    from matcad.render.previews import flat_preview, preview_name, printed_preview
+
+    figures = [flat_preview(cut_plan(flat, spec.outputs.reference_square), folder / preview_name(flat.name))
+               for flat in coupons]
+    return figures + [printed_preview("coupon_printed", folder / "coupon_printed.stl",
+                                      folder / preview_name("coupon_printed"))]
+
+
+def write_coupon_report(table: dict, folder: Path) -> None:
+    """report.json, report.md and report.html of a coupon kit (:mod:`matcad.report.coupon`)."""
+    import json
+
+    from matcad.report.coupon import coupon_markdown
+    from matcad.report.page import render_html
+
+    text = coupon_markdown(table)
+    (folder / "report.json").write_text(json.dumps(table, indent=2) + "\n", encoding="utf-8")
+    (folder / "report.md").write_text(text, encoding="utf-8")
+    (folder / "report.html").write_text(render_html(text, f"{table['name']} coupons"), encoding="utf-8")

@@ -70,6 +70,9 @@ def test_missing_file(tmp_path):
 def test_schema_text_and_json():
     code, out, _ = run_cli("schema")
     assert code == 0 and "cavity.diameter [mm]" in out
-    code, out, _ = run_cli("schema", "--json")
+    code, out, _ = run_cli("schema", "--json")  # a JSON Schema now (tests/test_json_schema.py); rows with --rows
+    schema = json.loads(out)
+    assert "mount" in schema["properties"]["neck"]["properties"]["mouth"]["enum"]
+    code, out, _ = run_cli("schema", "--json", "--rows")
     rows = json.loads(out)
     assert any(r["key"] == "neck.mouth" and "mount" in r["allowed"] for r in rows)

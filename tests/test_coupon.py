@@ -242,3 +242,22 @@ def test_every_printed_coupon_hole_has_its_size_recessed_next_to_it(coupons, tmp
     assert removed == pytest.approx(total * PRINTED_ENGRAVE_MM, rel=1e-2)
     print(f"labels {len(holes)}, glyph area {total:.3f} mm², removed {removed:.3f} mm³, "
           f"expected {total * PRINTED_ENGRAVE_MM:.3f} mm³")
+
+
+def test_coupon_kit_has_previews_and_a_report_that_names_every_hole(coupons):
+    """coupon writes a picture per laser sheet and of the printed coupon, and report.md/.html listing every hole
+    of report.json (the same finished sizes) with those pictures."""
+    import matplotlib.image as mpimg
+
+    _, folder = coupons
+    table = json.loads((folder / "report.json").read_text())
+    files = [f["file"] for f in table["figures"]]
+    assert sorted(files) == sorted(f"preview_{name}.png" for name in [*table["sheets"], "coupon_printed"])
+    for name in files:
+        image = mpimg.imread(folder / name)[..., :3]
+        assert image.shape[0] > 100 and (image < 0.5).mean() > 0.002  # drawn, not blank
+    md = (folder / "report.md").read_text()
+    for hole in table["laser_holes"]:
+        assert f"| {hole['part']} | {hole['purpose']} | {hole['finished_mm']:.3g} |" in md
+    html = (folder / "report.html").read_text()
+    assert all(f'src="{name}"' in html for name in files) and "@media print" in html

@@ -92,7 +92,10 @@ def test_cli_writes_a_spec_predict_agrees_with(tmp_path):
                                 "--json")
     assert code == 0, err
     data = json.loads(stdout)
-    assert sorted(p.name for p in out.iterdir()) == sorted([MANIFEST, "design.json", data["name"] + ".toml"])
+    # the picture is new: the target, f0 along the varied field and the solved section (plot_design.png)
+    assert sorted(p.name for p in out.iterdir()) == sorted([MANIFEST, "design.json", data["name"] + ".toml",
+                                                            "plot_design.png"])
+    assert data["written"][-1] == "plot_design.png"
     code, stdout, err = run_cli("predict", out / f"{data['name']}.toml", "--json")
     assert code == 0, err
     assert abs(json.loads(stdout)["f0_hz"] / 5500 - 1) < 0.005
@@ -158,6 +161,7 @@ def test_taxels_bands_are_disjoint_inside_the_band_and_check_accepts(tmp_path, w
     bands = taxel_bands(written)  # recomputed from the written file, not the designer's numbers
     assert conflicts(bands, guard_hz(written.microphone.sample_rate_hz)) == []
     assert all(3500 <= b.loaded_hz[0] < b.loaded_hz[1] <= 6500 for b in bands)
+    assert "plot_taxel_bands.png" in data["written"] and (out / "plot_taxel_bands.png").stat().st_size > 5000
     assert [round(b.loaded_hz[1]) for b in bands] == [round(t["loaded_hz"][1]) for t in data["taxels"]]
     code, stdout, err = run_cli("check", out / f"{data['name']}.toml", "--json")
     assert code == 0, stdout + err

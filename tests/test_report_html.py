@@ -142,3 +142,87 @@ def test_section_is_labelled_and_dimensioned_to_scale(kit):
     plate = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "neck_plate")
     ys = [float(v) for p in plate for v in re.findall(r"[-\d.]+,([-\d.]+)", p.get("d"))]
     assert max(ys) - min(ys) == pytest.approx(spec.neck.length, abs=1e-6)
+
+
+def test_printed_report_keeps_captions_with_their_pictures(kit, tmp_path):
+    """report.html printed to PDF by headless Chromium: every raster picture lands on the page of its caption
+    (no heading orphaned at a page's foot), and the pages stay few (mat-paper: 18 before the print stylesheet)."""
+    import shutil
+    import subprocess
+
+    from tests.browser import CHROMIUM, _missing
+
+    if not (shutil.which("pdfinfo") and shutil.which("pdftotext") and shutil.which("pdfimages")):
+        _missing("poppler-utils (pdfinfo, pdftotext, pdfimages) missing")
+    if not shutil.which(CHROMIUM) and not (CHROMIUM and __import__("os").path.exists(CHROMIUM)):
+        _missing("chromium missing")
+    _, out, report = kit
+    pdf = tmp_path / "report.pdf"
+    subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+                    f"--user-data-dir={tmp_path / 'profile'}", f"--print-to-pdf={pdf}", (out / "report.html").as_uri()],
+                   capture_output=True, timeout=120, check=True)
+    info = subprocess.run(["pdfinfo", str(pdf)], capture_output=True, text=True, check=True).stdout
+    pages = int(re.search(r"^Pages:\s+(\d+)", info, flags=re.M).group(1))
+    assert pages <= 10, pages
+    listed = subprocess.run(["pdfimages", "-list", str(pdf)], capture_output=True, text=True, check=True).stdout
+    image_pages = [int(line.split()[0]) for line in listed.splitlines()[2:]
+                   if line.split() and line.split()[2] == "image"]
+    texts = [subprocess.run(["pdftotext", "-f", str(k), "-l", str(k), "-layout", str(pdf), "-"], capture_output=True,
+                            text=True, check=True).stdout for k in range(1, pages + 1)]
+    raster = [f for f in report["figures"] if f["file"].endswith(".png")]
+    assert len(image_pages) >= len(raster)
+    for fig, page in zip(raster, image_pages):  # pictures are drawn in report order
+        head = " ".join(fig["caption"].split()[:3])
+        assert head in " ".join(texts[page - 1].split()), f"{fig['caption']!r} not on page {page} with its picture"
+
+
+def test_headline_and_band_chart_agree_on_an_invalid_chosen_model(kit, tmp_path):
+    """The report's headline and the band chart's title say the same of the chosen model: nothing when it holds;
+    when it fails its checks (the report data with the chosen model's check failed, as mat-sla-array's
+    elastic_wall does), both carry the same "chosen model NAME invalid (check)" and the verdict is named as the
+    design rules'."""
+    import copy
+
+    from matcad.render.plots import band_plot, chosen_model_status
+    from matcad.report.page import render_markdown
+
+    _, out, report = kit
+    head = render_markdown(report).splitlines()[2]
+    assert head.startswith("**Verdict: ") and "invalid" not in head
+    bad = copy.deepcopy(report)
+    p = bad["prediction"]
+    chosen = p["models"].setdefault(p["model"], {"f0_hz": p["f0_hz"], "checks": {}})
+    chosen.update(valid=False, checks={**chosen.get("checks", {}), "no_wall_mode_near_f": False})
+    status = chosen_model_status(p)
+    assert status.startswith(f"chosen model {p['model']} invalid (") and "no_wall_mode_near_f" in status
+    head = render_markdown(bad).splitlines()[2]
+    assert "(design rules)" in head and status in head
+    import matplotlib
+
+    titles = []
+    real_title = matplotlib.axes.Axes.set_title
+
+    def spy(self, text, *args, **kw):
+        titles.append(text)
+        return real_title(self, text, *args, **kw)
+
+    matplotlib.axes.Axes.set_title = spy
+    try:
+        band_plot(p, tmp_path / "band.png")
+    finally:
+        matplotlib.axes.Axes.set_title = real_title
+    assert any(status in t for t in titles)
+
+
+def test_no_picture_is_clipped_at_its_edge(kit):
+    """Every PNG of the kit has a blank outer ring of pixels: no caption, title or label runs off the picture
+    (figures are saved to their drawn extent, matcad.render.figure)."""
+    import matplotlib.image as mpimg
+
+    _, out, report = kit
+    for fig in report["figures"]:
+        if not fig["file"].endswith(".png"):
+            continue
+        dark = (mpimg.imread(out / fig["file"])[..., :3] < 0.85).any(axis=2)
+        ring = {"top": dark[0].sum(), "bottom": dark[-1].sum(), "left": dark[:, 0].sum(), "right": dark[:, -1].sum()}
+        assert not any(ring.values()), f"{fig['file']}: ink at the edge {ring}"

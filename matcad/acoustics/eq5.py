@@ -230,14 +230,19 @@ class Eq5:
     def to_toml(self, table: str = "calibration") -> str:
         """A [calibration] table that a spec accepts as it is (``table`` "taxel.calibration": the same fields as
         one [[taxel]] entry's sub-table)."""
-        cov = ", ".join(repr(float(x)) for x in self.covariance)
-        return (f"# written by `matcad calibrate`: paper Eq. 5, V_eff = v0 - a F^2 - b F\n[{table}]\n"
-                f"v0_mm3 = {self.v0_mm3!r}\na = {self.a!r}\nb = {self.b!r}\narea_convention = \"pi_d2/4\"\n"
-                f"k_mm3_hz2 = {self.k_mm3_hz2!r}\nforce_range_n = [{self.force_range_n[0]!r}, "
-                f"{self.force_range_n[1]!r}]\ncovariance = [{cov}]\n"
-                f"residual_std_mm3 = {self.residual_std_mm3!r}\ndof = {self.dof}\n"
-                f"cycle_std_mm3 = {self.cycle_std_mm3!r}\n"
-                + (f"temperature_c = {self.temperature_c!r}\n" if self.temperature_c is not None else ""))
+        import tomli_w  # the TOML writer the project depends on: quoting, floats and nesting done right
+
+        given = {"v0_mm3": self.v0_mm3, "a": self.a, "b": self.b, "area_convention": "pi_d2/4",
+                 "k_mm3_hz2": self.k_mm3_hz2, "force_range_n": self.force_range_n, "covariance": self.covariance,
+                 "residual_std_mm3": self.residual_std_mm3, "dof": self.dof, "cycle_std_mm3": self.cycle_std_mm3,
+                 "temperature_c": self.temperature_c}
+        fields = {k: (v if isinstance(v, str) else int(v) if k == "dof" else
+                      [float(x) for x in v] if isinstance(v, (tuple, list)) or hasattr(v, "__len__") else float(v))
+                  for k, v in given.items() if v is not None}
+        nested: dict = fields
+        for key in reversed(table.split(".")):
+            nested = {key: nested}
+        return "# written by `matcad calibrate`: paper Eq. 5, V_eff = v0 - a F^2 - b F\n" + tomli_w.dumps(nested)
 
 
 MAT_PAPER_2024 = Eq5(v0_mm3=32.21, a=-0.0086, b=0.4626, area_convention="d2/4", name="mat-paper-2024")

@@ -53,9 +53,12 @@ def run(args) -> int:
     from matcad.loop.plots import plot
     from matcad.output import staged_output
 
+    from matcad.progress import line
+
     listening = band(args, spec)
-    blocks, fs, name = recording_blocks(args)
-    result = analyze_stream(blocks, fs, [listening])[0]
+    with line("analyze", "s of recording", quiet=args.json) as progress:
+        blocks, fs, name = recording_blocks(args, progress)
+        result = analyze_stream(blocks, fs, [listening])[0]
     target = loop_output(args, "analyze", name)
     with staged_output(target) as tmp:
         outputs.write_track_csv(result, tmp / "track.csv")
@@ -77,9 +80,12 @@ def _board(args, spec) -> int:
     from matcad.output import staged_output
     from matcad.prediction.bands import listening_bands
 
+    from matcad.progress import line
+
     named_bands = listening_bands(spec)
-    blocks, fs, name = recording_blocks(args)
-    tracks = board.analyze_board(blocks, fs, named_bands)
+    with line("analyze", "s of recording", quiet=args.json) as progress:
+        blocks, fs, name = recording_blocks(args, progress)
+        tracks = board.analyze_board(blocks, fs, named_bands)
     target = loop_output(args, "analyze", name)
     report = {"recording": name, "taxels": board.taxels_dict(tracks)}
     with staged_output(target) as tmp:

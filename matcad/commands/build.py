@@ -18,12 +18,14 @@ def arguments(cmd) -> None:
 
 def run(args) -> int:
     from matcad.build import DesignRuleFailure, build
+    from matcad.progress import line
 
     spec = load_spec(args.spec, args)
     try:
         if spec.kind == "tube":
             return _tube(spec, args)
-        result = build(spec, out_dir=args.out, force=args.force)
+        with line(f"build {spec.name}", "stages", quiet=args.json) as progress:
+            result = build(spec, out_dir=args.out, force=args.force, progress=progress)
     except DesignRuleFailure as exc:
         if args.json:
             print_json(exc.to_dict())

@@ -80,20 +80,38 @@ def recording_arguments(cmd) -> None:
     cmd.add_argument("--channels", type=int, default=1, help="raw PCM channels (default 1), averaged")
 
 
-def recording_blocks(args):
-    """(sample blocks, rate Hz, name) of the recording argument: a WAV file read in blocks, or '-' for standard
-    input (WAV, or raw PCM with --format/--rate)."""
-    from matcad.loop import wav
+def recording_blocks(args, progress=None):
+    """(sample blocks, rate Hz, name) of the recording argument: a WAV file read in blocks, a FLAC/OGG file
+    (the optional extra ``matcad[audio]``), or '-' for standard input (WAV, or raw PCM with --format/--rate).
+    ``progress(seconds read, seconds)`` (:mod:`matcad.progress`) is told as blocks are read (seconds unknown on
+    standard input)."""
+    from matcad.loop import audio, wav
 
     if str(args.recording) == "-":
         stream = sys.stdin.buffer
         info = wav.stream_info(stream, getattr(args, "rate", None), getattr(args, "format", None),
                                getattr(args, "channels", 1))
-        return wav.iter_stream(stream, info), info.sample_rate_hz, "standard input"
+        return _told(wav.iter_stream(stream, info), info.sample_rate_hz, None, progress), info.sample_rate_hz, \
+            "standard input"
     if getattr(args, "format", None):
         raise ValueError("--format/--rate describe raw PCM on standard input: give the recording as '-'")
-    info = wav.read_info(args.recording)
-    return wav.iter_blocks(args.recording, info), info.sample_rate_hz, str(args.recording)
+    reader = audio if audio.compressed(args.recording) else wav
+    info = reader.read_info(args.recording)
+    blocks = reader.iter_blocks(args.recording, info) if reader is wav else reader.iter_blocks(args.recording)
+    return (_told(blocks, info.sample_rate_hz, info.frames / info.sample_rate_hz, progress), info.sample_rate_hz,
+            str(args.recording))
+
+
+def _told(blocks, rate_hz: float, total_s, progress):
+    """``blocks`` as they are, telling ``progress`` the seconds of recording read so far."""
+    if progress is None:
+        yield from blocks
+        return
+    frames = 0
+    for block in blocks:
+        yield block
+        frames += len(block)
+        progress(round(frames / rate_hz), None if total_s is None else round(total_s))
 
 
 def loop_output(args, kind: str, source: str) -> Path:

@@ -9,7 +9,8 @@ HELP = "test coupons sweeping neck, dowel and needle-bore sizes"
 OUT = "out/<name>-coupon"
 WRITTEN = ("coupon_<sheet>.dxf/.svg, one per sheet with its kerf (engraved sizes), coupon_printed.stl/.step (needle "
            "bores at theta and dowel holes, ascending left to right), needle_mount_y*.stl (y sweep, notches on +x) "
-           "and needle_mount_theta*.stl (theta sweep, notches on -x); report.json lists which is which")
+           "and needle_mount_theta*.stl (theta sweep, notches on -x), preview_*.png; report.json, report.md and "
+           "report.html list which is which")
 
 
 def arguments(cmd) -> None:
@@ -20,5 +21,8 @@ def run(args) -> int:
     from matcad.build import build_coupon
 
     target, table = build_coupon(load_spec(args.spec, args), out_dir=args.out)
-    print_json({"out_dir": str(target), **table}) if args.json else print(f"coupons in {target}/: {WRITTEN}")
+    if args.json:
+        print_json({"out_dir": str(target), **table})
+    else:
+        print(f"coupons in {target}/: {WRITTEN}\nopen first: {target / 'report.html'}")
     return EXIT_OK

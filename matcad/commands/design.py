@@ -81,10 +81,21 @@ def run(args) -> int:
         return EXIT_RULES
     target = args.out or Path("out") / f"{result.spec.name}-design"
     report = {"source": str(args.spec), **result.to_dict()}
-    write_design(target, result.spec, report, f"written by `matcad design` from {args.spec}")
+    files = write_design(target, result.spec, report, f"written by `matcad design` from {args.spec}",
+                         picture=lambda folder: picture(spec, result, folder))
     if args.json:
-        print_json({**report, "out_dir": str(target), "spec_file": str(target / f"{result.spec.name}.toml")})
+        print_json({**report, "out_dir": str(target), "spec_file": str(target / f"{result.spec.name}.toml"),
+                    "written": files})
     else:
         print(result.to_text())
-        print(f"  {result.spec.name}.toml and design.json in {target}/")
+        print(f"  {', '.join(files)} in {target}/")
     return EXIT_OK
+
+
+def picture(start, result, folder: Path) -> str:
+    """The design's picture in ``folder``: a solved taxel's f0 curve and section, or an array's band chart."""
+    from matcad.design.picture import allocation_chart, solution_plot
+
+    if hasattr(result, "bands"):
+        return allocation_chart(result, folder)
+    return solution_plot(start, result, folder)

@@ -36,13 +36,19 @@ def run(args) -> int:
     if is_array(spec):
         from matcad.prediction.board import predict_board
 
-        result = predict_board(spec, forces, args.model, args.fem_level)
+        from matcad.progress import line
+
+        with line(f"predict {spec.name}", "taxels", quiet=args.json) as progress:
+            result = predict_board(spec, forces, args.model, args.fem_level, progress)
         print_json(result.to_dict()) if args.json else print(result.to_text())
         return EXIT_OK
     from matcad.acoustics.design import design
     from matcad.prediction import predict
 
-    result = predict(spec, forces_n=forces, model=args.model, fem_level=args.fem_level)
+    from matcad.progress import line
+
+    with line(f"predict {spec.name}", "steps", quiet=args.json) as progress:
+        result = predict(spec, forces_n=forces, model=args.model, fem_level=args.fem_level, progress=progress)
     print_json(result.to_dict()) if args.json else print(result.to_text(spec.name, design(spec)))
     return EXIT_OK
 

@@ -47,9 +47,12 @@ def run(args) -> int:
     cal = sensing_law(load_calibration(args.calibration[0]))
     cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
     band = listening_band_hz(cal)
-    blocks, fs, name = recording_blocks(args)
+    from matcad.progress import line
+
     on_frame = live.taxel_printer(cal, args.temperature_c, partial(print, flush=True)) if args.live else None
-    result = analyze_stream(blocks, fs, [band], on_frame)[0]
+    with line("sense", "s of recording", quiet=args.json or args.live) as progress:  # --live prints its own lines
+        blocks, fs, name = recording_blocks(args, progress)
+        result = analyze_stream(blocks, fs, [band], on_frame)[0]
     reading = sense(result, cal, args.temperature_c)
     target = loop_output(args, "sense", name) if not (args.live and args.out is None) else None
     if target is not None:
@@ -84,10 +87,13 @@ def _board(args, spec) -> int:
     cals = {n: sensing_law(cal) for n, (_, cal) in given.items()}
     for cal in cals.values():
         cal.temperature_factor(args.temperature_c)  # bad temperature: exit 2 before reading anything
-    blocks, fs, name = recording_blocks(args)
+    from matcad.progress import line
+
     on_frame = live.board_printer(names, cals, args.temperature_c, partial(print, flush=True)) if args.live else None
     try:
-        tracks = board.analyze_board(blocks, fs, named_bands, on_frame)
+        with line("sense", "s of recording", quiet=args.json or args.live) as progress:
+            blocks, fs, name = recording_blocks(args, progress)
+            tracks = board.analyze_board(blocks, fs, named_bands, on_frame)
     finally:
         if on_frame is not None:
             on_frame.flush()

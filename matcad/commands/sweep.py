@@ -37,6 +37,7 @@ def run(args) -> int:
     from matcad.spec import apply_sets, read_spec_data
     from matcad.sweep import Executor, parse_axes, sweep
     from matcad.output import staged_output
+    from matcad.progress import line
     from matcad.sweep.outputs import TableWriter, write_json, write_maps
 
     lo, hi = WORKERS
@@ -48,10 +49,10 @@ def run(args) -> int:
     spec = load_spec(args.spec, args)  # validates the base spec (exit 2 naming the field) and prints its notes
     executor = Executor(args.workers, args.scheduler)
     target = Path(args.out or Path("out") / f"{spec.name}-sweep")
-    with staged_output(target) as tmp:  # the table streams into it; on any error nothing is left
-        table = TableWriter(tmp, axes, not args.no_rules)
+    with staged_output(target) as tmp, line("sweep", "variants", quiet=args.json) as progress:
+        table = TableWriter(tmp, axes, not args.no_rules)  # the table streams into tmp; on an error nothing is left
         result = sweep(data, axes, model=args.model, executor=executor, rules=not args.no_rules, cad=args.cad,
-                       fem_level=args.fem_level, sink=table)
+                       fem_level=args.fem_level, sink=table, progress=progress)
         files = table.close() + write_json(result, tmp) + write_maps(result, tmp)
     if args.json:
         print_json(result.summary_dict(target, files))

@@ -23,9 +23,10 @@ def spec_toml(spec, header: str = "") -> str:
     return comments + tomli_w.dumps(plain(to_dict(spec)))
 
 
-def write_design(target, spec, report: dict, header: str) -> None:
-    """``<name>.toml`` (the designed spec) and ``design.json`` (``report``) into the folder ``target``, through
-    :func:`matcad.output.staged_output`: the folder appears complete or not at all."""
+def write_design(target, spec, report: dict, header: str, picture=None) -> list[str]:
+    """``<name>.toml`` (the designed spec), ``design.json`` (``report``) and, with ``picture`` (a function of the
+    folder returning the file it drew), a PNG into the folder ``target``, through
+    :func:`matcad.output.staged_output`: the folder appears complete or not at all. Returns the files' names."""
     import json
 
     from matcad.output import staged_output
@@ -33,3 +34,5 @@ def write_design(target, spec, report: dict, header: str) -> None:
     with staged_output(target) as tmp:
         (tmp / f"{spec.name}.toml").write_text(spec_toml(spec, header), encoding="utf-8")
         (tmp / "design.json").write_text(json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+        drawn = [picture(tmp)] if picture is not None else []
+    return [f"{spec.name}.toml", "design.json", *drawn]

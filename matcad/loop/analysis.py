@@ -88,9 +88,32 @@ class Analysis:
 
     def segments_text(self, forces=None, heading: bool = True) -> list[str]:
         """Lines: how many steady segments (``heading``), then one per segment (:meth:`Segment.to_text`), with its
-        force when ``forces`` (per segment: force, low, high in N) is given."""
-        lines = [f"  {len(self.segments)} steady segments:"] if heading else []
-        return lines + [s.to_text(None if forces is None else forces[i]) for i, s in enumerate(self.segments)]
+        force when ``forces`` (per segment: force, low, high in N) is given. More than :data:`SEGMENTS_SHOWN`
+        (a long recording): the first and last :data:`SEGMENTS_END` and one summary line between them (how many
+        are left out, their frequency range, durations and flags); segments.csv keeps every one."""
+        segs = self.segments
+        lines = [f"  {len(segs)} steady segments:"] if heading else []
+
+        def line(i: int) -> str:
+            return segs[i].to_text(None if forces is None else forces[i])
+
+        if len(segs) <= SEGMENTS_SHOWN:
+            return lines + [line(i) for i in range(len(segs))]
+        hidden = segs[SEGMENTS_END:-SEGMENTS_END]
+        means = [s.mean_hz for s in hidden]
+        lengths = sorted(s.end_s - s.start_s for s in hidden)
+        flagged = sum(bool(s.flag) for s in hidden)
+        summary = (f"  ... {len(hidden)} more segments, {hidden[0].start_s:.2f}-{hidden[-1].end_s:.2f} s: mean "
+                   f"{min(means):.2f}-{max(means):.2f} Hz, {lengths[len(lengths) // 2]:.2f} s long (median), "
+                   f"{flagged} flagged; every segment in segments.csv")
+        return (lines + [line(i) for i in range(SEGMENTS_END)] + [summary]
+                + [line(i) for i in range(len(segs) - SEGMENTS_END, len(segs))])
+
+
+SEGMENTS_SHOWN = 12
+"""At most this many segment lines on standard output; a longer list is summarised (:meth:`segments_text`)."""
+SEGMENTS_END = 5
+"""Segments shown at each end of a summarised list."""
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,13 @@ PLOT_COLUMNS = 1200
 SPECTROGRAM_PX = (800, 320)
 """Width of the spectrogram picture and height of each of its panels (px)."""
 SPECTROGRAM_BOX = (85, 35, 785, 315)
-"""The spectrogram's axes in the picture (left, top, right, bottom px): a reader can map a pixel to (s, Hz)."""
+"""The spectrogram's axes in the picture (left, top, right, bottom px; one panel lower under a long recording's
+overview): a reader can map a pixel to (s, Hz), the time axis starting at 0 s."""
+OVERVIEW_S = 60.0
+"""A recording longer than this (s) gets an overview panel above its spectrogram: at 10 min the spectrogram alone
+is a strip of hundreds of segments."""
+OVERVIEW_WINDOWS = 60
+"""The overview's time windows: the median voiced frequency (and force) per window, with its spread."""
 
 
 class PlotPool:
@@ -52,15 +58,21 @@ def plot(analysis, path, forces=None) -> None:
     :mod:`matcad.canvas` (Pillow), not matplotlib: `analyze` stays near the cost of its tracker."""
     from matcad.canvas import Canvas, colour_map
 
-    rows = 2 if forces is not None else 1
+    long = len(analysis.times_s) > 0 and analysis.times_s[-1] > OVERVIEW_S
+    rows = 1 + (forces is not None) + long
     width, panel = SPECTROGRAM_PX
     canvas = Canvas(width, panel * rows + 45)
     t = analysis.plot_times_s
-    xlim = (float(t[0]), float(t[-1])) if len(t) > 1 and t[-1] > t[0] else (0.0, max(float(t[0]) if len(t) else 1.0, 1e-3))
+    xlim = (0.0, max(float(t[-1]) if len(t) else 1.0, 1e-3))  # the recording starts at 0 s, not at its first frame
+    left, top, right, bottom = SPECTROGRAM_BOX
+    if long:
+        overview(canvas, SPECTROGRAM_BOX, analysis, None if forces is None else forces[0])
+        top, bottom = top + panel, bottom + panel
     db = analysis.plot_db
     freqs = analysis.plot_freqs_hz
-    ax = canvas.axes(SPECTROGRAM_BOX, xlim, (float(freqs[0]), float(freqs[-1])))
-    ax.image(colour_map(db[::-1], float(np.percentile(db, 5)), float(db.max())))
+    ax = canvas.axes((left, top, right, bottom), xlim, (float(freqs[0]), float(freqs[-1])))
+    ax.image(colour_map(db[::-1], float(np.percentile(db, 5)), float(db.max())),
+             (float(t[0]), float(t[-1]), float(freqs[0]), float(freqs[-1])) if len(t) > 1 else None)
     ax.line(analysis.times_s, np.where(analysis.voiced, analysis.track_hz, np.nan), "cyan", 1)
     for s in analysis.segments:
         ax.line([s.start_s, s.end_s], [s.mean_hz, s.mean_hz], "red" if s.flag else "white", 2)
@@ -74,7 +86,6 @@ def plot(analysis, path, forces=None) -> None:
         span = np.concatenate([low[ok], high[ok], force[np.isfinite(force)]]) if ok.any() else np.array([0.0, 1.0])
         lo, hi = float(span.min()), float(span.max())
         pad = 0.05 * (hi - lo) or 0.5
-        left, top, right, bottom = SPECTROGRAM_BOX
         bx = canvas.axes((left, top + panel, right, bottom + panel), xlim, (lo - pad, hi + pad))
         times = analysis.times_s
         for run in np.split(np.arange(len(times)), np.flatnonzero(~ok) + 1):
@@ -88,6 +99,60 @@ def plot(analysis, path, forces=None) -> None:
         bx.frame(xlabel="time [s]", ylabel="force [N]", grid="y")
         bx.legend([("95 % interval", "#b5d0e8", "bar"), ("force per voiced frame", "black", "o")])
     canvas.save(path)
+
+
+def _windowed(times, values, edges):
+    """Per window of ``edges`` (s): the 10th, 50th and 90th percentile of the finite ``values`` (NaN if none)."""
+    out = np.full((len(edges) - 1, 3), np.nan)
+    which = np.digitize(times, edges) - 1
+    for k in range(len(edges) - 1):
+        v = values[(which == k) & np.isfinite(values)]
+        if len(v):
+            out[k] = np.percentile(v, [10, 50, 90])
+    return out
+
+
+def overview(canvas, box, analysis, force=None):
+    """The overview of a long recording in the pixel ``box`` of ``canvas``: per window (:data:`OVERVIEW_WINDOWS`)
+    the median voiced frequency (blue) with its 10-90 % spread on an axis from 0 Hz; with ``force`` (per frame, N)
+    the median force (red) on its own axis from 0 N, scaled into the same box (ticks on the right); a summary of the
+    segments and forces in the title. Returns the frequency axes, the force axes (or None) and the title."""
+    times = analysis.times_s
+    edges = np.linspace(0.0, float(times[-1]), OVERVIEW_WINDOWS + 1)
+    mids = (edges[:-1] + edges[1:]) / 2
+    hz = _windowed(times, np.where(analysis.voiced, analysis.track_hz, np.nan), edges)
+    top_hz = 1.15 * max(float(np.nanmax(hz[:, 2])) if np.isfinite(hz).any() else 1.0, float(analysis.band_hz[1]))
+    ax = canvas.axes(box, (0.0, float(times[-1])), (0.0, top_hz))
+    ok = np.isfinite(hz[:, 0])
+    for run in np.split(np.arange(len(mids)), np.flatnonzero(~ok) + 1):
+        run = run[ok[run]]
+        if len(run) > 1:
+            ax.polygon(list(zip(mids[run], hz[run, 2])) + list(zip(mids[run][::-1], hz[run, 0][::-1])), "#c5d7ec")
+    ax.line(mids, hz[:, 1], "#1f4e8c", 1)
+    means = np.array([s.mean_hz for s in analysis.segments])
+    summary = (f"{len(means)} segments, means {means.min():.0f}-{means.max():.0f} Hz (median {np.median(means):.0f})"
+               if len(means) else "no steady segment")
+    legend = [("median voiced frequency (10-90 %)", "#1f4e8c", "line")]
+    fx = None
+    if force is not None:
+        f = _windowed(times, np.asarray(force, dtype=float), edges)
+        top_n = 1.15 * max(float(np.nanmax(f[:, 2])) if np.isfinite(f).any() else 1.0, 1e-3)
+        fx = canvas.axes(box, ax.xlim, (0.0, top_n))
+        fx.line(mids, f[:, 1], "#c0392b", 1)
+        from matcad.canvas import nice_ticks, tick_label
+
+        ticks = [v for v in nice_ticks(0.0, top_n, 5) if 0.0 <= v <= top_n]
+        for v in ticks:
+            canvas.text(box[2] + 4, fx.y(v), tick_label(v, ticks), 9, "#c0392b", anchor="lm")
+        finite = np.asarray(force, dtype=float)
+        finite = finite[np.isfinite(finite)]
+        if len(finite):
+            summary += f"; force {finite.min():.2f}-{finite.max():.2f} N (median {np.median(finite):.2f})"
+        legend.append(("median force [N], right axis", "#c0392b", "line"))
+    title = f"overview of {times[-1]:.0f} s: {summary}"
+    ax.frame(ylabel="frequency [Hz]", grid="y", size=10, title=title)
+    ax.legend(legend, 9, corner="upper left")
+    return ax, fx, title
 
 
 def plot_board(tracks, path, readings=None) -> None:
@@ -104,7 +169,7 @@ def plot_board(tracks, path, readings=None) -> None:
     levels = np.concatenate([t.analysis.plot_db.ravel() for t in present]) if present else np.zeros(1)
     vmin, vmax = float(np.percentile(levels, 5)), float(levels.max())
     times = np.concatenate([t.analysis.plot_times_s for t in present]) if present else np.array([0.0, 1.0])
-    xlim = (float(times.min()), float(times.max()) if times.max() > times.min() else float(times.min()) + 1.0)
+    xlim = (0.0, max(float(times.max()), 1e-3))  # the recording starts at 0 s
     lo, hi = min(t.band_hz[0] for t in tracks), max(t.band_hz[1] for t in tracks)
     ax = canvas.axes(box, xlim, (lo, hi))
     legend = []
@@ -150,5 +215,4 @@ def plot_board(tracks, path, readings=None) -> None:
         bx.frame(xlabel="time [s]", ylabel="force [N]", grid="y")
         bx.legend([(t.name, TAB10[k % 10], "line") for k, t, _ in shown], 9)
     canvas.save(path)
-
 

@@ -84,9 +84,11 @@ def deformed_resonator(res: Resonator, volume_mm3: float, length_mm: float, neck
         inner_step=float(models.step_end_correction_mm(neck_diameter_mm, d)))
 
 
-def force_curve(d: Design, curve: CapCurve, f0_hz: float | None = None, fem_level: int | None = None) -> ForceCurve:
+def force_curve(d: Design, curve: CapCurve, f0_hz: float | None = None, fem_level: int | None = None,
+                progress=None) -> ForceCurve:
     """f(F) of design ``d`` along ``curve``; ``f0_hz`` the unloaded ladder's chosen f0 (default: the transmission
-    line's); ``fem_level`` runs the FEM on every deformed outline and makes it the route of the shift."""
+    line's); ``fem_level`` runs the FEM on every deformed outline and makes it the route of the shift
+    (``progress(outlines done, outlines)`` told as each is solved)."""
     from matcad.acoustics.eq5fit import fit
     from matcad.errors import LoopError
 
@@ -111,6 +113,8 @@ def force_curve(d: Design, curve: CapCurve, f0_hz: float | None = None, fem_leve
                 fem_note = (f"FEM on the deformed outline unavailable from x = {xs[i]:.3g} mm ({exc}); the shift "
                             "comes from the transmission line")
                 break
+            if progress is not None:
+                progress(i + 1, len(outlines))
     route = f_tl if f_fem is None or fem_note else f_fem
     f = (route[0] if f0_hz is None else f0_hz) * route / route[0]
     slope = tangent_hz_per_n(forces, f)
@@ -159,13 +163,13 @@ def _finite(x: float) -> float | None:
 
 
 def load_points(d: Design, curve: CapCurve, forces_n, f0_hz: float,
-                fem_level: int | None = None) -> tuple[list[dict], dict]:
+                fem_level: int | None = None, progress=None) -> tuple[list[dict], dict]:
     """The cap model's answer to ``matcad predict --force``: one row per force (force_n, f_hz, displacement_mm,
     cavity_volume_mm3, reason, source) and a summary (material, contact, run, df/dF, turn force, Eq. 5 fit, the
     whole computed curve with each state's deformed cavity outline as [r, z] mm from the wall's foot to the axis) for
     design ``d`` along the cap's ``curve``. ``f0_hz`` is the unloaded ladder's chosen f0 (Hz); see
     :func:`force_curve`."""
-    fc = force_curve(d, curve, f0_hz, fem_level)
+    fc = force_curve(d, curve, f0_hz, fem_level, progress)
     source = f"cap mechanics ({curve.material.model}, {curve.contact}, G = {curve.material.shear_modulus_mpa:.3g} MPa)"
     rows = [{"force_n": F, "f_hz": f, "displacement_mm": x, "cavity_volume_mm3": v, "reason": why, "source": source}
             for F, f, x, v, why in at_forces(fc, forces_n)]

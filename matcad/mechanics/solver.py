@@ -139,23 +139,23 @@ def _singular_corner(cm: CapMesh, sec: CapSection, point) -> str:
     return ""
 
 
-def cap_curve(case) -> CapCurve:
+def cap_curve(case, progress=None) -> CapCurve:
     """The load curve of a :class:`~matcad.mechanics.case.CapCase` (see :func:`compress`), read from the disk cache
     of :mod:`matcad.mechanics.store` when an earlier run computed this case with this code, else computed and
-    stored."""
+    stored. ``progress(steps done, steps)`` is told as each load step converges (:mod:`matcad.progress`)."""
     from matcad.mechanics import store
 
     curve = store.load(case, CapCurve, CapStep)
     if curve is None:
         curve = compress(case.section, case.material, case.contact, case.displacement_mm, case.steps,
-                         case.element_size_mm)
+                         case.element_size_mm, progress=progress)
         store.save(case, curve)
     return curve
 
 
 def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking", displacement_mm: float = 2.0,
              steps: int = 10, element_size_mm: float | None = None, mesh: CapMesh | None = None,
-             linear: bool = False) -> CapCurve:
+             linear: bool = False, progress=None) -> CapCurve:
     """Press the cap ``sec`` by ``displacement_mm`` (mm) in ``steps`` equal steps; F(x), V(x), outlines, strain.
 
     ``mesh`` replaces the cap's own (e.g. :func:`matcad.mechanics.mesh.disc_mesh` for the bonded-disc check);
@@ -266,6 +266,8 @@ def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking",
                 results.append(state)  # the last converged sub-step: the curve ends where the message says
             break
         results.append(state)
+        if progress is not None:
+            progress(len(results), steps)
     return CapCurve(section=sec, material=material, contact=contact, unloaded_volume_mm3=v0,
                     unloaded_outline=outline0, corner=cm.corner, steps=tuple(results), complete=not message, message=message,
                     nodes=n, cells=len(cm.cells), element_size_mm=cm.element_size_mm, newton_iterations=iterations,

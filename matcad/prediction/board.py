@@ -45,17 +45,22 @@ class BoardPrediction:
         return "\n".join(lines)
 
 
-def predict_board(spec, forces_n=(), model: str | None = None, fem_level: int | None = None) -> BoardPrediction:
+def predict_board(spec, forces_n=(), model: str | None = None, fem_level: int | None = None,
+                  progress=None) -> BoardPrediction:
     """Every taxel of ``spec`` predicted (:func:`matcad.prediction.taxel.predict`, at ``forces_n`` N) with its band
-    (:func:`matcad.prediction.bands.taxel_band`), and the board's summary."""
+    (:func:`matcad.prediction.bands.taxel_band`), and the board's summary; ``progress(taxels done, taxels)`` is told
+    as each taxel is done."""
     from matcad.prediction.bands import summary, taxel_band
     from matcad.prediction.taxel import predict
     from matcad.spec import taxel_spec, taxels
 
     bands, predictions = [], {}
-    for t in taxels(spec):
+    board = taxels(spec)
+    for t in board:
         one = taxel_spec(spec, t)
         p = predict(one, forces_n=forces_n, model=model, fem_level=fem_level)
         bands.append(taxel_band(one, t.name, t.x, t.y, prediction=p))
         predictions[t.name] = p
+        if progress is not None:
+            progress(len(predictions), len(board))
     return BoardPrediction(spec.name, tuple(bands), predictions, summary(spec, bands))

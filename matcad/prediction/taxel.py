@@ -21,14 +21,14 @@ from matcad.acoustics.registry import ModelResult
 from matcad.prediction.anchor import ANCHORS, anchor
 from matcad.prediction.curves import cap_curve
 
-def load_model_of(spec, model: str):
+def load_model_of(spec, model: str, progress=None):
     """(design, cap curve) that f(F) of the single-taxel ``spec`` is computed on: the drawn design and the grade's
     curve, or, when its prediction is ``as_built``, the design built in the inferred lab state and the curve of its
     silicone (:mod:`matcad.prediction.asbuilt`)."""
     from matcad.mechanics.case import cap_case
 
     d = adapt.design(spec)
-    curve = cap_curve(cap_case(spec))
+    curve = cap_curve(cap_case(spec), progress)
     if model != "as_built":
         return d, curve
     from matcad.prediction import asbuilt
@@ -51,13 +51,14 @@ def _anchored(spec, p: Prediction, name: str | None) -> Prediction:
 
 
 def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None = None,
-            mechanics: bool = True) -> Prediction:
+            mechanics: bool = True, progress=None) -> Prediction:
     """Predict the unloaded resonance of the single-taxel ``spec`` with every model, and f at ``forces_n`` (N) from
     the cap mechanics (imported only then; ``mechanics=False`` skips it) and, if calibrated, from Eq. 5 too.
 
     ``model`` overrides the automatic choice: a registered model that serves the spec's wall, or 'relative'
     (ValueError otherwise); ``fem_level`` sets the FEM's elements across the neck radius (default
-    :data:`matcad.acoustics.fem.DEFAULT_LEVEL`).
+    :data:`matcad.acoustics.fem.DEFAULT_LEVEL`); ``progress(done, total)`` (:mod:`matcad.progress`) is told the
+    cap's load steps as they converge and the FEM's deformed outlines as they are solved.
     """
     if spec.taxel or spec.array is not None:
         from matcad.spec import SpecError, taxel_spec, taxels
@@ -90,9 +91,9 @@ def predict(spec, forces_n=(), model: str | None = None, fem_level: int | None =
         from matcad.mechanics.frequency import load_points
 
         # the FEM route on the deformed outlines when the FEM is the chosen model; as built, when inferred
-        built, cap = load_model_of(spec, p.model)
+        built, cap = load_model_of(spec, p.model, progress)
         rows, load_model = load_points(built, cap, forces_n, p.f0_hz,
-                                       (fem_level or DEFAULT_LEVEL) if p.model == "fem" else None)
+                                       (fem_level or DEFAULT_LEVEL) if p.model == "fem" else None, progress)
         curve += tuple(LoadPoint(**row) for row in rows)
         if load_model["message"]:
             warnings.append(f"cap mechanics: {load_model['message']}")

@@ -11,6 +11,17 @@ BAND_PNG = "plot_band.png"
 LOAD_PNG = "plot_load.png"
 
 
+def chosen_model_status(p: dict) -> str:
+    """'' when the prediction's chosen model holds for this design; else "chosen model NAME invalid (failed
+    checks)". The one phrase the report's headline, the build's verdict line and the band chart share, so that a
+    headline never says "pass" while the chart marks the chosen model invalid."""
+    m = p.get("models", {}).get(p.get("model"))
+    if m is None or m.get("valid", True):
+        return ""
+    failed = ", ".join(k for k, ok in m.get("checks", {}).items() if not ok)
+    return f"chosen model {p['model']} invalid" + (f" ({failed})" if failed else "")
+
+
 def band_plot(p: dict, path: Path) -> dict:
     """Every model's f0 (dot; cross when invalid), the chosen band (orange) and each budget line's shift (Hz) as a
     bar from f0 (blue), f0 dotted; drawn with :mod:`matcad.canvas` (no matplotlib on the build's path)."""
@@ -39,8 +50,10 @@ def band_plot(p: dict, path: Path) -> dict:
             ax.marker(m["f0_hz"], y, "o" if m["valid"] else "x", "black")
         y += 1
     ax.line([f0, f0], list(ax.ylim), "#333333", 1, dash=3)
-    ax.frame(xlabel="frequency [Hz]", title=f"f0 = {f0:.0f} Hz ({p['model']}), band {lo:.0f}–{hi:.0f} Hz",
-             yticks=list(enumerate(labels)), grid="x")
+    status = chosen_model_status(p)
+    ax.frame(xlabel="frequency [Hz]", yticks=list(enumerate(labels)), grid="x", title_colour="#a03000" if status
+             else "black", title=f"f0 = {f0:.0f} Hz ({p['model']}), band {lo:.0f}–{hi:.0f} Hz"
+             + (f"; {status}" if status else ""))
     canvas.save(path)
     return {"part": "prediction", "file": path.name, "caption": "models, band and uncertainty budget"}
 

@@ -187,24 +187,32 @@ def printed_preview(name: str, stl: Path, path: Path, mesh=None) -> dict:
 def flat_preview(plan, path: Path) -> dict:
     """The laser cut plan of one part (kerf-compensated, as in its DXF) with each hole's finished size (mm), drawn
     with :mod:`matcad.canvas` at one scale across and up (no matplotlib on a laser-only build's path)."""
-    from matcad.canvas import Canvas
+    from matcad.canvas import Canvas, font
 
     flat = plan.flat
     x0, y0, x1, y1 = plan.extents
     aspect = (y1 - y0 + 4) / max(x1 - x0 + 4, 1e-9)
-    width = 660
+    title = (f"{flat.name}: {flat.quantity} × {flat.width:g} × {flat.depth:g} mm from {flat.thickness:g} mm "
+             f"sheet (cut lines, kerf {plan.kerf:g} mm)")
+    width = max(660, round(font(11).getlength(title)) + 110)  # a long title widens the picture, never clipped
     height = round(max(242, min(660, 600 * aspect + 88)))
     canvas = Canvas(width, height)
     ax = canvas.axes((70, 34, width - 16, height - 50), (x0 - 2, x1 + 2), (y0 - 2, y1 + 2), equal=True)
     for ox0, oy0, ox1, oy1, r in plan.outlines:
         ax.rounded(ox0, oy0, ox1, oy1, r, FLAT_COLOURS["outline"], 1)
     labelled = set()
+    sizes: dict = {}
+    for c in plan.circles:
+        sizes.setdefault(c.purpose, set()).add(c.finished_diameter)
     for c in plan.circles:
         ax.circle(c.x, c.y, c.diameter / 2, FLAT_COLOURS["hole"], 1)
-        if (c.purpose, c.finished_diameter) not in labelled and c.x <= plan.outlines[0][2]:
-            labelled.add((c.purpose, c.finished_diameter))
-            canvas.text(ax.x(c.x), ax.y(c.y + c.diameter / 2) - 4, f"{c.purpose} Ø{c.finished_diameter:g}", 9,
-                        "#102080", anchor="md")
+        graded = len(sizes[c.purpose]) > 2  # a coupon's row of sizes: one label per row, the sizes engraved
+        key = c.purpose if graded else (c.purpose, c.finished_diameter)
+        if key not in labelled and c.x <= plan.outlines[0][2]:
+            labelled.add(key)
+            text = (f"{c.purpose} Ø{min(sizes[c.purpose]):g}–{max(sizes[c.purpose]):g}" if graded
+                    else f"{c.purpose} Ø{c.finished_diameter:g}")
+            canvas.text(ax.x(c.x), ax.y(c.y + c.diameter / 2) - 4, text, 9, "#102080", anchor="ld" if graded else "md")
     for t in plan.texts:
         ax.text(t.x, t.y, t.text, 9, FLAT_COLOURS["engrave"], anchor="ls")
     if plan.reference_square:
@@ -213,7 +221,6 @@ def flat_preview(plan, path: Path) -> dict:
                 1, dash=3)
         ax.text(sx + side / 2, sy + side / 2, f"{side:g} mm\nreference", 8, FLAT_COLOURS["reference"], anchor="mm")
     ax.frame(xlabel="x [mm]", ylabel="y [mm]", size=10,
-             title=f"{flat.name}: {flat.quantity} × {flat.width:g} × {flat.depth:g} mm from {flat.thickness:g} mm "
-                   f"sheet (cut lines, kerf {plan.kerf:g} mm)")
+             title=title)
     canvas.save(path)
     return {"part": flat.name, "file": path.name, "caption": f"{flat.name}: laser cut plan"}

@@ -27,18 +27,39 @@ img { max-width: 100%; border: 1px solid #e0e0e0; background: white; }
 img[src$=".svg"] { width: 40rem; }
 code { font-size: 0.85rem; }
 h2 { border-bottom: 1px solid #ddd; margin-top: 2rem; }
-:target + h3 { background: #fff3c4; }
+.picture:target h3 { background: #fff3c4; }
+@page { size: A4; margin: 12mm 12mm 14mm; }
+@media print {
+  body { max-width: none; margin: 0; padding: 0; font-size: 9.5pt; line-height: 1.3; }
+  h1 { font-size: 16pt; margin: 0 0 0.4rem; }
+  h2 { font-size: 12.5pt; margin-top: 0.9rem; }
+  h3 { font-size: 10.5pt; margin: 0.5rem 0 0.2rem; }
+  h1, h2, h3 { break-after: avoid; page-break-after: avoid; break-inside: avoid; }
+  .picture, img, tr, pre { break-inside: avoid; page-break-inside: avoid; }
+  .picture { display: inline-block; vertical-align: top; width: 49%; margin: 0 0 0.3rem; }
+  .picture img, img { max-height: 88mm; max-width: 100%; width: auto; border: none; }
+  table { font-size: 8pt; margin: 0.3rem 0 0.6rem; }
+  th, td { padding: 0.05rem 0.3rem; }
+  a { color: inherit; text-decoration: none; }
+}
 """
+"""The page's look on screen and, under ``@media print``, on paper (A4): headings never end a page (they stay with
+the table or picture that follows: ``break-after: avoid``), a picture and its caption are never split
+(``break-inside: avoid``) and two pictures share a row."""
 
 
 def _pictures(r: dict) -> list[str]:
+    """The pictures, each with its caption in one ``picture`` block (kept together on paper); a part's first
+    picture carries the part's anchor (``#part-NAME``: the findings link to it)."""
     lines, seen = ["## Pictures", ""], set()
     for fig in r.get("figures", ()):
+        anchor = ""
         if fig["part"] not in seen:
             seen.add(fig["part"])
-            lines += [f'<a id="{part_anchor(fig["part"])}"></a>', ""]
-        lines += [f"### {fig['caption']}", "", f"![{fig['caption']}]({fig['file']})", ""]
-    return lines if seen else []
+            anchor = f' id="{part_anchor(fig["part"])}"'
+        lines += [f'<div class="picture"{anchor}>', "", f"### {fig['caption']}", "",
+                  f"![{fig['caption']}]({fig['file']})", "", "</div>", ""]
+    return lines + [""] if seen else []
 
 
 def _title(key: str) -> str:

@@ -71,15 +71,22 @@ def _lost(chunk: list[dict], exc: BaseException) -> list[dict]:
     return [{"index": t["index"], "status": "failed", "reason": reason} for t in chunk]
 
 
-def run(fn_chunk, tasks: list[dict], executor: Executor) -> list[dict]:
-    """``fn_chunk`` (a module-level function: list of task dicts → list of result dicts) over ``tasks``."""
+def run(fn_chunk, tasks: list[dict], executor: Executor, progress=None) -> list[dict]:
+    """``fn_chunk`` (a module-level function: list of task dicts → list of result dicts) over ``tasks``;
+    ``progress(tasks done, tasks)`` is called as chunks come back (in this process: every few tasks)."""
     if not tasks:
         return []
     if executor.scheduler:
         return _dask(fn_chunk, tasks, executor.scheduler)
     workers = min(executor.workers, len(tasks))  # never more processes than variants
     if workers == 1:
-        return fn_chunk(tasks)
+        if progress is None:
+            return fn_chunk(tasks)
+        out: list[dict] = []
+        for chunk in _chunks(tasks, len(tasks)):  # one task at a time, told as each is done
+            out += fn_chunk(chunk)
+            progress(len(out), len(tasks))
+        return out
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
@@ -88,7 +95,7 @@ def run(fn_chunk, tasks: list[dict], executor: Executor) -> list[dict]:
     chunks = _chunks(tasks, workers)
     with ProcessPoolExecutor(workers, mp_context=context) as pool:
         futures = [pool.submit(fn_chunk, c) for c in chunks]
-        done = _results(futures)
+        done = _results(futures, chunks, progress)
     lost = [k for k, r in enumerate(done) if isinstance(r, BaseException)]
     if lost:  # a dead worker broke the pool: every chunk that did not come back again, one fresh process each
         for start in range(0, len(lost), workers):
@@ -104,14 +111,19 @@ def run(fn_chunk, tasks: list[dict], executor: Executor) -> list[dict]:
     return _joined(chunks, done)
 
 
-def _results(futures) -> list:
-    """Each future's result, or the exception it raised."""
+def _results(futures, chunks=None, progress=None) -> list:
+    """Each future's result, or the exception it raised; ``progress(tasks done, tasks)`` told as each comes."""
     out = []
-    for future in futures:
+    total = sum(len(c) for c in chunks) if chunks else 0
+    done = 0
+    for k, future in enumerate(futures):
         try:
             out.append(future.result())
         except Exception as exc:  # noqa: BLE001 - a dead worker fails its variants, not the sweep
             out.append(exc)
+        if progress is not None and chunks:
+            done += len(chunks[k])
+            progress(done, total)
     return out
 
 

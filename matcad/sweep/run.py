@@ -125,11 +125,13 @@ def allowed_models(spec) -> list[str]:
 
 
 def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor: Executor = Executor(),
-          rules: bool = True, cad: bool = False, fem_level: int | None = None, sink=None) -> SweepResult:
+          rules: bool = True, cad: bool = False, fem_level: int | None = None, sink=None,
+          progress=None) -> SweepResult:
     """Sweep the spec ``data`` (raw TOML-like data; each variant is it with the axes' values set, validated like a
     file, so defaults such as the cap's 2.5 × D follow the varied cavity) over the full grid of ``axes``.
     ``model`` defaults to the spec's own choice (:func:`predict`); ``cad`` also builds each variant's end cap.
-    ``sink`` (a callable) is given the rows chunk by chunk, in grid order, as they are made."""
+    ``sink`` (a callable) is given the rows chunk by chunk, in grid order, as they are made; ``progress`` (a
+    callable, :mod:`matcad.progress`) is told (variants done, variants) as chunks come back."""
     from matcad.acoustics.design import calibration
     from matcad.prediction import predict
     from matcad.spec import SpecError, from_dict
@@ -145,7 +147,7 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     size = math.prod(len(a.values) for a in axes)
     if not cad and arrays.eligible(base, model):
         keep = sink is None or len(axes) <= 2 or size <= MAX_VARIANTS
-        rows, counted, worker_seconds = _array_rows(data, axes, model, rules, executor, sink, keep)
+        rows, counted, worker_seconds = _array_rows(data, axes, model, rules, executor, sink, keep, progress)
         return SweepResult(base.name, model, tuple(axes), tuple(rows), True, executor.describe(), rules,
                            time.perf_counter() - start, worker_seconds, None if keep else counted)
     if size > MAX_VARIANTS:
@@ -182,7 +184,7 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     if not vectorised or rules or cad:
         tasks = [{"index": i, "data": datas[i], "model": model, "fem_level": fem_level, "predict": not vectorised,
                   "rules": rules, "cad": cad} for i in ok]
-        for result in run_tasks(run_chunk, tasks, executor):
+        for result in run_tasks(run_chunk, tasks, executor, progress):
             worker_seconds += result.get("seconds", 0.0)
             rows[result["index"]].update({k: v for k, v in result.items() if k in RESULT_KEYS or k.startswith("cad_")})
     result = SweepResult(base.name, model, tuple(axes), tuple(rows), vectorised, executor.describe(), rules,
@@ -194,7 +196,7 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     return SweepResult(**{**result.__dict__, "seconds": time.perf_counter() - start})
 
 
-def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, sink, keep: bool):
+def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, sink, keep: bool, progress=None):
     """(rows if ``keep``, counts, worker seconds) of every variant by :func:`array_chunk` over chunks of
     :data:`matcad.sweep.arrays.CHUNK` variants streamed from the executor (each chunk's rows go to ``sink`` as
     they come); a chunk whose worker was lost is a row ``failed`` per variant."""
@@ -216,6 +218,8 @@ def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, s
                      "reason": result["reason"], "model": model}
                     for i, values in zip(range(task["start"], task["stop"]), grid(axes, task["start"], task["stop"]))]
         tally(rows, counted)
+        if progress is not None:
+            progress(task["stop"], size)
         if sink is not None:
             sink(rows)
         if keep:
