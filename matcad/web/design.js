@@ -93,7 +93,7 @@ function buildTaxels(entries) {
     th.title = `${col.key} [${col.unit}]: ${col.doc}`;
     head.appendChild(th);
   }
-  head.appendChild(document.createElement("th"));
+  head.prepend(document.createElement("th"));
   $("taxels").tHead.replaceChildren(head);
   $("taxels").tBodies[0].replaceChildren();
   taxelRows = [];
@@ -133,7 +133,7 @@ function addTaxel(entry) {
     onEdit();
   });
   td.appendChild(remove);
-  tr.appendChild(td);
+  tr.prepend(td);
   $("taxels").tBodies[0].appendChild(tr);
   taxelRows.push(row);
   numberTaxels();
