@@ -11,7 +11,7 @@ const inputs = {};
 let taxelRows = [];      // [{cells: {column: input}, extra: {...}}]: extra keeps what the table does not edit
 let preserved = {};      // other arrays of tables ([[measured]], ...) passed through unchanged
 let INITIAL = BOOT.initial;
-window.matcad = {stages: [], bandsShownMs: null, previewMs: [], meshMs: null};
+window.matcad = {stages: [], bandsShownMs: null, previewMs: [], editToSectionMs: [], meshMs: null, editAt: null};
 
 function initialValue(key) {
   let node = INITIAL;
@@ -26,7 +26,7 @@ function shown(row, value) {
   return String(value);
 }
 
-function onEdit() { schedulePredict(); drawPlan(); }
+function onEdit() { window.matcad.editAt = performance.now(); schedulePredict(); drawPlan(); }
 
 function buildForm() {
   const holder = $("fields");
@@ -240,7 +240,8 @@ function schedulePredict() { clearTimeout(timer); timer = setTimeout(predict, 20
 async function predict() {
   const mine = ++generation;
   $("status").textContent = "predicting…";
-  const [status, data] = await post("/predict");
+  const spec = collect();
+  const [status, data] = await post("/predict", {spec});
   if (mine !== generation) return;  // a newer edit is on its way
   clearErrors();
   $("status").textContent = "";
@@ -268,7 +269,7 @@ async function predict() {
   list("warnings", data.warnings);
   list("notes", data.notes);
   showDetails();
-  schedulePreview();
+  schedulePreview(spec);
 }
 
 function el(tag, attrs, text) {
@@ -379,13 +380,17 @@ function drawPlan() {  // the plate and every taxel's cap flange and neck, from 
   $("plan").replaceChildren(svg);
 }
 
-let previewBusy = false, previewDirty = false, previewTimer = null;
-function schedulePreview() { clearTimeout(previewTimer); previewTimer = setTimeout(preview, 150); }
+let previewBusy = false, previewDirty = false, previewTimer = null, previewSpec = null;
+function schedulePreview(spec) {  // the spec just predicted (so known valid), drawn 150 ms later
+  previewSpec = spec;
+  clearTimeout(previewTimer);
+  previewTimer = setTimeout(preview, 150);
+}
 
 async function preview() {  // the section, then the meshes; a newer edit waits for the one in flight
   if (previewBusy) { previewDirty = true; return; }
   previewBusy = true;
-  const spec = collect(), t0 = performance.now();
+  const spec = previewSpec, t0 = performance.now(), editAt = window.matcad.editAt;
   $("preview-status").textContent = "drawing the section…";
   try {
     const [status, data] = await post("/preview", {spec, what: "section"});
@@ -393,6 +398,7 @@ async function preview() {  // the section, then the meshes; a newer edit waits 
       $("section").src = "data:image/svg+xml;base64," + btoa(unescape(encodeURIComponent(data.svg)));
       const ms = performance.now() - t0;
       window.matcad.previewMs.push(ms);
+      if (editAt !== null && !previewDirty) window.matcad.editToSectionMs.push(performance.now() - editAt);
       $("preview-status").textContent = `section ${ms.toFixed(0)} ms`;
       if (!previewDirty) await mesh(spec);
     } else {
@@ -400,7 +406,7 @@ async function preview() {  // the section, then the meshes; a newer edit waits 
     }
   } finally {
     previewBusy = false;
-    if (previewDirty) { previewDirty = false; schedulePreview(); }
+    if (previewDirty) { previewDirty = false; schedulePreview(previewSpec); }
   }
 }
 
