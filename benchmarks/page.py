@@ -61,8 +61,8 @@ def main(argv: list[str]) -> None:
             times = []
             for i in range(n):
                 before = d.execute_script("return window.matcad.previewMs.length")
-                d.execute_script(f"const b = document.getElementById('in-cavity.length'); b.value = '{4.5 + 0.1 * i:.2f}';"
-                                 "b.dispatchEvent(new Event('input'));")
+                d.execute_script("const b = document.getElementById('in-cavity.length'); "
+                                 f"b.value = '{4.5 + 0.1 * i:.2f}'; b.dispatchEvent(new Event('input'));")
                 wait(d, f"return window.matcad.previewMs.length > {before}")
                 times.append(d.execute_script("return window.matcad.previewMs[window.matcad.previewMs.length - 1]"))
                 wait(d, "return !previewBusy")

@@ -213,7 +213,8 @@ def test_board_template_on_the_page(url):
         wait = WebDriverWait(driver, 180)
         driver.get(url + "/?template=mat-array-4")
         wait.until(lambda d: len(_bands(d)) == 4)
-        print(f"\nopening the page to a board's bands: {driver.execute_script('return window.matcad.bandsShownMs'):.0f} ms")
+        shown_ms = driver.execute_script("return window.matcad.bandsShownMs")
+        print(f"\nopening the page to a board's bands: {shown_ms:.0f} ms")
         assert len(driver.find_elements(By.CSS_SELECTOR, "#taxels tbody tr")) == 4
         first = _bands(driver)
         for b in want.bands:
