@@ -126,5 +126,5 @@ def test_wheel_ships_templates_docs_page_and_license(tmp_path):
         assert f"matcad/templates/{template.name}" in names
     for doc in ("physics.md", "paper.md", "api.md"):
         assert f"matcad/docs/{doc}" in names
-    assert "matcad/web/design.html" in names
+    assert {"matcad/web/design.html", "matcad/web/design.js", "matcad/web/viewer.js"} <= names  # the page inlines both
     assert any(n.endswith("LICENSE") for n in names)

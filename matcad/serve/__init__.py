@@ -2,9 +2,11 @@
 
 stdlib only (``http.server``), bound to 127.0.0.1. The server keeps no state: each request carries the whole spec
 as JSON; a build runs as its own `matcad build` process in its own temporary folder, is zipped into the response
-and the folder deleted. Endpoints: ``GET /`` the page (``?template=NAME`` picks the starting values),
-``GET /schema.json``, ``POST /predict`` and ``POST /build`` with ``{"spec": {...}}``. Errors come back as
-``{"error": {"field": "neck.diameter", "message": "..."}}``.
+and the folder deleted; the section and meshes of the preview come from one child process holding the CAD
+kernel (:mod:`matcad.serve.preview`). Endpoints: ``GET /`` the page (``?template=NAME`` picks the starting
+values), ``GET /schema.json``, ``GET /progress?build=ID`` (a running build's stage), ``POST /predict`` (a taxel
+or a whole board), ``/preview``, ``/build``, ``/toml`` with ``{"spec": {...}}`` and ``POST /parse`` with
+``{"toml": "..."}`` (docs/page.md). Errors come back as ``{"error": {"field": "neck.diameter", "message": "..."}}``.
 
 What it refuses, and how (times s, sizes bytes):
 

@@ -11,11 +11,40 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import re
 import threading
+import time
 import zipfile
 from pathlib import Path
 
 from matcad.serve.common import BUILD_TIMEOUT_S, MIME, Refused, error, spec_of
+
+BUILD_ID = re.compile(r"[A-Za-z0-9_-]{8,64}")
+"""A build's id, chosen by the page so that it can ask for the build's progress while it waits for the kit."""
+STAGES = (
+    ("starting", "starting: loading matcad, checking the rules, predicting every band", ()),
+    ("laser", "laser parts and cut sheets (DXF, SVG, PDF)", (".dxf", ".pdf")),
+    ("solids", "printed parts (STL, STEP; the CAD kernel)", (".stl",)),
+    ("assembly", "assembly and section", ("assembly.step", "section.svg")),
+    ("print", "print job (3MF)", (".3mf",)),
+    ("pictures", "pictures (previews, plots, band chart)", (".png",)),
+    ("report", "report", ("report.json", "report.md", "report.html")),
+    ("zip", "packing the kit", ()),
+)
+"""A build's stages in the order `matcad build` writes them, each with the file names (suffixes) whose first
+appearance in its output folder marks it (:meth:`Builds.progress`)."""
+
+
+def stage_of(names: set[str], finished: bool) -> int:
+    """The index in :data:`STAGES` of the furthest stage whose files are among ``names`` (a build's folder so far);
+    ``finished`` (the kit is in place) is the last stage."""
+    if finished:
+        return len(STAGES) - 1
+    reached = 0
+    for i, (_, _, marks) in enumerate(STAGES):
+        if any(name == m or (m.startswith(".") and name.endswith(m)) for m in marks for name in names):
+            reached = i
+    return reached
 
 
 class Builds:
@@ -25,7 +54,27 @@ class Builds:
         self.lock = threading.Lock()
         self.folders: set[Path] = set()
         self.processes: set[subprocess.Popen] = set()
+        self.running: dict[str, tuple[Path, float]] = {}  # build id → (its kit folder, start monotonic s)
         self.stopping = False
+
+    def progress(self, build_id: str) -> dict:
+        """What the build ``build_id`` has written so far: its stage (index, key, text, of how many), the files
+        in its folder and the seconds since it started; Refused(404) for a build that is not running."""
+        with self.lock:
+            entry = self.running.get(build_id)
+        if entry is None:
+            raise Refused(404, f"no build {build_id[:64]!r} is running", "build")
+        kit, started = entry
+        names: set[str] = set()
+        for folder in (kit, *kit.parent.glob(f".{kit.name}.tmp-*")):  # matcad.output stages into a hidden sibling
+            try:
+                names |= {p.name for p in folder.iterdir()}
+            except OSError:
+                pass
+        i = stage_of(names, kit.is_dir())
+        key, text, _ = STAGES[i]
+        return {"stage": key, "text": text, "index": i + 1, "of": len(STAGES), "files": len(names),
+                "elapsed_s": round(time.monotonic() - started, 1)}
 
     def folder(self) -> Path:
         with self.lock:
@@ -85,7 +134,13 @@ def build_json(payload: dict, builds: Builds) -> tuple[int, dict]:
     from matcad.report import KIT_ARCHIVE
 
     spec = spec_of(payload)  # a bad spec is told at once, before a process starts
+    build_id = payload.get("build_id")
+    if build_id is not None and not (isinstance(build_id, str) and BUILD_ID.fullmatch(build_id)):
+        raise Refused(422, "build_id must be 8-64 letters, digits, '_' or '-'", "build_id")
     tmp = builds.folder()
+    if build_id:
+        with builds.lock:
+            builds.running[build_id] = (tmp / spec.name, time.monotonic())
     try:
         request = tmp / "request.json"
         request.write_text(json.dumps({"spec": payload["spec"]}), encoding="utf-8")
@@ -114,4 +169,6 @@ def build_json(payload: dict, builds: Builds) -> tuple[int, dict]:
                      "zip": base64.b64encode(buf.getvalue()).decode(), "previews": previews,
                      "findings": [f for f in result["findings"] if f["level"] != "info"]}
     finally:
+        with builds.lock:
+            builds.running.pop(build_id, None)
         builds.remove(tmp)

@@ -17,19 +17,10 @@ from matcad.init import DEFAULT_TEMPLATE
 from matcad.serve.builds import Builds, build_json
 from matcad.serve.common import (BACKLOG, BUILDS, DEFAULT_PORT, HOST, MAX_BODY_BYTES, MAX_CONNECTIONS, QUEUE_WAIT_S,
                                  REQUEST_DEADLINE_S, WORKERS, WRITE_TIMEOUT_S, Refused, error, spec_of)
+from matcad.serve.page import predict_json, spec_from_toml, spec_toml
+from matcad.serve.preview import PreviewWorker
 
-
-def predict_json(payload: dict) -> dict:
-    """The prediction for the request's spec, as plain data (Hz, mm)."""
-    from matcad.prediction import predict
-    from matcad.spec import spec_notes
-
-    spec = spec_of(payload)
-    p = predict(spec)
-    return {"name": spec.name, "f0_hz": p.f0_hz, "band_hz": list(p.band_hz), "model": p.model,
-            "models": {k: {"f0_hz": m.f0_hz, "valid": m.valid} for k, m in p.models.items()},
-            "budget": [{"source": b.source, "low_hz": b.low_hz, "high_hz": b.high_hz} for b in p.budget],
-            "warnings": list(p.warnings), "notes": spec_notes(spec, payload["spec"])}
+__all__ = ["DesignServer", "make_server", "page_html", "predict_json"]
 
 
 def page_html(template: str) -> str:
@@ -40,8 +31,23 @@ def page_html(template: str) -> str:
     raw = tomllib.loads(template_path(template).read_text(encoding="utf-8"))
     boot = json.dumps({"schema": schema(), "initial": raw, "template": template,
                        "templates": template_names()}).replace("</", "<\\/")
-    page = (resources.files("matcad") / "web" / "design.html").read_text(encoding="utf-8")
-    return page.replace("/*BOOT*/null", boot)
+    web = resources.files("matcad") / "web"
+    scripts = "\n".join((web / name).read_text(encoding="utf-8") for name in ("viewer.js", "design.js"))
+    if "</script" in scripts.lower():
+        raise AssertionError("a page script may not contain '</script'")  # it would end the inline script
+    page = (web / "design.html").read_text(encoding="utf-8")
+    return page.replace("/*SCRIPTS*/", scripts).replace("/*BOOT*/null", boot)
+
+
+def preview_json(payload: dict, worker: PreviewWorker) -> tuple[int, dict]:
+    """The request's spec (validated here first) drawn by the preview process: ``"what": "section"`` (default) →
+    the report's section SVG; ``"mesh"`` → the parts' meshes for the page's 3-D view (:mod:`matcad.serve.preview`)."""
+    spec_of(payload)
+    what = payload.get("what", "section")
+    if what not in ("section", "mesh"):
+        raise Refused(422, f"what {str(what)[:40]!r} invalid, must be 'section' or 'mesh'", "what")
+    answer = worker.ask(payload["spec"], what)
+    return (422 if "error" in answer else 200), answer
 
 
 class _DeadlineReader(io.RawIOBase):
@@ -194,13 +200,17 @@ class Handler(BaseHTTPRequestHandler):
                 from matcad.spec import schema
 
                 return 200, {"schema": schema()}
+            if url.path == "/progress":
+                return 200, self.server.builds.progress(parse_qs(url.query).get("build", [""])[0])
             return 404, error(None, f"no page {url.path}")
 
         self._answer(work)
 
     def do_POST(self):
         routes = {"/predict": lambda p: (200, predict_json(p)),
-                  "/build": lambda p: build_json(p, self.server.builds)}
+                  "/build": lambda p: build_json(p, self.server.builds),
+                  "/preview": lambda p: preview_json(p, self.server.preview),
+                  "/toml": lambda p: (200, spec_toml(p)), "/parse": lambda p: (200, spec_from_toml(p))}
 
         def work():
             self._check_host()
@@ -209,7 +219,8 @@ class Handler(BaseHTTPRequestHandler):
                 return 404, error(None, f"no endpoint {self.path[:80]}")
             length = self._check_post()
             payload = parse_body(self.rfile.read(length))
-            slot = self.server.build_slot if route is routes["/build"] else self.server.workers
+            slot = {"/build": self.server.build_slot, "/preview": self.server.preview_slot}.get(
+                urlparse(self.path).path, self.server.workers)
             if not slot.acquire(timeout=QUEUE_WAIT_S):
                 raise Refused(503, f"busy: no worker free within {QUEUE_WAIT_S:g} s; try again")
             try:
@@ -230,7 +241,9 @@ class DesignServer(ThreadingHTTPServer):
         self.connections = threading.BoundedSemaphore(MAX_CONNECTIONS)
         self.workers = threading.BoundedSemaphore(WORKERS)
         self.build_slot = threading.BoundedSemaphore(BUILDS)
+        self.preview_slot = threading.BoundedSemaphore(1)
         self.builds = Builds()
+        self.preview = PreviewWorker()
         super().__init__((HOST, port), Handler)
 
     def process_request(self, request, client_address):
@@ -273,6 +286,7 @@ class DesignServer(ThreadingHTTPServer):
     def server_close(self) -> None:
         """Stop listening, end every build and remove every temporary folder."""
         super().server_close()
+        self.preview.stop()
         self.builds.stop()
 
 

@@ -1,0 +1,82 @@
+"""The design page as a user meets it, timed in headless Chromium against a fresh in-process server.
+
+  board      open ?template=mat-array-4 in a fresh server: ms from navigation to the four bands drawn (browser's
+             performance.now() when the chart is drawn), then again on a second page load (server warm)
+  section    mat-paper: the first section (the preview process loads the CAD kernel), then N edits of
+             cavity.length, each timed from the edit's request to the section shown (ms, median and max)
+  mesh       the 3-D view's meshes after the first section (ms)
+  board-section  the same for the board's section
+
+With --shots DIR it saves a screenshot of the board page and of the single-taxel page there (PNG).
+
+Run: PYTHONPATH=. .venv/bin/python benchmarks/page.py [N] [--shots DIR]   (default N 5)
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import threading
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from matcad.serve import make_server  # noqa: E402
+from tests.browser import chromium  # noqa: E402
+
+
+def wait(driver, script: str, timeout: float = 300.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = driver.execute_script(script)
+        if value:
+            return value
+        time.sleep(0.05)
+    raise TimeoutError(script)
+
+
+def main(argv: list[str]) -> None:
+    n = int(argv[0]) if argv and argv[0].isdigit() else 5
+    shots = Path(argv[argv.index("--shots") + 1]) if "--shots" in argv else None
+    server = make_server(0)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    url = f"http://127.0.0.1:{server.server_address[1]}"
+    try:
+        with chromium() as d:
+            d.set_window_size(1500, 1900)
+            for visit in ("cold", "warm"):
+                d.get(url + "/?template=mat-array-4")
+                ms = wait(d, "return document.querySelectorAll('#bandchart g.band').length === 4 "
+                             "&& window.matcad.bandsShownMs")
+                print(f"board {visit}: page opened -> 4 bands shown {ms:8.0f} ms")
+            first = wait(d, "return window.matcad.previewMs.length && window.matcad.previewMs[0]")
+            mesh = wait(d, "return window.matcad.meshMs")
+            print(f"board-section first {first:8.0f} ms   board mesh {mesh:8.0f} ms")
+            if shots:
+                shots.mkdir(parents=True, exist_ok=True)
+                d.save_screenshot(str(shots / "page-board.png"))
+            d.get(url + "/?template=mat-paper")
+            wait(d, "return window.matcad.meshMs")
+            times = []
+            for i in range(n):
+                before = d.execute_script("return window.matcad.previewMs.length")
+                d.execute_script("const b = document.getElementById('in-cavity.length'); "
+                                 f"b.value = '{4.5 + 0.1 * i:.2f}'; b.dispatchEvent(new Event('input'));")
+                wait(d, f"return window.matcad.previewMs.length > {before}")
+                times.append(d.execute_script("return window.matcad.previewMs[window.matcad.previewMs.length - 1]"))
+                wait(d, "return !previewBusy")
+            edits = d.execute_script("return window.matcad.editToSectionMs")
+            print(f"section request -> shown (mat-paper, {n} edits): median {statistics.median(times):6.0f} ms, "
+                  f"max {max(times):6.0f} ms")
+            print(f"edit -> f0 predicted -> section shown (debounces 200 + 150 ms included): median "
+                  f"{statistics.median(edits):6.0f} ms, max {max(edits):6.0f} ms")
+            if shots:
+                d.save_screenshot(str(shots / "page-taxel.png"))
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
