@@ -57,6 +57,16 @@ def test_missing_required_table_is_refused(validator):
     assert any("neck" in e.message for e in validator.iter_errors(data))
 
 
+def test_each_kind_requires_its_own_tables(validator):
+    """kind = "tube" needs [tube] and not the MAT taxel's [cavity]/[neck]; the loader agrees on the refusal."""
+    tube = tomllib.loads((ROOT / "matcad" / "templates" / "acoustac-tube.toml").read_text())
+    assert "cavity" not in tube and list(validator.iter_errors(tube)) == []
+    del tube["tube"]
+    assert any("'tube' is a required property" in e.message for e in validator.iter_errors(tube))
+    with pytest.raises(SpecError):
+        from_dict(tube)
+
+
 def test_descriptions_carry_units_and_defaults(validator):
     props = validator.schema["properties"]
     assert "[mm]" in props["cavity"]["properties"]["diameter"]["description"]

@@ -65,7 +65,8 @@ def json_schema(rows=None) -> dict:
 
     rows = schema() if rows is None else rows
     top = {"$schema": DIALECT, "$id": ID, "title": "matcad spec",
-           "description": "A matcad spec (TOML): one MAT taxel or a board of them; lengths in mm. "
+           "description": "A matcad spec (TOML): one MAT taxel, a board of them, or (kind = \"tube\") a fipple "
+                          "tube taxel; lengths in mm. "
                           "`matcad schema` prints every field with its unit, default and range.",
            **_table(), "required": []}
     for row in rows:
@@ -83,4 +84,10 @@ def json_schema(rows=None) -> dict:
         if row["required"] and tables:  # a required field makes its table required at the top
             if tables[0] not in top["required"]:
                 top["required"].append(tables[0])
+    # kind = "tube" (docs/tube.md) needs its [tube] table instead of the MAT taxel's required tables
+    mat_tables = [t for t in top["required"] if t != "name"]
+    top["required"] = [t for t in top["required"] if t not in mat_tables]
+    top["if"] = {"properties": {"kind": {"const": "tube"}}, "required": ["kind"]}
+    top["then"] = {"required": ["tube"]}
+    top["else"] = {"required": mat_tables}
     return top
