@@ -136,7 +136,7 @@ def compare_with_paper(fc, curve):
               f"{fo / (fp - PAPER_F_OF_X[1]):6.2f}")
     vol = curve.column("cavity_volume_mm3")
     veff = paper_veff_mm3(x)
-    print(f"  f(x) at equal travel: " + ", ".join(
+    print("  f(x) at equal travel: " + ", ".join(
         f"x {xp:g} mm: ours {100 * (np.interp(xp, x, f) / f[0] - 1):.1f} %, paper Fig. 8 V_eff "
         f"{100 * (math.sqrt(paper_veff_mm3(0.0) / paper_veff_mm3(xp)) - 1):.1f} %"
         for xp in (0.4, 1.0, 2.0) if xp <= x[-1] + 1e-9))

@@ -305,8 +305,6 @@ def build(spec, out_dir: Path | None = None, force: bool = False, progress=None)
 
 def build_coupon(spec, out_dir: Path | None = None) -> tuple[Path, dict]:
     """Write the laser and printed test coupons to ``out_dir`` (default out/<name>-coupon) with a hole table."""
-    import json
-
     from matcad.parts.coupon import (coupon_sheets, laser_coupon, printed_coupon, printed_coupon_holes,
                                      needle_sweep_mounts, needle_sweeps)
 

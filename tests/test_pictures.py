@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import json
 
 import matplotlib.image as mpimg
 import numpy as np
-import pytest
 from scipy.io import wavfile
 
 from tests.conftest import ROOT, run_cli

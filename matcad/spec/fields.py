@@ -16,7 +16,7 @@ import sys
 from dataclasses import field
 from typing import Any, ClassVar
 
-from matcad.errors import MISSING, SpecError, shorten  # defined at the base: the CLI catches SpecError without loading the spec
+from matcad.errors import MISSING, SpecError  # defined at the base: the CLI catches SpecError without loading the spec
 
 LENGTH_MIN_MM = 1e-3
 LENGTH_MAX_MM = 1e5
