@@ -59,7 +59,7 @@ def test_mechanics_rise_once_per_cap_and_equal_to_predict_load(monkeypatch):
 
     calls = []
     real = solver.cap_curve
-    monkeypatch.setattr(solver, "cap_curve", lambda s: calls.append(1) or real(s))
+    monkeypatch.setattr(solver, "cap_curve", lambda s, progress=None: calls.append(1) or real(s, progress))
     monkeypatch.setattr(curve_cache, "_CAP_CURVES", {})
     s = spec_mod.from_dict(tomllib.loads(FAST))
     wide = dataclasses.replace(s, neck=dataclasses.replace(s.neck, diameter=2.6))
