@@ -20,6 +20,9 @@ WINDOW_S = 0.093
 """~4096 samples at 44.1 kHz: ~11 Hz resolution (5.4 Hz bins with 2× padding), 46 ms between frames."""
 ZERO_PAD = 2
 """The FFT is this many window lengths long (bins of fs / (ZERO_PAD · window))."""
+HARMONICS = (2, 3)
+"""Overtones of a taxel's tone that another taxel's band must avoid or its tracker discount: an edge tone is rich
+in harmonics, and overblowing jumps to them (paper Sec. VI-B); the 2nd and 3rd are the strong ones."""
 EXCLUDE_BINS = 6
 """Bins either side of a line that belong to it (Hann main lobe is ±4 bins at 2× padding)."""
 FREQUENCY_KHZ_MAX = 100.0

@@ -57,6 +57,8 @@ def console_errors(driver) -> list[dict]:
 
 
 def broken_images(driver) -> list[str]:
-    """src of every <img> on the page that did not load (naturalWidth 0 once complete)."""
+    """src of every <img> on the page that did not load (naturalWidth 0 once complete), and of every shown <img>
+    with nothing to show (no src: a broken-picture icon)."""
     return driver.execute_script(
-        "return [...document.images].filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.src)")
+        "return [...document.images].filter(i => (i.getAttribute('src') || !i.hidden)"
+        " && !(i.complete && i.naturalWidth > 0)).map(i => i.src)")

@@ -197,20 +197,20 @@ def test_headline_and_band_chart_agree_on_an_invalid_chosen_model(kit, tmp_path)
     assert status.startswith(f"chosen model {p['model']} invalid (") and "no_wall_mode_near_f" in status
     head = render_markdown(bad).splitlines()[2]
     assert "(design rules)" in head and status in head
-    import matplotlib
+    from matcad import canvas
 
     titles = []
-    real_title = matplotlib.axes.Axes.set_title
+    real_frame = canvas.Axes.frame
 
-    def spy(self, text, *args, **kw):
-        titles.append(text)
-        return real_title(self, text, *args, **kw)
+    def spy(self, *args, **kw):
+        titles.append(kw.get("title", ""))
+        return real_frame(self, *args, **kw)
 
-    matplotlib.axes.Axes.set_title = spy
+    canvas.Axes.frame = spy
     try:
         band_plot(p, tmp_path / "band.png")
     finally:
-        matplotlib.axes.Axes.set_title = real_title
+        canvas.Axes.frame = real_frame
     assert any(status in t for t in titles)
 
 

@@ -82,7 +82,7 @@ def run(args) -> int:
     target = args.out or Path("out") / f"{result.spec.name}-design"
     report = {"source": str(args.spec), **result.to_dict()}
     files = write_design(target, result.spec, report, f"written by `matcad design` from {args.spec}",
-                         picture=lambda folder: picture(spec, result, folder))
+                         picture=None if spec.kind == "tube" else lambda folder: picture(spec, result, folder))
     if args.json:
         print_json({**report, "out_dir": str(target), "spec_file": str(target / f"{result.spec.name}.toml"),
                     "written": files})
@@ -93,7 +93,8 @@ def run(args) -> int:
 
 
 def picture(start, result, folder: Path) -> str:
-    """The design's picture in ``folder``: a solved taxel's f0 curve and section, or an array's band chart."""
+    """The design's picture in ``folder``: a solved taxel's f0 curve and section, or an array's band chart (a tube's
+    design draws none yet: its f1 against tube.length is printed)."""
     from matcad.design.picture import allocation_chart, solution_plot
 
     if hasattr(result, "bands"):

@@ -33,8 +33,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from matcad.errors import LoopError
-from matcad.listening import EDGE_BINS
-from matcad.prediction.bands import HARMONICS
+from matcad.listening import EDGE_BINS, HARMONICS
 from matcad.loop.segments import STEP_HZ
 from matcad.loop.voicing import MIN_RUN_HARMONIC, WEAK_DB
 from matcad.loop.analysis import Analysis
@@ -97,7 +96,8 @@ def analyze_board(blocks, fs: float, named_bands, on_frame=None) -> list[TaxelTr
     taxel. ``on_frame`` is called as (taxel index, time s, frequency Hz or NaN, excess dB). Raises LoopError when
     no taxel has a tone."""
     bands = [tuple(band) for _, band in named_bands]
-    trackers, duration, mean_power = run_trackers(blocks, fs, bands, on_frame)
+    hold = None if on_frame is None else TailHold(len(bands), on_frame)
+    trackers, duration, mean_power = run_trackers(blocks, fs, bands, hold)
     tracks = []
     for k, ((name, band), tracker) in enumerate(zip(named_bands, trackers)):
         others = [b for j, b in enumerate(bands) if j != k]
@@ -108,6 +108,8 @@ def analyze_board(blocks, fs: float, named_bands, on_frame=None) -> list[TaxelTr
                                                                              *dropouts(name, heard)))))
         except LoopError as exc:
             tracks.append(TaxelTrack(name, band, None, str(exc)))
+    if hold is not None:  # the trackers' last frames come as they finish
+        hold.flush()
     tracks = discount_harmonics(tracks)
     if all(t.analysis is None for t in tracks):
         raise LoopError("no taxel's tone found: " + "; ".join(f"{t.name}: {t.reason}" for t in tracks))
@@ -219,34 +221,82 @@ TAIL_DB = 6.0
 
 def room_tails(a: Analysis) -> Analysis:
     """A board taxel's analysis with the frames before a fast pitch step that hold the room's reverberant tail of
-    the old pitch left out: up to TAIL_FRAMES voiced frames just before the next voiced frame moves more than
-    STEP_HZ (within 3 frames), at the old pitch (within STEP_HZ) and ≥ TAIL_DB weaker than the median of the
-    voiced frames before them (TAIL_FRAMES + 4 frames back). A press ramped in 0.15 s spreads the new pitch over
-    many bins of a 93 ms window while the tail stays on one: the ridge keeps the old pitch for 2-3 frames, 40-130
-    Hz off on a 96 kHz board's high taxels (benchmarks/design.py --capacity-only). Segments are kept (the tail
-    is at the old, steady pitch); the frame counts change."""
+    the old pitch left out (:func:`tail_before`, for every pair of neighbouring voiced frames). A press ramped in
+    0.15 s spreads the new pitch over many bins of a 93 ms window while the tail stays on one: the ridge keeps the
+    old pitch for 2-3 frames, 40-130 Hz off on a 96 kHz board's high taxels (benchmarks/design.py
+    --capacity-only). Segments are kept (the tail is at the old, steady pitch); the frame counts change. Live
+    output leaves out the same frames (:class:`TailHold`)."""
     v = np.flatnonzero(a.voiced)
     if len(v) < 2:
         return a
-    f, e = a.track_hz, a.frame_snr_db
-    out = np.zeros(len(f), dtype=bool)
+    out = np.zeros(len(a.track_hz), dtype=bool)
     for i, j in zip(v[:-1], v[1:]):
-        if j - i > 3 or abs(f[j] - f[i]) <= STEP_HZ:
-            continue
-        ref = v[(v < i - TAIL_FRAMES + 1) & (v >= i - 2 * TAIL_FRAMES - 3)]
-        if len(ref) < 3:
-            continue
-        level = float(np.median(e[ref]))
-        for k in range(i, max(-1, i - TAIL_FRAMES), -1):
-            if not a.voiced[k] or abs(f[k] - f[i]) > STEP_HZ or e[k] > level - TAIL_DB:
-                break
-            out[k] = True
+        tail_before(a.track_hz, a.frame_snr_db, a.voiced, i, j, out)
     voiced = a.voiced & ~out
     if not np.any(out) or not np.any(voiced):
         return a
-    g = f[voiced]
+    g = a.track_hz[voiced]
     return replace(a, mean_hz=float(np.mean(g)), median_hz=float(np.median(g)), std_hz=float(np.std(g)),
                    tone_fraction=float(np.mean(voiced)), voiced=voiced)
+
+
+def tail_before(f, e, voiced, i: int, j: int, out) -> None:
+    """Mark in ``out`` the room's tail before voiced frame ``j`` (``i``: the voiced frame before it; ``f`` Hz,
+    ``e`` excess dB, ``voiced`` per frame): when j comes within 3 frames and moves more than STEP_HZ, up to
+    TAIL_FRAMES voiced frames from i back, at i's pitch (within STEP_HZ) and at least TAIL_DB weaker than the
+    median of the voiced frames TAIL_FRAMES..2·TAIL_FRAMES + 3 before i."""
+    if j - i > 3 or abs(f[j] - f[i]) <= STEP_HZ:
+        return
+    lo = max(0, i - 2 * TAIL_FRAMES - 3)
+    ref = lo + np.flatnonzero(voiced[lo:max(lo, i - TAIL_FRAMES + 1)])
+    if len(ref) < 3:
+        return
+    level = float(np.median(e[ref]))
+    for k in range(i, max(-1, i - TAIL_FRAMES), -1):
+        if not voiced[k] or abs(f[k] - f[i]) > STEP_HZ or e[k] > level - TAIL_DB:
+            break
+        out[k] = True
+
+
+class TailHold:
+    """Between the trackers and a live ``on_frame``: each taxel's frames are held until no later frame can make
+    them the room's tail (TAIL_FRAMES + 3 frames), then passed on, a tail frame as unvoiced (NaN): live lines
+    say what the final analysis says (:func:`room_tails`). Keeps 2·TAIL_FRAMES + 8 frames per taxel."""
+
+    KEEP = 2 * TAIL_FRAMES + 8
+
+    def __init__(self, count: int, on_frame):
+        self.on_frame = on_frame
+        self.frames = [[] for _ in range(count)]  # per taxel: [time s, f Hz, excess dB, tail?] of the last KEEP
+        self.sent = [0] * count  # per taxel: how many of the kept frames (from the newest back) are not yet sent
+
+    def __call__(self, k: int, time_s: float, freq: float, excess: float) -> None:
+        frames = self.frames[k]
+        frames.append([time_s, freq, excess, False])
+        self.sent[k] += 1
+        f = np.array([x[1] for x in frames])
+        voiced = np.isfinite(f)
+        if voiced[-1]:
+            earlier = np.flatnonzero(voiced[:-1])
+            if len(earlier):
+                out = np.zeros(len(f), dtype=bool)
+                tail_before(f, np.array([x[2] for x in frames]), voiced, int(earlier[-1]), len(f) - 1, out)
+                for n in np.flatnonzero(out):
+                    frames[n][3] = True
+        while self.sent[k] > TAIL_FRAMES + 3:
+            self._send(k, len(frames) - self.sent[k])
+        del frames[:max(0, len(frames) - self.KEEP)]
+
+    def _send(self, k: int, n: int) -> None:
+        time_s, freq, excess, tail = self.frames[k][n]
+        self.on_frame(k, time_s, float("nan") if tail else freq, excess)
+        self.sent[k] -= 1
+
+    def flush(self) -> None:
+        """Pass on every frame still held (the recording ended)."""
+        for k, frames in enumerate(self.frames):
+            while self.sent[k]:
+                self._send(k, len(frames) - self.sent[k])
 
 
 DROPOUT_FRAMES = (5, 65)

@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from matcad.listening import EXCLUDE_BINS
-from matcad.prediction.bands import HARMONICS
+from matcad.listening import EXCLUDE_BINS, HARMONICS
+from matcad.loop.spectrum import running_max
 
 WEAKER_DB = 10.0
 """A line at a predicted harmonic is discounted when it is at least this much weaker than the tone it is predicted
@@ -60,9 +60,7 @@ class Overtones:
         tiny = np.finfo(float).tiny
         log = 10 * np.log10(power + tiny)
         rows = np.arange(frames)
-        from scipy.ndimage import maximum_filter1d
-
-        widest = {m: maximum_filter1d(log, 2 * half_width(m) + 1, axis=1) for m in HARMONICS}
+        widest = {m: running_max(log, 2 * half_width(m) + 1) for m in HARMONICS}
         for bins in self.bins:
             if len(bins) < 3:
                 continue

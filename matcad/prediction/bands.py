@@ -23,11 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.listening import guard_hz
+from matcad.listening import HARMONICS, guard_hz
 
-HARMONICS = (2, 3)
-"""Overtones of a taxel's tone that another taxel's band must avoid: an edge tone is rich in harmonics, and
-overblowing jumps to them (paper Sec. VI-B); the 2nd and 3rd are the strong ones."""
 EQ5_POINTS = 65
 """Forces sampled from 0 to the maximum force to find Eq. 5's highest f (it may turn back inside the range)."""
 

@@ -396,6 +396,7 @@ async function preview() {  // the section, then the meshes; a newer edit waits 
     const [status, data] = await post("/preview", {spec, what: "section"});
     if (status === 200) {
       $("section").src = "data:image/svg+xml;base64," + btoa(unescape(encodeURIComponent(data.svg)));
+      $("section").hidden = false;  // no empty (broken) picture before the first section arrives
       const ms = performance.now() - t0;
       window.matcad.previewMs.push(ms);
       if (editAt !== null && !previewDirty) window.matcad.editToSectionMs.push(performance.now() - editAt);
