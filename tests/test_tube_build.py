@@ -58,13 +58,47 @@ def test_tube_mesh_dimensions_bore_window_and_print_pose(kit):
     assert radii == pytest.approx([t.bore_diameter / 2, t.bore_diameter / 2 + t.wall], abs=0.01)
     window = mesh.section(plane_origin=[0, 0, t.block_length + t.edge_distance / 2], plane_normal=[0, 0, 1])
     assert len(window.discrete) == 1  # the window opens the wall: one C-shaped loop, not two circles
-    # print pose: every downward face steeper than the FDM limit (30° from vertical, 1° slack) is one of the two
-    # bridges the design leaves, the needle seat's ceiling under the windway and the window's top at the edge
+    # print pose (docs/tube.md, the kit): no downward face anywhere steeper than the FDM limit, 30° from vertical
+    # (+5° for the STL's facets: those of a 30° cone tilt up to 3.3° at the build's chordal tolerance). Before the
+    # needle seat's cone this failed on the seat's flat ceiling (1.07 mm² at z = 4 mm).
     n, c, area = mesh.face_normals, mesh.triangles_center, mesh.area_faces
-    steep = (n[:, 2] < 0) & (np.degrees(np.arcsin(np.clip(-n[:, 2], 0, 1))) > SEAT_CONE_DEG + 1) & (c[:, 2] > 1e-3)
-    levels = np.unique(np.round(c[steep, 2], 2))
-    assert set(levels) <= {round(t.block_length / 2, 2), round(z["edge"], 2)}, levels
-    assert area[steep].sum() < 2 * t.windway_width * t.wall  # bridges, not a floor
+    steep = (n[:, 2] < 0) & (np.degrees(np.arcsin(np.clip(-n[:, 2], 0, 1))) > SEAT_CONE_DEG + 5) & (c[:, 2] > 1e-3)
+    assert not steep.any(), {lv: area[steep & (np.round(c[:, 2], 2) == lv)].sum() for lv in np.round(c[steep, 2], 2)}
+    # what starts in mid-air: a horizontal convex edge between two downward faces. The one such edge is the
+    # labium's tip, a bridge of the window's width B over the window (docs/tube.md: why it cannot be avoided with
+    # the bore vertical, and what PrusaSlicer makes of it)
+    v, adj, edges = mesh.vertices, mesh.face_adjacency, mesh.face_adjacency_edges
+    hanging = ((n[adj[:, 0], 2] < -0.05) & (n[adj[:, 1], 2] < -0.05) & mesh.face_adjacency_convex
+               & (mesh.face_adjacency_angles > np.radians(60)) & (v[edges[:, 0], 2] > 1e-3)
+               & (np.abs(v[edges[:, 0], 2] - v[edges[:, 1], 2]) < 1e-6))
+    assert set(np.round(v[edges[hanging, 0], 2], 3)) == {round(z["edge"], 3)}
+    length = np.linalg.norm(v[edges[hanging, 0]] - v[edges[hanging, 1]], axis=1).sum()
+    assert length == pytest.approx(t.windway_width, rel=0.01)
+
+
+def test_the_block_slices_with_no_support(tmp_path):
+    """The tube below the window (the block: needle seat, its cone, the windway) sliced by PrusaSlicer as the repo's
+    other printed parts are (tests/test_real_clients.py: automatic supports on) generates no support. Before the
+    seat's cone: 22.0 mm³ of support under the seat's flat ceiling."""
+    from build123d import Box, Pos
+
+    from matcad.export.mesh import write_stl
+    from matcad.parts.tube import fipple_tube
+    from matcad.spec import load
+    from tests.test_real_clients import need, support_volume_mm3
+
+    need("prusa-slicer")
+    spec = load(TEMPLATE)
+    block = fipple_tube(spec) & (Pos(0, 0, spec.tube.block_length / 2) * Box(50, 50, spec.tube.block_length))
+    stl, gcode = tmp_path / "block.stl", tmp_path / "block.gcode"
+    write_stl(block, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance)
+    run = subprocess.run(["prusa-slicer", "--export-gcode", "--support-material", "--support-material-auto",
+                          "--output", str(gcode), str(stl)], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-500:]
+    text = gcode.read_text()
+    assert "; support_material = 1" in text  # supports really were on
+    volume = support_volume_mm3(text)
+    assert volume == 0.0 and ";TYPE:Support material" not in text, f"{volume:.1f} mm^3 of support"
 
 
 def test_the_cap_is_the_mat_cap_on_the_bore(kit):

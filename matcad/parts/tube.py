@@ -25,9 +25,6 @@ SEAT_CONE_DEG = 30.0
 EDGE_LAND_MM = 0.1
 """The labium's tip sits this far outside the bore's wall line: a plane through the wall line would touch the bore
 at one point (no valid solid), and no printer makes a sharper edge than this anyway."""
-EDGE_LAND_MM = 0.1
-"""The labium's tip sits this far outside the bore's wall line: a plane through the wall line would touch the bore
-at one point (no valid solid), and no printer makes a sharper edge than this anyway."""
 NEEDLE_SEAT_DEPTH_FRACTION = 0.5
 """The needle's seat reaches this fraction of the block; the windway runs the rest."""
 
@@ -42,6 +39,14 @@ def heights_mm(spec) -> dict:
     cone = max(seat_r - outer, 0.0) / math.tan(math.radians(SEAT_CONE_DEG))
     return {"windway_exit": t.block_length, "edge": edge, "cone_start": top - SEAT_THICKNESS_MM - cone,
             "top": top, "bore_radius": a, "outer_radius": outer, "seat_radius": seat_r}
+
+
+def seat_taper_mm(spec) -> float:
+    """Height of the cone that closes the needle's seat into the windway (mm): from the needle's radius to a
+    quarter of the windway's height (inside the slot, so no face is tangent to it) at :data:`SEAT_CONE_DEG` from
+    vertical; 0 when the needle is no wider than the slot."""
+    needle_r, h = spec.needle.outer_diameter / 2, spec.tube.windway_height
+    return max(needle_r - h / 4, 0.0) / math.tan(math.radians(SEAT_CONE_DEG)) if needle_r > h / 2 else 0.0
 
 
 def fipple_tube(spec):
@@ -61,10 +66,15 @@ def fipple_tube(spec):
     body -= frustum_up(1e-3, a, roof, z=t.block_length - roof)
     h, b = t.windway_height, t.windway_width
     seat_depth = NEEDLE_SEAT_DEPTH_FRACTION * t.block_length
-    body -= cylinder_up(spec.needle.outer_diameter / 2, seat_depth, x=a)  # the needle's seat, from the bed
+    needle_r = spec.needle.outer_diameter / 2
+    body -= cylinder_up(needle_r, seat_depth, x=a)  # the needle's seat, from the bed
+    if needle_r > h / 2:  # its ceiling: a cone at the FDM limit into the windway, not a flat roof (docs/tube.md)
+        body -= frustum_up(needle_r, h / 4, seat_taper_mm(spec), x=a, z=seat_depth)
     body -= Pos(a, 0, seat_depth / 2 + t.block_length / 2) * Box(h, b, t.block_length - seat_depth + 1e-3)
-    window_h = t.edge_distance  # the window, from the axis out through the wall (no face tangent to the bore)
-    body -= Pos(outer, 0, t.block_length + window_h / 2) * Box(2 * outer + 2.0, b, window_h)
+    # the window, from the axis (inside the bore for |y| < B/2 <= a: no face tangent to it) out through the wall;
+    # not from beyond the axis, where it would nick the far wall and leave a flat sliver of ceiling there
+    window_h = t.edge_distance
+    body -= Pos((outer + 1.0) / 2, 0, t.block_length + window_h / 2) * Box(outer + 1.0, b, window_h)
     # the labium: above the window, the wall outside the plane through the edge (x = a, z = edge) tilted edge_angle
     # from vertical is cut away over the window's width; the bevel's underside overhangs edge_angle
     reach, tip = outer + 1.0, a + EDGE_LAND_MM
