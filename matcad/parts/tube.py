@@ -1,12 +1,14 @@
 """The printed fipple tube of a ``kind = "tube"`` spec (docs/tube.md), built in its print pose: bore vertical, the
 block on the bed. Lengths mm.
 
-From the bed up: the block (z 0 → ``block_length``) with the supply needle's seat (a hole from the bed face) feeding
-the windway, a slot h × B centred on the bore's wall line; the mouth window (z ``block_length`` →
-``block_length`` + W) cut through the wall over the windway's width; above it the labium, the wall's edge at the
-bore's wall line bevelled outward at ``edge_angle`` from vertical; the bore (``length`` from the edge); the cap's
-seat, a flange of the cap flange's diameter reached by a 30°-from-vertical cone so that nothing overhangs more than
-the FDM limit. The cap (the MAT cap, its cavity the bore continued) is glued on the seat's face.
+From the bed up: the block (z 0 → ``block_length``) with the supply needle's seat (a hole from the bed face, closed
+by a 30°-from-vertical cone, not a flat ceiling) feeding the windway, a slot h × B centred on the bore's wall line;
+the mouth window (z ``block_length`` → ``block_length`` + W) cut through the wall over the windway's width; above it
+the labium, the wall's edge at the bore's wall line bevelled outward at ``edge_angle`` from vertical; the bore
+(``length`` from the edge); the cap's seat, a flange of the cap flange's diameter reached by a 30°-from-vertical
+cone so that nothing overhangs more than the FDM limit. The one thing that starts in mid-air is the labium's tip, a
+bridge B long over the window (docs/tube.md: why, and what the slicer makes of it). The cap (the MAT cap, its cavity
+the bore continued) is glued on the seat's face.
 
 Not a registered part (:mod:`matcad.parts.registry`): its flag would enter every MAT spec's [outputs] and change
 their outputs; the tube kit lists its parts in :mod:`matcad.tube_build`.
