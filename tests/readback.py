@@ -10,6 +10,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import ezdxf
+import numpy as np
 
 from matcad.export.dxf_svg import LAYERS
 from matcad.output import MANIFEST
@@ -98,3 +99,21 @@ def section_circles(mesh, z: float) -> list[tuple[float, float, float]]:
 def nearest_circle(circles, x: float, y: float) -> tuple[float, float, float]:
     """The circle whose centre is nearest (x, y)."""
     return min(circles, key=lambda c: (c[0] - x) ** 2 + (c[1] - y) ** 2)
+
+
+def hanging_edge_length_mm(mesh, tol=1e-6) -> dict:
+    """z (mm, 3 decimals) → total length (mm) of the mesh's edges where printed material starts in mid-air: a
+    horizontal edge that is the lowest edge of a face pointing downward, whose neighbour across it does not reach below
+    it. A face merely steeper than the overhang limit is the other check; this one sees a bridge's or a tip's line."""
+    n, v, faces = mesh.face_normals, mesh.vertices, mesh.faces
+    adj, edges, unshared = mesh.face_adjacency, mesh.face_adjacency_edges, mesh.face_adjacency_unshared
+    z0 = v[edges[:, 0], 2]
+    flat = np.abs(v[edges[:, 1], 2] - z0) < tol
+    hanging = np.zeros(len(adj), bool)
+    for k in (0, 1):
+        f = adj[:, k]
+        lowest = np.abs(v[faces[f]][:, :, 2].min(axis=1) - z0) < tol
+        hanging |= (n[f, 2] < -0.05) & lowest & (v[unshared[:, 1 - k], 2] >= z0 - tol)
+    hanging &= flat & (z0 > 1e-3)
+    length = np.linalg.norm(v[edges[:, 0]] - v[edges[:, 1]], axis=1)
+    return {lv: float(length[hanging & (np.round(z0, 3) == lv)].sum()) for lv in np.unique(np.round(z0[hanging], 3))}
