@@ -161,6 +161,10 @@ def test_preview_section_and_mesh(url, server):
     assert max(xs) - min(xs) == pytest.approx(spec.plate.width, abs=0.01)
     assert max(zs) - min(zs) == pytest.approx(spec.neck.length, abs=0.01)
     assert max(parts["end_cap"]["triangles"]) < len(parts["end_cap"]["vertices"]) // 3
+    _, assembly = _post(url, "/preview", {"spec": raw, "what": "assembly"})  # the page's two steps: the same parts
+    _, molds = _post(url, "/preview", {"spec": raw, "what": "molds"})
+    assert [p["name"] for p in molds["parts"]] == ["end_cap_mold_base", "end_cap_mold_lid"]
+    assert assembly["parts"] + molds["parts"] == mesh["parts"]
     assert "build123d" not in sys.modules or server.preview.proc is not None  # the kernel is the child's
     status, bad = _post(url, "/preview", {"spec": raw, "what": "everything"})
     assert status == 422 and bad["error"]["field"] == "what"

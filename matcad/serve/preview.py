@@ -46,8 +46,8 @@ class PreviewWorker:
                                 stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env)
 
     def ask(self, spec_data: dict, what: str = "section", timeout_s: float = PREVIEW_TIMEOUT_S) -> dict:
-        """The preview of the validated spec data ``spec_data``: ``what`` = "section" → {"svg", "ms"}, "mesh" →
-        {"parts", "ms"}; or {"error": ...}.
+        """The preview of the validated spec data ``spec_data``: ``what`` = "section" → {"svg", "ms"}, "mesh",
+        "assembly" or "molds" (:data:`MESHES`) → {"parts", "ms"}; or {"error": ...}.
         TimeoutError when the child does not answer within ``timeout_s`` (it is then ended)."""
         from matcad.serve.common import Refused
 
@@ -206,9 +206,14 @@ def section(spec, cache: PartCache | None = None) -> dict:
     return {"svg": svg, "ms": round(1e3 * (time.perf_counter() - t0))}
 
 
-def meshes(spec, cache: PartCache | None = None) -> dict:
-    """The meshes of the assembled parts and of the cap mold's parts (when the spec asks for the mold), the molds
-    set beside the plate (+x), and the time it took (ms)."""
+MESHES = {"mesh": ("assembly", "molds"), "assembly": ("assembly",), "molds": ("molds",)}
+"""A mesh request's ``what`` → the groups it draws: the page asks for the assembly, then the molds (slow on a
+board: the mold is rebuilt on any cap edit), so an edit made meanwhile waits for the assembly only."""
+
+
+def meshes(spec, cache: PartCache | None = None, groups=("assembly", "molds")) -> dict:
+    """The meshes of the assembled parts (group "assembly") and of the cap mold's parts when the spec asks for the
+    mold (group "molds"), the molds set beside the plate (+x), and the time it took (ms)."""
     from build123d import Pos
 
     from matcad.parts.registry import part
@@ -216,12 +221,14 @@ def meshes(spec, cache: PartCache | None = None) -> dict:
 
     t0 = time.perf_counter()
     colours, cache = section_colours(), cache or CACHE
-    parts, keys = cache.assembled(spec)
-    out = [cache.mesh(keys[name], name, solid, colours.get(layer_of(name), "#999999")) if name in keys
-           else _mesh(name, solid, colours.get(layer_of(name), "#999999")) for name, solid in parts.items()]
+    out = []
+    if "assembly" in groups:
+        parts, keys = cache.assembled(spec)
+        out = [cache.mesh(keys[name], name, solid, colours.get(layer_of(name), "#999999")) if name in keys
+               else _mesh(name, solid, colours.get(layer_of(name), "#999999")) for name, solid in parts.items()]
     x = spec.plate.width / 2 + 6.0
     for name in MOLD_PARTS:
-        if not part(name).wanted(spec):
+        if "molds" not in groups or not part(name).wanted(spec):
             continue
         solid, key = cache.mold(spec, name)
         box = solid.bounding_box()
@@ -240,8 +247,9 @@ def serve_requests(stdin, stdout) -> None:
     for line in stdin:
         try:
             request = json.loads(line)
-            work = meshes if request.get("what") == "mesh" else section
-            answer = work(from_dict(request["spec"]))
+            what = request.get("what", "section")
+            answer = meshes(from_dict(request["spec"]), groups=MESHES[what]) if what in MESHES \
+                else section(from_dict(request["spec"]))
         except (SpecError, ValueError) as exc:
             answer = {"error": {"field": getattr(exc, "field", None), "message": str(exc)}}
         except Exception as exc:  # noqa: BLE001 - a bug in a preview is told to the page, the child lives on
