@@ -45,7 +45,8 @@ def edits_timed(driver, field: str, values: list[float]) -> tuple[list[float], l
     for value in values:
         before = driver.execute_script("return window.matcad.previewMs.length")
         driver.execute_script(f"const b = document.getElementById('{field}'); b.value = '{value:.2f}'; "
-                              "b.dispatchEvent(new Event('input')); window.matcad.meshMs = window.matcad.moldMs = null;")
+                              "b.dispatchEvent(new Event('input')); "
+                              "window.matcad.meshMs = window.matcad.moldMs = null;")
         wait(driver, f"return window.matcad.previewMs.length > {before}")
         sections.append(driver.execute_script("return window.matcad.previewMs[window.matcad.previewMs.length - 1]"))
         meshes.append(wait(driver, "return window.matcad.meshMs"))

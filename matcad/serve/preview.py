@@ -5,8 +5,10 @@ plate for the page's 3-D view. Lengths mm, times ms.
 Both need the CAD kernel (build123d, ~0.5 GB and seconds to import), which the server process never loads (its
 predictions stay light): :class:`PreviewWorker` keeps ONE child process, ``python -m matcad.serve.preview``,
 that imports the kernel once and then answers one request per line (JSON in on stdin, JSON out on stdout), so
-each preview after the first costs only the geometry (measure: ``benchmarks/page.py``). The child is started on
-the first preview, restarted if it dies or overruns :data:`PREVIEW_TIMEOUT_S`, and ended with the server.
+each preview after the first costs only the geometry (measure: ``benchmarks/page.py``). The child is started when
+the page is served (:meth:`PreviewWorker.warm`) or on the first preview, restarted if it dies or overruns
+:data:`PREVIEW_TIMEOUT_S`, and ended with the server. It keeps the parts it built (:class:`PartCache`): an edit
+rebuilds only the parts built from the fields it changed.
 """
 
 from __future__ import annotations
@@ -44,6 +46,17 @@ class PreviewWorker:
                                                                          os.environ.get("PYTHONPATH")]))}
         return subprocess.Popen([sys.executable, "-m", "matcad.serve.preview"], stdin=subprocess.PIPE,
                                 stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env)
+
+    def warm(self) -> None:
+        """Start the child now if none runs and no preview is in flight (the page was just opened: the child loads
+        the CAD kernel while the page predicts, and its first preview costs only the geometry)."""
+        if not self.lock.acquire(blocking=False):
+            return
+        try:
+            if not self.stopped and (self.proc is None or self.proc.poll() is not None):
+                self.proc = self._start()
+        finally:
+            self.lock.release()
 
     def ask(self, spec_data: dict, what: str = "section", timeout_s: float = PREVIEW_TIMEOUT_S) -> dict:
         """The preview of the validated spec data ``spec_data``: ``what`` = "section" → {"svg", "ms"}, "mesh",

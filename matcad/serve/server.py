@@ -196,7 +196,9 @@ class Handler(BaseHTTPRequestHandler):
             if url.path == "/":
                 template = parse_qs(url.query).get("template", [DEFAULT_TEMPLATE])[0]
                 try:
-                    return 200, page_html(template).encode(), "text/html; charset=utf-8"
+                    html = page_html(template).encode()
+                    self.server.preview.warm()  # the page previews once it has predicted: load the kernel now
+                    return 200, html, "text/html; charset=utf-8"
                 except ValueError as exc:
                     raise Refused(400, str(exc), "template") from None
             if url.path == "/schema.json":
