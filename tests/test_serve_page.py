@@ -174,9 +174,13 @@ def test_the_preview_process_ends_with_the_server():
     srv = make_server(0)
     threading.Thread(target=srv.serve_forever, daemon=True).start()
     port = srv.server_address[1]
+    with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=30) as r:
+        assert r.status == 200
+    warmed = srv.preview.proc  # opening the page starts the child: it loads the kernel while the page predicts
+    assert warmed is not None
     status, _ = _post(f"http://127.0.0.1:{port}", "/preview", {"spec": _raw(LASER_ONLY)})
     proc = srv.preview.proc
-    assert status == 200 and proc.poll() is None
+    assert status == 200 and proc is warmed and proc.poll() is None
     srv.shutdown()
     srv.server_close()
     assert proc.wait(timeout=10) is not None
