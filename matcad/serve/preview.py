@@ -128,8 +128,9 @@ CAP_ONLY = ("cavity_diameter", "cavity_length", "cap_top_thickness", "calibratio
 """[[taxel]] keys only that taxel's cap reads: an edit there rebuilds that cap alone."""
 MOLD_IGNORES = ("x", "y")
 """[[taxel]] keys the cap mold does not read (it casts the caps side by side, wherever they sit on the plate)."""
-CACHE_SIZE = 256
-"""Solids (and meshes) kept, least recently used dropped first: a board's parts for a few dozen edits."""
+CACHE_SIZE = 128
+"""Solids kept, and meshes kept, least recently used dropped first: a board's 18 parts for several edits (a mesh
+is up to ~1 MB of lists, a mold solid a few MB)."""
 
 
 def _projection(spec, drop: tuple[str, ...] = ()) -> str:
