@@ -4,8 +4,10 @@
              performance.now() when the chart is drawn), then again on a second page load (server warm)
   section    mat-paper: the first section (the preview process loads the CAD kernel), then N edits of
              cavity.length, each timed from the edit's request to the section shown (ms, median and max)
-  mesh       the 3-D view's meshes after the first section (ms)
-  board-section  the same for the board's section
+  mesh       the 3-D view's meshes after the first section: the assembly, then with the mold (ms)
+  board-section  the same for the board's section: the first, then N edits of t1's cavity_length (the taxel in the
+             section's plane), each timed from the edit's request to the section shown and to the meshes shown (the
+             preview process keeps built parts: an edit rebuilds the edited taxel's cap and the mold only)
 
 With --shots DIR it saves a screenshot of the board page and of the single-taxel page there (PNG).
 
@@ -36,6 +38,23 @@ def wait(driver, script: str, timeout: float = 300.0):
     raise TimeoutError(script)
 
 
+def edits_timed(driver, field: str, values: list[float]) -> tuple[list[float], list[float], list[float]]:
+    """Set input ``field`` to each value in turn, waiting for the section and the meshes after each: (section ms,
+    assembly mesh ms, assembly + mold meshes ms) per edit, from each request, as the page timed them."""
+    sections, meshes, molds = [], [], []
+    for value in values:
+        before = driver.execute_script("return window.matcad.previewMs.length")
+        driver.execute_script(f"const b = document.getElementById('{field}'); b.value = '{value:.2f}'; "
+                              "b.dispatchEvent(new Event('input')); "
+                              "window.matcad.meshMs = window.matcad.moldMs = null;")
+        wait(driver, f"return window.matcad.previewMs.length > {before}")
+        sections.append(driver.execute_script("return window.matcad.previewMs[window.matcad.previewMs.length - 1]"))
+        meshes.append(wait(driver, "return window.matcad.meshMs"))
+        molds.append(wait(driver, "return window.matcad.moldMs"))
+        wait(driver, "return !previewBusy")
+    return sections, meshes, molds
+
+
 def main(argv: list[str]) -> None:
     n = int(argv[0]) if argv and argv[0].isdigit() else 5
     shots = Path(argv[argv.index("--shots") + 1]) if "--shots" in argv else None
@@ -51,8 +70,14 @@ def main(argv: list[str]) -> None:
                              "&& window.matcad.bandsShownMs")
                 print(f"board {visit}: page opened -> 4 bands shown {ms:8.0f} ms")
             first = wait(d, "return window.matcad.previewMs.length && window.matcad.previewMs[0]")
-            mesh = wait(d, "return window.matcad.meshMs")
-            print(f"board-section first {first:8.0f} ms   board mesh {mesh:8.0f} ms")
+            mesh, mold = wait(d, "return window.matcad.meshMs"), wait(d, "return window.matcad.moldMs")
+            print(f"board-section first {first:8.0f} ms   board mesh: assembly {mesh:8.0f} ms, with the mold "
+                  f"{mold:8.0f} ms")
+            sections, meshes, molds = edits_timed(d, "in-taxel[1].cavity_length", [4.5 + 0.1 * i for i in range(n)])
+            print(f"board edits (t1 cavity_length, {n}), median (max) ms from the request: section shown "
+                  f"{statistics.median(sections):6.0f} ({max(sections):.0f}); assembly meshes shown "
+                  f"{statistics.median(meshes):6.0f} ({max(meshes):.0f}); with the mold "
+                  f"{statistics.median(molds):6.0f} ({max(molds):.0f})")
             if shots:
                 shots.mkdir(parents=True, exist_ok=True)
                 d.save_screenshot(str(shots / "page-board.png"))

@@ -136,6 +136,9 @@ def test_design_page_end_to_end_in_chromium(url):
         assert {"mat-laser-only/neck_plate.dxf", "mat-laser-only/preview_neck_plate.png"} <= set(kit.namelist())
         n = driver.execute_script("return document.querySelectorAll('#previews img').length")
         assert n == len(report["figures"]) > 0
+        # the geometry preview's section (its first one loads the CAD kernel: under load it can come after a
+        # laser-only build) is then a picture too
+        wait.until(lambda d: d.find_element(By.ID, "section").get_attribute("src"))
         assert broken_images(driver) == []
         errors = console_errors(driver)
         refused = [e for e in errors

@@ -161,6 +161,10 @@ def test_preview_section_and_mesh(url, server):
     assert max(xs) - min(xs) == pytest.approx(spec.plate.width, abs=0.01)
     assert max(zs) - min(zs) == pytest.approx(spec.neck.length, abs=0.01)
     assert max(parts["end_cap"]["triangles"]) < len(parts["end_cap"]["vertices"]) // 3
+    _, assembly = _post(url, "/preview", {"spec": raw, "what": "assembly"})  # the page's two steps: the same parts
+    _, molds = _post(url, "/preview", {"spec": raw, "what": "molds"})
+    assert [p["name"] for p in molds["parts"]] == ["end_cap_mold_base", "end_cap_mold_lid"]
+    assert assembly["parts"] + molds["parts"] == mesh["parts"]
     assert "build123d" not in sys.modules or server.preview.proc is not None  # the kernel is the child's
     status, bad = _post(url, "/preview", {"spec": raw, "what": "everything"})
     assert status == 422 and bad["error"]["field"] == "what"
@@ -170,9 +174,13 @@ def test_the_preview_process_ends_with_the_server():
     srv = make_server(0)
     threading.Thread(target=srv.serve_forever, daemon=True).start()
     port = srv.server_address[1]
+    with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=30) as r:
+        assert r.status == 200
+    warmed = srv.preview.proc  # opening the page starts the child: it loads the kernel while the page predicts
+    assert warmed is not None
     status, _ = _post(f"http://127.0.0.1:{port}", "/preview", {"spec": _raw(LASER_ONLY)})
     proc = srv.preview.proc
-    assert status == 200 and proc.poll() is None
+    assert status == 200 and proc is warmed and proc.poll() is None
     srv.shutdown()
     srv.server_close()
     assert proc.wait(timeout=10) is not None

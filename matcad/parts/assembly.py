@@ -35,11 +35,19 @@ def drilled(plate, neck_diameters: tuple[float, ...]):
     return dataclasses.replace(plate, holes=holes)
 
 
-def assembled_parts(spec, made: dict | None = None) -> dict[str, object]:
+def _build(name: str, cap, build):
+    """The default ``memo`` of :func:`assembled_parts`: build every part."""
+    return build()
+
+
+def assembled_parts(spec, made: dict | None = None, memo=_build) -> dict[str, object]:
     """Name → solid in the assembly frame (mm). Spacers are numbered when laser-cut; a board's caps and needles
     are named after their taxels (end_cap_t1, needle_t1, ...). ``made``: solids the build already made in their
     design frame (:func:`matcad.parts.catalogue.printed_parts`): a single taxel's cap and the needle mount are
-    placed from those (moved copies) instead of being built again."""
+    placed from those (moved copies) instead of being built again. ``memo(name, cap, build)`` returns the solid
+    ``build()`` makes, or an equal one it kept (the design page's preview caches parts,
+    :mod:`matcad.serve.preview`): ``cap`` is the single-taxel spec a cap is made from (its position dropped),
+    None for a part that depends on the whole board."""
     from build123d import Pos
 
     from matcad.spec import taxel_spec, taxels
@@ -47,27 +55,33 @@ def assembled_parts(spec, made: dict | None = None) -> dict[str, object]:
     made = made or {}
     board = taxels(spec)
 
-    def reuse(name, build):
-        return Pos(0, 0, 0) * made[name] if name in made else build()
+    def reuse(name, build, cap=None):
+        return Pos(0, 0, 0) * made[name] if name in made else memo(name, cap, build)
 
     plate_t = spec.neck.length
     parts = {
-        "neck_plate": flat_solid(drilled(neck_plate(spec), tuple(t.neck.diameter for t in board))),
-        "guide_locator": flat_solid(guide(spec, "locator"), plate_t),
-        "guide_clamp": flat_solid(guide(spec, "clamp"), clamp_seat_z_mm(spec)),
+        "neck_plate": memo("neck_plate", None, lambda: flat_solid(drilled(neck_plate(spec),
+                                                                          tuple(t.neck.diameter for t in board)))),
+        "guide_locator": memo("guide_locator", None, lambda: flat_solid(guide(spec, "locator"), plate_t)),
+        "guide_clamp": memo("guide_clamp", None, lambda: flat_solid(guide(spec, "clamp"), clamp_seat_z_mm(spec))),
     }
     if len(board) == 1:
-        parts |= {"end_cap": Pos(0, 0, plate_t) * reuse("end_cap", lambda: end_cap(spec)),
-                  "needle_mount": reuse("needle_mount", lambda: needle_mount(spec)), "needle": needle(spec)}
+        parts |= {"end_cap": Pos(0, 0, plate_t) * reuse("end_cap", lambda: end_cap(spec), cap=spec),
+                  "needle_mount": reuse("needle_mount", lambda: needle_mount(spec)),
+                  "needle": memo("needle", None, lambda: needle(spec))}
     else:
-        parts |= {f"end_cap_{t.name}": Pos(t.x, t.y, plate_t) * end_cap(taxel_spec(spec, t)) for t in board}
+        caps = {t.name: taxel_spec(spec, t) for t in board}
+        parts |= {f"end_cap_{t.name}": Pos(t.x, t.y, plate_t) * memo(f"end_cap_{t.name}", caps[t.name],
+                                                                     lambda c=caps[t.name]: end_cap(c))
+                  for t in board}
         parts["needle_mount"] = reuse("needle_mount", lambda: needle_mount(spec))
-        parts |= {f"needle_{t.name}": taxel_needle(t) for t in board}
+        parts |= {f"needle_{t.name}": memo(f"needle_{t.name}", None, lambda t=t: taxel_needle(t)) for t in board}
     if spec.spacer.style == "laser":
         one = spacer(spec)
         for i, (x, y) in enumerate(plate_bolt_positions_mm(spec), 1):
             # each spacer its own solid: moved copies of one solid share one STEP product, named after the last
-            parts[f"spacer_{i}"] = Pos(x, y, 0) * flat_solid(one, -spec.spacer.height)
+            parts[f"spacer_{i}"] = memo(f"spacer_{i}", None,
+                                        lambda x=x, y=y: Pos(x, y, 0) * flat_solid(one, -spec.spacer.height))
     return parts
 
 

@@ -5,8 +5,10 @@ plate for the page's 3-D view. Lengths mm, times ms.
 Both need the CAD kernel (build123d, ~0.5 GB and seconds to import), which the server process never loads (its
 predictions stay light): :class:`PreviewWorker` keeps ONE child process, ``python -m matcad.serve.preview``,
 that imports the kernel once and then answers one request per line (JSON in on stdin, JSON out on stdout), so
-each preview after the first costs only the geometry (measure: ``benchmarks/page.py``). The child is started on
-the first preview, restarted if it dies or overruns :data:`PREVIEW_TIMEOUT_S`, and ended with the server.
+each preview after the first costs only the geometry (measure: ``benchmarks/page.py``). The child is started when
+the page is served (:meth:`PreviewWorker.warm`) or on the first preview, restarted if it dies or overruns
+:data:`PREVIEW_TIMEOUT_S`, and ended with the server. It keeps the parts it built (:class:`PartCache`): an edit
+rebuilds only the parts built from the fields it changed.
 """
 
 from __future__ import annotations
@@ -45,9 +47,20 @@ class PreviewWorker:
         return subprocess.Popen([sys.executable, "-m", "matcad.serve.preview"], stdin=subprocess.PIPE,
                                 stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env)
 
+    def warm(self) -> None:
+        """Start the child now if none runs and no preview is in flight (the page was just opened: the child loads
+        the CAD kernel while the page predicts, and its first preview costs only the geometry)."""
+        if not self.lock.acquire(blocking=False):
+            return
+        try:
+            if not self.stopped and (self.proc is None or self.proc.poll() is not None):
+                self.proc = self._start()
+        finally:
+            self.lock.release()
+
     def ask(self, spec_data: dict, what: str = "section", timeout_s: float = PREVIEW_TIMEOUT_S) -> dict:
-        """The preview of the validated spec data ``spec_data``: ``what`` = "section" → {"svg", "ms"}, "mesh" →
-        {"parts", "ms"}; or {"error": ...}.
+        """The preview of the validated spec data ``spec_data``: ``what`` = "section" → {"svg", "ms"}, "mesh",
+        "assembly" or "molds" (:data:`MESHES`) → {"parts", "ms"}; or {"error": ...}.
         TimeoutError when the child does not answer within ``timeout_s`` (it is then ended)."""
         from matcad.serve.common import Refused
 
@@ -109,25 +122,97 @@ def _mesh(name: str, solid, colour: str) -> dict:
             "triangles": [i for t in triangles for i in t]}
 
 
-_LAST: dict = {}
-"""The child's last spec (its JSON) and its assembled parts: the mesh request that follows a section reuses them."""
+ACOUSTIC_TABLES = ("air", "wall", "microphone", "silicone", "calibration", "mechanics", "reference", "measured")
+"""Spec tables no solid reads (the physics' inputs): an edit there rebuilds no part."""
+CAP_ONLY = ("cavity_diameter", "cavity_length", "cap_top_thickness", "calibration")
+"""[[taxel]] keys only that taxel's cap reads: an edit there rebuilds that cap alone."""
+MOLD_IGNORES = ("x", "y")
+"""[[taxel]] keys the cap mold does not read (it casts the caps side by side, wherever they sit on the plate)."""
+CACHE_SIZE = 128
+"""Solids kept, and meshes kept, least recently used dropped first: a board's 18 parts for several edits (a mesh
+is up to ~1 MB of lists, a mold solid a few MB)."""
 
 
-def _assembled(spec, key: str) -> dict:
-    from matcad.parts.assembly import assembled_parts
+def _projection(spec, drop: tuple[str, ...] = ()) -> str:
+    """``spec`` as text without the tables no solid reads, the shared [cavity] if ``drop`` names it, and the
+    [[taxel]] keys ``drop`` names: the key of the parts built from it."""
+    import dataclasses
 
-    if _LAST.get("key") != key:
-        _LAST.clear()
-        _LAST.update(key=key, parts=assembled_parts(spec))
-    return _LAST["parts"]
+    data = dataclasses.asdict(spec)
+    for table in ACOUSTIC_TABLES + tuple(t for t in drop if t == "cavity"):
+        data.pop(table, None)
+    data["taxel"] = [{k: v for k, v in entry.items() if k not in drop} for entry in data.get("taxel", ())]
+    return repr(data)
 
 
-def section(spec, key: str) -> dict:
-    """The report's dimensioned section of ``spec`` as SVG text, and the time it took (ms)."""
+class PartCache:
+    """The child's solids and meshes kept between requests, keyed by what they are built from: a board part by the
+    spec without the physics' tables and the caps' own fields; a cap by its single-taxel spec (position dropped);
+    the mold by the spec without the physics' tables and the positions. An edit to one taxel's cavity rebuilds its
+    cap and the mold only; a move rebuilds the board's flat parts, mount and needles but no cap and no mold. ``built``
+    counts the parts built (name → times), for the tests."""
+
+    def __init__(self):
+        from collections import Counter, OrderedDict
+
+        self.solids: OrderedDict = OrderedDict()
+        self.meshes: OrderedDict = OrderedDict()
+        self.built: Counter = Counter()
+
+    @staticmethod
+    def _get(store, key, make):
+        if key in store:
+            store.move_to_end(key)
+            return store[key]
+        value = store[key] = make()
+        if len(store) > CACHE_SIZE:
+            store.popitem(last=False)
+        return value
+
+    def assembled(self, spec) -> tuple[dict, dict]:
+        """The assembled parts of ``spec`` (name → solid, :func:`matcad.parts.assembly.assembled_parts`) and each
+        one's cache key (name → key)."""
+        from matcad.parts.assembly import assembled_parts
+
+        board_key, keys = _projection(spec, ("cavity", *CAP_ONLY)), {}
+
+        def memo(name, cap, build):
+            key = keys[name] = ("end_cap", _projection(cap)) if cap is not None \
+                else (name, board_key)
+            return self._get(self.solids, key, lambda: self._count(name, build))
+
+        parts = assembled_parts(spec, memo=memo)
+        return parts, keys
+
+    def _count(self, name, build):
+        self.built[name] += 1
+        return build()
+
+    def mold(self, spec, name: str):
+        """The printed mold part ``name`` of ``spec`` (design frame) and its key."""
+        from matcad.parts.registry import part
+
+        key = (name, _projection(spec, MOLD_IGNORES))
+        return self._get(self.solids, key, lambda: self._count(name, lambda: part(name).make(spec))), key
+
+    def mesh(self, key, name: str, solid, colour: str) -> dict:
+        """:func:`_mesh` of ``solid`` (made from ``key``; its bounding box tells where it was placed), kept."""
+        box = solid.bounding_box()
+        where = tuple(round(c, 6) for c in (box.min.X, box.min.Y, box.min.Z, box.max.X, box.max.Y, box.max.Z))
+        return self._get(self.meshes, (key, where, colour), lambda: _mesh(name, solid, colour)) | {"name": name}
+
+
+CACHE = PartCache()
+"""The child's one cache."""
+
+
+def section(spec, cache: PartCache | None = None) -> dict:
+    """The report's dimensioned section of ``spec`` as SVG text, and the time it took (ms); parts from ``cache``
+    (default :data:`CACHE`)."""
     from matcad.render.section import write_section_svg
 
     t0 = time.perf_counter()
-    parts = _assembled(spec, key)
+    parts, _ = (cache or CACHE).assembled(spec)
     with tempfile.TemporaryDirectory(prefix="matcad-preview-") as tmp:
         path = Path(tmp) / "section.svg"
         write_section_svg(spec, path, parts)
@@ -135,27 +220,35 @@ def section(spec, key: str) -> dict:
     return {"svg": svg, "ms": round(1e3 * (time.perf_counter() - t0))}
 
 
-def meshes(spec, key: str) -> dict:
-    """The meshes of the assembled parts and of the cap mold's parts (when the spec asks for the mold), the molds
-    set beside the plate (+x), and the time it took (ms)."""
+MESHES = {"mesh": ("assembly", "molds"), "assembly": ("assembly",), "molds": ("molds",)}
+"""A mesh request's ``what`` → the groups it draws: the page asks for the assembly, then the molds (slow on a
+board: the mold is rebuilt on any cap edit), so an edit made meanwhile waits for the assembly only."""
+
+
+def meshes(spec, cache: PartCache | None = None, groups=("assembly", "molds")) -> dict:
+    """The meshes of the assembled parts (group "assembly") and of the cap mold's parts when the spec asks for the
+    mold (group "molds"), the molds set beside the plate (+x), and the time it took (ms)."""
     from build123d import Pos
 
     from matcad.parts.registry import part
     from matcad.render.section import layer_of, section_colours
 
     t0 = time.perf_counter()
-    colours = section_colours()
-    out = [_mesh(name, solid, colours.get(layer_of(name), "#999999"))
-           for name, solid in _assembled(spec, key).items()]
+    colours, cache = section_colours(), cache or CACHE
+    out = []
+    if "assembly" in groups:
+        parts, keys = cache.assembled(spec)
+        out = [cache.mesh(keys[name], name, solid, colours.get(layer_of(name), "#999999")) if name in keys
+               else _mesh(name, solid, colours.get(layer_of(name), "#999999")) for name, solid in parts.items()]
     x = spec.plate.width / 2 + 6.0
     for name in MOLD_PARTS:
-        if not part(name).wanted(spec):
+        if "molds" not in groups or not part(name).wanted(spec):
             continue
-        solid = part(name).make(spec)
+        solid, key = cache.mold(spec, name)
         box = solid.bounding_box()
         placed = Pos(x - box.min.X, -(box.min.Y + box.max.Y) / 2, -box.min.Z) * solid
         x += box.max.X - box.min.X + 4.0
-        out.append(_mesh(name, placed, "#b0b8c8" if name.endswith("lid") else "#8890a8"))
+        out.append(cache.mesh(key, name, placed, "#b0b8c8" if name.endswith("lid") else "#8890a8"))
     return {"parts": out, "ms": round(1e3 * (time.perf_counter() - t0))}
 
 
@@ -168,9 +261,9 @@ def serve_requests(stdin, stdout) -> None:
     for line in stdin:
         try:
             request = json.loads(line)
-            key = json.dumps(request["spec"], sort_keys=True)
-            work = meshes if request.get("what") == "mesh" else section
-            answer = work(from_dict(request["spec"]), key)
+            what = request.get("what", "section")
+            answer = meshes(from_dict(request["spec"]), groups=MESHES[what]) if what in MESHES \
+                else section(from_dict(request["spec"]))
         except (SpecError, ValueError) as exc:
             answer = {"error": {"field": getattr(exc, "field", None), "message": str(exc)}}
         except Exception as exc:  # noqa: BLE001 - a bug in a preview is told to the page, the child lives on

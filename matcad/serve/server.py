@@ -41,11 +41,14 @@ def page_html(template: str) -> str:
 
 def preview_json(payload: dict, worker: PreviewWorker) -> tuple[int, dict]:
     """The request's spec (validated here first) drawn by the preview process: ``"what": "section"`` (default) →
-    the report's section SVG; ``"mesh"`` → the parts' meshes for the page's 3-D view (:mod:`matcad.serve.preview`)."""
+    the report's section SVG; ``"mesh"`` → the parts' meshes for the page's 3-D view, ``"assembly"`` or ``"molds"``
+    → the assembled parts' or the cap mold's alone (:data:`matcad.serve.preview.MESHES`)."""
+    from matcad.serve.preview import MESHES
+
     spec_of(payload)
     what = payload.get("what", "section")
-    if what not in ("section", "mesh"):
-        raise Refused(422, f"what {str(what)[:40]!r} invalid, must be 'section' or 'mesh'", "what")
+    if what not in ("section", *MESHES):
+        raise Refused(422, f"what {str(what)[:40]!r} invalid, must be one of section, {', '.join(MESHES)}", "what")
     answer = worker.ask(payload["spec"], what)
     return (422 if "error" in answer else 200), answer
 
@@ -193,7 +196,9 @@ class Handler(BaseHTTPRequestHandler):
             if url.path == "/":
                 template = parse_qs(url.query).get("template", [DEFAULT_TEMPLATE])[0]
                 try:
-                    return 200, page_html(template).encode(), "text/html; charset=utf-8"
+                    html = page_html(template).encode()
+                    self.server.preview.warm()  # the page previews once it has predicted: load the kernel now
+                    return 200, html, "text/html; charset=utf-8"
                 except ValueError as exc:
                     raise Refused(400, str(exc), "template") from None
             if url.path == "/schema.json":

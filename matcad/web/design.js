@@ -11,7 +11,8 @@ const inputs = {};
 let taxelRows = [];      // [{cells: {column: input}, extra: {...}}]: extra keeps what the table does not edit
 let preserved = {};      // other arrays of tables ([[measured]], ...) passed through unchanged
 let INITIAL = BOOT.initial;
-window.matcad = {stages: [], bandsShownMs: null, previewMs: [], editToSectionMs: [], meshMs: null, editAt: null};
+window.matcad = {stages: [], bandsShownMs: null, previewMs: [], editToSectionMs: [], meshMs: null, moldMs: null,
+                 editAt: null};
 
 function initialValue(key) {
   let node = INITIAL;
@@ -411,14 +412,21 @@ async function preview() {  // the section, then the meshes; a newer edit waits 
   }
 }
 
-async function mesh(spec) {
+async function mesh(spec) {  // the assembly, then (unless a newer edit waits) the mold beside it
   const t0 = performance.now();
   $("mesh-status").textContent = "(meshing…)";
-  const [status, data] = await post("/preview", {spec, what: "mesh"});
+  const [status, data] = await post("/preview", {spec, what: "assembly"});
   if (status !== 200) { $("mesh-status").textContent = "(no mesh: " + data.error.message + ")"; return; }
   window.matcad.meshMs = performance.now() - t0;
-  $("mesh-status").textContent = `(${data.parts.length} parts, ${window.matcad.meshMs.toFixed(0)} ms)`;
+  $("mesh-status").textContent = `(${data.parts.length} parts, ${window.matcad.meshMs.toFixed(0)} ms; mold…)`;
   viewer.show(data.parts);
+  if (previewDirty) return;
+  const [moldStatus, molds] = await post("/preview", {spec, what: "molds"});
+  if (moldStatus !== 200) { $("mesh-status").textContent = "(no mold mesh: " + molds.error.message + ")"; return; }
+  window.matcad.moldMs = performance.now() - t0;
+  const parts = data.parts.concat(molds.parts);
+  $("mesh-status").textContent = `(${parts.length} parts, ${window.matcad.moldMs.toFixed(0)} ms)`;
+  viewer.show(parts);
 }
 
 // ---- save, load, share ----------------------------------------------------------------------------------------------
