@@ -1,7 +1,7 @@
 """Fast checks of the recording loop's decisions that a deliberate fault would break (issue 20): the listening band
 of a single taxel's `analyze --spec`, the sense band and force from a calibration file, a crossing decided by the
-two lines' levels, the voicing thresholds, and the temperature correction of sense. Short synthetic recordings
-(matcad.loop.synth), a few seconds in all."""
+two lines' levels, a hop onto where the second tone was, the voicing thresholds, and the temperature correction of
+sense. Short synthetic recordings (matcad.loop.synth), a few seconds in all."""
 
 from __future__ import annotations
 
@@ -138,6 +138,28 @@ def test_touch_and_return_of_unequal_levels_is_decided_by_level(taxel_db, seed):
     after = a.voiced & (a.times_s > 4.5)  # released: the taxel back at its 2 N pitch, the neighbour at 8 N
     err = np.abs(a.track_hz - truth[np.clip((a.times_s * FS).astype(int), 0, len(truth) - 1)])
     assert after.sum() > 50 and np.all(err[after] < 10.0)
+
+
+def test_ridge_landing_where_the_second_tone_was_is_a_hop():
+    """The ridge jumps 150 Hz onto a second tone seen for 30 frames before, and the taxel's own line is not seen
+    after (a weaker taxel under a newcomer): a hop, said in a warning, and no frame after it is reported at the
+    other tone's pitch; the frames before are the taxel's, unchanged. Per-frame lines at the analysis' bin spacing
+    (matcad.listening), no recording."""
+    from matcad.listening import ZERO_PAD, window_samples
+    from matcad.loop.crossing import follow_taxel
+
+    n, df = 60, FS / (ZERO_PAD * window_samples(FS))
+    freqs = 3900.0 + df * np.arange(400)
+    taxel, other = (freqs[round((hz - freqs[0]) / df)] for hz in (4450.0, 4600.0))
+    frame = np.arange(n)
+    track = np.where(frame < 40, taxel, other)
+    seen = (frame >= 10) & (frame < 40)  # the second tone: 14 dB over its floor, 3 dB under the ridge
+    other_bin = np.where(seen, round((other - freqs[0]) / df), round((5400.0 - freqs[0]) / df))
+    identity = follow_taxel(frame * window_samples(FS) / 2 / FS, track, np.ones(n, dtype=int), other_bin,
+                            np.where(seen, 14.0, 0.0), np.where(seen, -3.0, -30.0), np.full(n, 20.0), freqs)
+    assert any("the ridge jumped" in w and "the taxel is kept on its line" in w for w in identity.warnings)
+    assert not np.any((identity.state[40:] >= 1) & (np.abs(identity.track_hz[40:] - other) < 10.0))
+    assert np.all(identity.state[:40] == 1) and np.all(identity.track_hz[:40] == taxel)
 
 
 # --- voicing thresholds -----------------------------------------------------------------------------------------

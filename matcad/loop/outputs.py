@@ -76,15 +76,24 @@ def write_track_csv(analysis, path: Path) -> None:
 def write_segments_csv(analysis, path: Path, forces=None) -> None:
     """segments.csv of one taxel: per segment start, end (s), frames, mean/median/sd frequency (Hz), flag; and force
     with its 95 % interval (N) when ``forces`` (one (force, low, high) per segment) is given."""
-    head = "start_s,end_s,frames,mean_hz,median_hz,std_hz"
-    head += ",force_n,force_low_n,force_high_n" if forces is not None else ""
-    rows = [head + ",flag"]
-    for i, s in enumerate(analysis.segments):
-        row = f"{s.start_s:.3f},{s.end_s:.3f},{s.frames},{s.mean_hz:.3f},{s.median_hz:.3f},{s.std_hz:.3f}"
-        if forces is not None:
-            row += "," + ",".join(_cell(v) for v in forces[i])
-        rows.append(row + "," + s.flag.replace(",", ";"))
+    rows = [_segments_head(forces is not None)]
+    rows += [_segment_row(s, None if forces is None else forces[i]) for i, s in enumerate(analysis.segments)]
     path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+
+
+def _segments_head(with_force: bool) -> str:
+    """segments.csv's columns after any leading ones: the segment's, the force's when ``with_force``, the flag."""
+    return "start_s,end_s,frames,mean_hz,median_hz,std_hz" + (",force_n,force_low_n,force_high_n" if with_force
+                                                               else "") + ",flag"
+
+
+def _segment_row(s, force=None) -> str:
+    """One segments.csv row after any leading columns: start, end (s), frames, mean/median/sd (Hz), the
+    ``force`` cells (force, low, high in N; None: no force columns) and the flag."""
+    row = f"{s.start_s:.3f},{s.end_s:.3f},{s.frames},{s.mean_hz:.3f},{s.median_hz:.3f},{s.std_hz:.3f}"
+    if force is not None:
+        row += "," + ",".join(_cell(v) for v in force)
+    return row + "," + s.flag.replace(",", ";")
 
 
 def write_forces_csv(analysis, reading, path: Path) -> None:
@@ -121,18 +130,14 @@ def write_board_segments_csv(tracks, path: Path, readings=None) -> None:
     """segments.csv of a board: per taxel and segment taxel, start, end (s), frames, mean/median/sd frequency
     (Hz), with ``readings`` ({name: Reading}) force and its 95 % interval (N; empty for a taxel without
     calibration), flag."""
-    head = "taxel,start_s,end_s,frames,mean_hz,median_hz,std_hz"
-    head += ",force_n,force_low_n,force_high_n" if readings is not None else ""
-    rows = [head + ",flag"]
+    rows = ["taxel," + _segments_head(readings is not None)]
     for t in tracks:
         if t.analysis is None:
             continue
         reading = (readings or {}).get(t.name)
         for i, s in enumerate(t.analysis.segments):
-            row = f"{t.name},{s.start_s:.3f},{s.end_s:.3f},{s.frames},{s.mean_hz:.3f},{s.median_hz:.3f},{s.std_hz:.3f}"
-            if readings is not None:
-                row += "," + ",".join(_cell(v) for v in (reading.segments_n[i] if reading else (None,) * 3))
-            rows.append(row + "," + s.flag.replace(",", ";"))
+            force = None if readings is None else (reading.segments_n[i] if reading else (None,) * 3)
+            rows.append(f"{t.name}," + _segment_row(s, force))
     path.write_text("\n".join(rows) + "\n", encoding="utf-8")
 
 

@@ -88,17 +88,23 @@ def plot(analysis, path, forces=None) -> None:
         pad = 0.05 * (hi - lo) or 0.5
         bx = canvas.axes((left, top + panel, right, bottom + panel), xlim, (lo - pad, hi + pad))
         times = analysis.times_s
-        for run in np.split(np.arange(len(times)), np.flatnonzero(~ok) + 1):
-            run = run[ok[run]]
-            if len(run) > 1:
-                bx.polygon(list(zip(times[run], high[run])) + list(zip(times[run][::-1], low[run][::-1])),
-                           "#b5d0e8")
+        _interval(bx, times, low, high, "#b5d0e8")
         for x, f in zip(times, force):
             if np.isfinite(f):
                 bx.marker(x, f, "o", "black", 1.2)
         bx.frame(xlabel="time [s]", ylabel="force [N]", grid="y")
         bx.legend([("95 % interval", "#b5d0e8", "bar"), ("force per voiced frame", "black", "o")])
     canvas.save(path)
+
+
+def _interval(ax, times, low, high, colour) -> None:
+    """The band from ``low`` to ``high`` (a force's interval in N, a frequency's spread in Hz) over ``times`` (s)
+    filled in ``colour``: one polygon per run of two or more points where both ends are finite."""
+    ok = np.isfinite(low) & np.isfinite(high)
+    for run in np.split(np.arange(len(times)), np.flatnonzero(~ok) + 1):
+        run = run[ok[run]]
+        if len(run) > 1:
+            ax.polygon(list(zip(times[run], high[run])) + list(zip(times[run][::-1], low[run][::-1])), colour)
 
 
 def _windowed(times, values, edges):
@@ -123,11 +129,7 @@ def overview(canvas, box, analysis, force=None):
     hz = _windowed(times, np.where(analysis.voiced, analysis.track_hz, np.nan), edges)
     top_hz = 1.15 * max(float(np.nanmax(hz[:, 2])) if np.isfinite(hz).any() else 1.0, float(analysis.band_hz[1]))
     ax = canvas.axes(box, (0.0, float(times[-1])), (0.0, top_hz))
-    ok = np.isfinite(hz[:, 0])
-    for run in np.split(np.arange(len(mids)), np.flatnonzero(~ok) + 1):
-        run = run[ok[run]]
-        if len(run) > 1:
-            ax.polygon(list(zip(mids[run], hz[run, 2])) + list(zip(mids[run][::-1], hz[run, 0][::-1])), "#c5d7ec")
+    _interval(ax, mids, hz[:, 0], hz[:, 2], "#c5d7ec")
     ax.line(mids, hz[:, 1], "#1f4e8c", 1)
     means = np.array([s.mean_hz for s in analysis.segments])
     summary = (f"{len(means)} segments, means {means.min():.0f}-{means.max():.0f} Hz (median {np.median(means):.0f})"
@@ -204,12 +206,7 @@ def plot_board(tracks, path, readings=None) -> None:
         for k, t, r in shown:
             colour, times = TAB10[k % 10], t.analysis.times_s
             low, high = np.asarray(r.frames_interval_n[:, 0], float), np.asarray(r.frames_interval_n[:, 1], float)
-            ok = np.isfinite(low) & np.isfinite(high)
-            for run in np.split(np.arange(len(times)), np.flatnonzero(~ok) + 1):
-                run = run[ok[run]]
-                if len(run) > 1:
-                    bx.polygon(list(zip(times[run], high[run])) + list(zip(times[run][::-1], low[run][::-1])),
-                               tint(colour, 0.25))
+            _interval(bx, times, low, high, tint(colour, 0.25))
         for k, t, r in shown:
             bx.line(t.analysis.times_s, np.asarray(r.frames_n, float), TAB10[k % 10], 1)
         bx.frame(xlabel="time [s]", ylabel="force [N]", grid="y")

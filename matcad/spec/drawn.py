@@ -14,22 +14,21 @@ from dataclasses import dataclass
 from matcad.spec.fields import length_mm
 
 
+def _drawn(what: str):
+    """One length of the measured taxel's drawing (mm; None: the spec's as loaded)."""
+    return length_mm(f"{what} of the measured taxel's drawing; default this spec's as loaded", None)
+
+
 @dataclass(frozen=True, kw_only=True)
 class Drawn:
     """Geometry fields of a measured taxel's drawing (mm; None: this spec's as loaded)."""
 
-    cavity_diameter: float | None = length_mm("cavity diameter of the measured taxel's drawing; default this spec's "
-                                              "as loaded", None)
-    cavity_length: float | None = length_mm("cavity length of the measured taxel's drawing; default this spec's as "
-                                            "loaded", None)
-    neck_diameter: float | None = length_mm("neck diameter of the measured taxel's drawing; default this spec's as "
-                                            "loaded", None)
-    neck_length: float | None = length_mm("neck length (sheet) of the measured taxel's drawing; default this spec's "
-                                          "as loaded", None)
-    cap_outer_diameter: float | None = length_mm("end-cap outer diameter of the measured taxel's drawing; default "
-                                                 "this spec's as loaded", None)
-    cap_top_thickness: float | None = length_mm("end-cap top thickness of the measured taxel's drawing; default "
-                                                "this spec's as loaded", None)
+    cavity_diameter: float | None = _drawn("cavity diameter")
+    cavity_length: float | None = _drawn("cavity length")
+    neck_diameter: float | None = _drawn("neck diameter")
+    neck_length: float | None = _drawn("neck length (sheet)")
+    cap_outer_diameter: float | None = _drawn("end-cap outer diameter")
+    cap_top_thickness: float | None = _drawn("end-cap top thickness")
 
 
 DRAWN = {"cavity_diameter": ("cavity", "diameter"), "cavity_length": ("cavity", "length"),

@@ -21,6 +21,19 @@ CAP_OUTER_PER_D = 2.5
 CAP_TOP_PER_D = 0.6
 
 
+def _example_sheet(thickness: str) -> Any:
+    """A sheet's ``thickness_example`` field, whose thickness is the field ``thickness`` ('neck.length')."""
+    return param(f"true if {thickness} (with thickness_measured = true) is an example value, a template's stand-in "
+                 "for a calipered sheet: predictions use it as measured, `check` reports it unverified until you "
+                 "enter yours and set this false", default=False, kind="bool")
+
+
+def _sheet_kerf(sheet: str) -> Any:
+    """A laser-cut sheet's ``laser_kerf`` field (mm; None: machine.laser_kerf)."""
+    return param(f"full kerf in the {sheet} sheet; default machine.laser_kerf (kerf grows with sheet thickness: "
+                 "measure each sheet with `matcad coupon`)", "mm", None, lo=0.0, hi=5.0, lo_open=False)
+
+
 @dataclass(frozen=True)
 class Cavity(Section):
     """The silicone end cap's cylindrical channel (paper: D, L)."""
@@ -55,10 +68,7 @@ class Plate(Section):
     depth: float = length_mm("neck plate depth (y), neck at its centre", 24.0)
     thickness_measured: bool = param("true if neck.length is the measured sheet thickness (cast acrylic "
                                      "varies +-(0.4 + 0.1 t) mm, ISO 7823-1)", default=False, kind="bool")
-    thickness_example: bool = param("true if neck.length (with thickness_measured = true) is an example value, a "
-                                    "template's stand-in for a calipered sheet: predictions use it as measured, "
-                                    "`check` reports it unverified until you enter yours and set this false",
-                                    default=False, kind="bool")
+    thickness_example: bool = _example_sheet("neck.length")
     label: str = param("text engraved on the neck plate ('' for none)", default="", kind="text")
     neck_pilot: bool = param("cut the neck as an undersize pilot, to be drilled to neck.diameter "
                              "(avoids the laser's taper in thick sheet)", default=False, kind="bool")
@@ -66,9 +76,7 @@ class Plate(Section):
                                    hi=LENGTH_MAX_MM)
     bolt_inset: float = param("bolt and dowel centres inset from the plate edges", "mm", 2.5, lo=0.0,
                               hi=LENGTH_MAX_MM)
-    laser_kerf: float | None = param("full kerf in the neck plate sheet; default machine.laser_kerf (kerf "
-                                     "grows with sheet thickness: measure each sheet with `matcad coupon`)",
-                                     "mm", None, lo=0.0, hi=5.0, lo_open=False)
+    laser_kerf: float | None = _sheet_kerf("neck plate")
 
 
 @dataclass(frozen=True)
@@ -80,13 +88,8 @@ class Guide(Section):
     thickness: float = length_mm("guide sheet thickness (paper: 1.5 mm acrylic)", 1.5)
     thickness_measured: bool = param("true if guide.thickness is a measured value", default=False,
                                      kind="bool")
-    thickness_example: bool = param("true if guide.thickness (with thickness_measured = true) is an example value, a "
-                                    "template's stand-in for a calipered sheet: predictions use it as measured, "
-                                    "`check` reports it unverified until you enter yours and set this false",
-                                    default=False, kind="bool")
-    laser_kerf: float | None = param("full kerf in the guide sheet; default machine.laser_kerf (kerf "
-                                     "grows with sheet thickness: measure each sheet with `matcad coupon`)",
-                                     "mm", None, lo=0.0, hi=5.0, lo_open=False)
+    thickness_example: bool = _example_sheet("guide.thickness")
+    laser_kerf: float | None = _sheet_kerf("guide")
 
 
 @dataclass(frozen=True)
@@ -102,13 +105,8 @@ class Spacer(Section):
     size: float = length_mm("spacer square side / standoff diameter", 5.0)
     thickness_measured: bool = param("true if spacer.height is a measured sheet thickness", default=False,
                                      kind="bool")
-    thickness_example: bool = param("true if spacer.height (with thickness_measured = true) is an example value, a "
-                                    "template's stand-in for a calipered sheet: predictions use it as measured, "
-                                    "`check` reports it unverified until you enter yours and set this false",
-                                    default=False, kind="bool")
-    laser_kerf: float | None = param("full kerf in the spacer sheet; default machine.laser_kerf (kerf "
-                                     "grows with sheet thickness: measure each sheet with `matcad coupon`)",
-                                     "mm", None, lo=0.0, hi=5.0, lo_open=False)
+    thickness_example: bool = _example_sheet("spacer.height")
+    laser_kerf: float | None = _sheet_kerf("spacer")
 
 
 @dataclass(frozen=True)
