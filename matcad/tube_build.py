@@ -1,6 +1,6 @@
 """`matcad build` of a ``kind = "tube"`` spec: the printed fipple tube, the MAT cap and its mold (the registry's
-parts, made on the tube's cap), previews, and report.json / report.md, written atomically into one folder. Lengths
-mm. docs/tube.md.
+parts, made on the tube's cap), previews, and report.json / report.md (with a MAT taxel at the same pitch beside it,
+:mod:`matcad.design.tube_vs_mat`), written atomically into one folder. Lengths mm. docs/tube.md.
 """
 
 from __future__ import annotations
@@ -40,6 +40,7 @@ def build_tube(spec, out_dir: Path | None = None, force: bool = False):
     """Build a tube spec into ``out_dir`` (default out/<name>); raises DesignRuleFailure on rule errors unless
     ``force``. Returns (folder, report data)."""
     from matcad.build import DesignRuleFailure, default_out_dir, write_archive, write_printed_part
+    from matcad.design.tube_vs_mat import compare
     from matcad.parts.registry import part
     from matcad.prediction.tube import predict_tube
     from matcad.render.previews import preview_name, printed_preview
@@ -54,24 +55,25 @@ def build_tube(spec, out_dir: Path | None = None, force: bool = False):
         raise failure
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
     t = spec.tube
+    steps = [s.format(h=t.windway_height, d=t.bore_diameter, grade=spec.silicone.grade,
+                      needle=spec.needle.outer_diameter, flow=t.supply_flow_l_min) for s in STEPS]
+    comparison = compare(spec, prediction.f0_hz, steps)
     with staged_output(target) as tmp:
         meshes = {"tube.stl": _tube_files(spec, tmp)}
         for name in CAP_PARTS:
             meshes[f"{name}.stl"] = write_printed_part(name, part(name).make(spec), spec, tmp)
         figures = [printed_preview(Path(name).stem, tmp / name, tmp / preview_name(Path(name).stem))
                    for name in meshes]
-        steps = [s.format(h=t.windway_height, d=t.bore_diameter, grade=spec.silicone.grade,
-                          needle=spec.needle.outer_diameter, flow=t.supply_flow_l_min) for s in STEPS]
         report = {"name": spec.name, "kind": "tube", "spec": to_dict(spec), "prediction": prediction.to_dict(),
                   "findings": [f.to_dict() for f in findings], "meshes": meshes, "figures": figures,
-                  "fabrication": steps}
-        _write_report(report, prediction, tmp)
+                  "fabrication": steps, "beside_mat": comparison.to_dict()}
+        _write_report(report, prediction, comparison, tmp)
         write_archive(tmp, KIT_ARCHIVE)
     return target, report
 
 
-def _write_report(report: dict, prediction, folder: Path) -> None:
-    """report.json and report.md of a tube kit."""
+def _write_report(report: dict, prediction, comparison, folder: Path) -> None:
+    """report.json and report.md of a tube kit (``comparison``: :class:`matcad.design.tube_vs_mat.Comparison`)."""
     import json
 
     (folder / "report.json").write_text(json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8")
@@ -82,5 +84,6 @@ def _write_report(report: dict, prediction, folder: Path) -> None:
     lines += [f"| {name} | {m['volume_mm3']:.1f} | {m['watertight']} | {m['bed_face']} |"
               for name, m in report["meshes"].items()]
     lines += ["", "## Steps", ""] + [f"{i}. {s}" for i, s in enumerate(report["fabrication"], 1)]
+    lines += ["", "## Beside a MAT taxel", ""] + comparison.to_markdown()
     lines += [""] + [f"![{f['caption']}]({f['file']})" for f in report["figures"]]
     (folder / "report.md").write_text("\n".join(lines) + "\n", encoding="utf-8")

@@ -113,3 +113,23 @@ def test_build_refuses_a_supply_outside_the_edge_tone_window_and_writes_nothing(
     run = subprocess.run([sys.executable, "-m", "matcad", "build", str(TEMPLATE), "--out", str(out), "--set",
                           "tube.supply_flow_l_min=1.0"], capture_output=True, text=True, cwd=ROOT, timeout=300)
     assert run.returncode == 1 and "tube.edge_tone" in run.stdout and not out.exists()
+
+
+def test_the_report_sets_a_mat_taxel_at_the_same_pitch_beside_the_tube(kit):
+    """The tube's report compares a MAT taxel of the same f1 over the same forces (the paper's, its neck diameter
+    solved): the tube's height is the two STLs' stacked (tube, then the cap on its seat), f(F) rises for both."""
+    import trimesh
+
+    out, report, spec = kit
+    side = report["beside_mat"]
+    assert side["unavailable"] == ""
+    assert side["mat_f_hz"][0] == pytest.approx(report["prediction"]["f0_hz"], rel=1e-6)
+    assert side["tube_f_hz"][0] == pytest.approx(report["prediction"]["f0_hz"], rel=1e-9)
+    stacked = sum(trimesh.load_mesh(out / f"{name}.stl").extents[2] for name in ("tube", "end_cap"))
+    assert side["tube_length_mm"] == pytest.approx(stacked, abs=1e-3)
+    t = spec.tube
+    assert side["tube_air_mm3"] == pytest.approx(np.pi * t.bore_diameter**2 / 4 * (t.length + t.cap_cavity_depth))
+    assert np.all(np.diff(side["mat_f_hz"]) > 0) and np.all(np.diff(side["tube_f_hz"]) > 0)
+    assert side["tube_steps"] == len(report["fabrication"]) and len(side["mat_steps"]) > side["tube_steps"]
+    text = (out / "report.md").read_text(encoding="utf-8")
+    assert "## Beside a MAT taxel" in text and f"| taxel length (mm) | {side['mat_length_mm']:.2f}" in text

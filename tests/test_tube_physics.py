@@ -81,6 +81,32 @@ def test_stiff_cap_tends_to_the_rigid_line_and_the_wall_is_the_mat_wall_model(td
     assert T.cap_compliance_mm3_pa(td, 1.0, g) == pytest.approx(static, rel=1e-5)  # the wall's static limit
 
 
+def test_exterior_fem_resolves_the_flanged_mouth_and_converges_to_norris_and_sheng(td):
+    """The rung above the line: the MAT taxel's axisymmetric FEM (scikit-fem) on the tube, its mouth radiating
+    into a baffled exterior. The correction its f1 implies rises under refinement to Norris & Sheng's fit at the
+    same ka (order ~1.4, the flange edge's singularity); the line's lumped 0.8216 a is 0.1 % from it."""
+    flanged = dataclasses.replace(td, mouth="flanged")
+    long = dataclasses.replace(flanged, length=60.0)  # ka = 0.05: near the ka -> 0 limit
+    errors = []
+    for level in (2, 4, 8):
+        f = T.exterior_fem(long, level).f0_hz
+        errors.append(T.flanged_phase_correction_mm(long, f) - T.phase_correction_mm(long, f))
+    a = td.bore_diameter / 2
+    assert errors[2] > 0 and errors[2] < 0.003 * a
+    assert 2.2 < errors[0] / errors[1] < 3.2 and 2.2 < errors[1] / errors[2] < 3.2
+    fem_f = T.exterior_fem(flanged, 4).f0_hz
+    assert 0 < fem_f / T.line_hz(flanged) - 1 < 0.002
+    with pytest.raises(ValueError, match="flanged mouth only"):
+        T.exterior_fem(td)
+    from matcad.prediction.tube import predict_tube
+    from matcad.spec import from_dict, to_dict
+
+    data = to_dict(load(TEMPLATE))
+    data["tube"]["mouth"] = "flanged"
+    assert predict_tube(from_dict(data), fem_level=4).routes_hz["exterior FEM, level 4 (rigid)"] == pytest.approx(
+        fem_f, rel=1e-9)
+
+
 def test_edge_tone_window_is_strouhal_bounded_and_the_next_mode_needs_a_faster_jet(td):
     f1 = T.line_hz(td)
     f2 = T.line_hz(td, mode=2)

@@ -158,6 +158,42 @@ def fem_hz(td: TubeDesign, kappa_mm: float = 0.0, elements: int = 64, order: int
     return math.sqrt(k2[mode - 1]) * speed_of_sound(td.air) * 1e3 / (2 * math.pi)
 
 
+def exterior_fem(td: TubeDesign, level: int | None = None):
+    """The rigid-capped tube's f1 by the MAT taxel's axisymmetric P2 FEM (:func:`matcad.acoustics.fem.solve`,
+    scikit-fem): the (r, z) half-plane with the bore as its neck (``length``), the cap's cavity as its cavity of the
+    same radius (``cap_depth``), and the mouth radiating into the exterior, a quarter disc of 15 a in a rigid
+    baffle with the spherical radiation condition (fem's 'baffled'). It resolves the radiating mouth instead of
+    assuming δ: its f1 tends to the quarter wave with Norris & Sheng's frequency-dependent flanged correction
+    (:func:`flanged_phase_correction_mm`). ``level``: elements across the bore's radius (default fem's). Returns a
+    :class:`matcad.acoustics.fem.FemResult` (f in Hz). Only ``mouth = 'flanged'`` is axisymmetric with an exterior
+    fem.py builds; raises ValueError for 'fipple' (a window in the wall: 3-D) and 'unflanged' (the exterior around
+    the tube's outside is not meshed)."""
+    from matcad.acoustics import fem
+
+    if td.mouth != "flanged":
+        raise ValueError(f"the axisymmetric exterior FEM models a flanged mouth only, not tube.mouth = "
+                         f"'{td.mouth}' (a fipple window is 3-D; an unflanged exterior is not meshed): docs/tube.md")
+    a = td.bore_diameter / 2
+    g = fem.FemGeometry(neck_radius=a, neck_length=td.length, cavity_radius=a, cavity_tip_radius=a,
+                        cavity_length=td.cap_depth, mouth="baffled")
+    c = speed_of_sound(td.air)
+    return fem.solve(g, 2 * math.pi * line_hz(td) / (c * 1e3), level or fem.DEFAULT_LEVEL, speed_of_sound_m_s=c)
+
+
+def phase_correction_mm(td: TubeDesign, f_hz: float, mode: int = 1) -> float:
+    """The open end's correction (mm) that a rigid-capped resonance at ``f_hz`` (Hz) implies: the length the
+    reflection's phase adds, (2n − 1) c / 4f − ℓ (the definition of Norris & Sheng 1989 and Dalmont et al. 2001)."""
+    return (2 * mode - 1) * speed_of_sound(td.air) * 1e3 / (4 * f_hz) - td.column_mm
+
+
+def flanged_phase_correction_mm(td: TubeDesign, f_hz: float) -> float:
+    """Norris & Sheng's fit (1989, J. Sound Vib. 135:85, for ka < 3.5) of the flanged open end's phase correction
+    at ``f_hz`` (mm): 0.8216 a / (1 + (0.77 ka)² / (1 + 0.77 ka))."""
+    a = td.bore_diameter / 2
+    x = 0.77 * 2 * math.pi * f_hz / (speed_of_sound(td.air) * 1e3) * a
+    return FLANGED * a / (1 + x * x / (1 + x))
+
+
 def cap_shape(td: TubeDesign) -> wall_model.CapShape:
     """The silicone cap around the cap's cavity (the bore continued), mm: the MAT wall model's cap."""
     return wall_model.CapShape(cavity_radius=td.bore_diameter / 2, cavity_length=td.cap_depth,

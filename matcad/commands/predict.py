@@ -54,12 +54,14 @@ def run(args) -> int:
 
 
 def _tube(spec, forces, args) -> int:
-    """A fipple tube's prediction (docs/tube.md): its own routes; --model and --fem-level are the MAT ladder's."""
-    if args.model or args.fem_level:
-        raise ValueError("--model and --fem-level choose among the MAT taxel's models; a kind = 'tube' spec has "
-                         "its own routes (docs/tube.md): leave them out")
+    """A fipple tube's prediction (docs/tube.md): its own routes; ``--model fem [--fem-level N]`` adds the
+    axisymmetric exterior FEM (a flanged mouth), the MAT ladder's other models do not apply."""
+    if args.model not in (None, "fem"):
+        raise ValueError(f"--model {args.model} is a MAT taxel's model; a kind = 'tube' spec has its own routes "
+                         "(docs/tube.md): leave it out, or --model fem for the exterior FEM of a flanged tube")
+    from matcad.acoustics.fem import DEFAULT_LEVEL
     from matcad.prediction.tube import predict_tube
 
-    result = predict_tube(spec, forces)
+    result = predict_tube(spec, forces, (args.fem_level or DEFAULT_LEVEL) if args.model == "fem" else None)
     print_json(result.to_dict()) if args.json else print(result.to_text())
     return EXIT_OK

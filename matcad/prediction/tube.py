@@ -1,4 +1,5 @@
-"""A fipple tube's prediction: the air column's three routes (closed form, transmission line, 1-D FEM), the cap's
+"""A fipple tube's prediction: the air column's routes (closed form, transmission line, 1-D FEM; for a flanged mouth
+on request the axisymmetric exterior FEM), the cap's
 wall (the MAT wall model as the closed end's compliance), the edge-tone window of the first two modes, and f(F)
 from the cap mechanics (the MAT cap pressed by a plate: its cavity's volume sets the closed end). Frequencies Hz,
 forces N, lengths mm. Sources: docs/tube.md.
@@ -58,7 +59,8 @@ class TubePrediction:
     def to_text(self) -> str:
         lines = [f"{self.name}: fipple tube, air column {self.column_mm:g} mm + mouth correction "
                  f"{self.mouth_correction_mm:.2f} mm"]
-        lines += [f"  {route:<22} {f:8.0f} Hz" for route, f in self.routes_hz.items()]
+        width = max(map(len, self.routes_hz))
+        lines += [f"  {route:<{width}} {f:8.0f} Hz" for route, f in self.routes_hz.items()]
         lines.append(f"  f1 = {self.f0_hz:.0f} Hz, band {self.band_hz[0]:.0f}-{self.band_hz[1]:.0f} Hz "
                      f"({'; '.join(self.band_sources)})")
         lines.append(f"  overblown mode: {self.f_mode2_hz:.0f} Hz")
@@ -85,12 +87,16 @@ def _wall_results(td: air.TubeDesign):
     return results, notes
 
 
-def predict_tube(spec, forces_n=()) -> TubePrediction:
+def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePrediction:
     """The prediction of a ``kind = "tube"`` spec, with f at ``forces_n`` (N) from the cap mechanics (FElupe,
-    imported only then)."""
+    imported only then); with ``fem_level`` (elements across the bore's radius) also the axisymmetric exterior
+    FEM's f1 of a flanged tube (scikit-fem, :func:`matcad.acoustics.tube.exterior_fem`; ValueError for the other
+    mouths)."""
     td = air.tube_design(spec)
     routes = {"closed form (rigid)": air.closed_form_hz(td), "line (rigid)": air.line_hz(td),
               "1-D FEM P2 (rigid)": air.fem_hz(td, 0.0, FEM_ELEMENTS, 2)}
+    if fem_level is not None:
+        routes[f"exterior FEM, level {fem_level} (rigid)"] = air.exterior_fem(td, fem_level).f0_hz
     notes: list[str] = []
     f0, kappa, band = routes["line (rigid)"], None, [routes["line (rigid)"]] * 2
     sources = ["rigid cap"]
