@@ -142,3 +142,54 @@ def test_infer_command_writes_the_state_and_predict_is_anchored_as_built(tmp_pat
     bare = write_spec(_paper_text(), name="bare.toml")
     code, out, err = run_cli("infer", bare, "--out", tmp_path / "none")
     assert code == 2 and "[[measured]]" in err and not (tmp_path / "none").exists()
+
+
+BOARD = PAPER.parent / "mat-array-4.toml"
+TAXEL_CALIBRATION = """[taxel.calibration]
+v0_mm3 = 37.8
+a = -0.0086
+b = 0.4626
+k_mm3_hz2 = {k!r}
+covariance = [1e-6, 0.0, 0.0, 0.0, 1e-10, 0.0, 0.0, 0.0, 1e-10]
+"""
+"""A tight fit (V0 to 0.001 mm³): its f(0) band is the air temperature's ±0.5 % and little else."""
+
+
+def _board_with_t2_calibrated(f0_hz: float) -> str:
+    """templates/mat-array-4.toml with t2 (physics ~6.4 kHz) carrying its own tight calibration of f(0) =
+    ``f0_hz``."""
+    entries = BOARD.read_text(encoding="utf-8").split("[[taxel]]")
+    entries[2] = entries[2].rstrip("\n") + "\n" + TAXEL_CALIBRATION.format(k=37.8 * f0_hz ** 2) + "\n"
+    return "[[taxel]]".join(entries)
+
+
+def test_a_board_taxels_own_calibration_anchors_its_band_and_analyze_finds_it(tmp_path, write_spec):
+    """A board's [taxel.calibration] anchors that taxel alone: predict --json gives its calibration's f(0) as f0 with
+    the physics beside it, its band (the one board allocation, check and the band chart use) and its listening band
+    hold the calibrated tone, not the physics'; the other taxels keep the physics. Analyze of a 4.6 kHz tone with
+    the board spec finds it in t2 (the physics put t2 at 6.2-6.7 kHz), although t2's loaded band at the template's
+    1 N (75 Hz) is narrower than the tracker's 15 bins (81 Hz at 44.1 kHz): the loop widens it (exit 2 before)."""
+    from matcad.prediction.bands import listening_bands
+
+    path = write_spec(_board_with_t2_calibrated(4600.0), name="board.toml")
+    code, out, err = run_cli("predict", path, "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    t2 = data["predictions"]["t2"]
+    assert t2["model"] == "calibration" and t2["f0_hz"] == pytest.approx(4600.0, rel=1e-6)
+    assert t2["physics_model"] == "elastic_wall" and t2["physics_band_hz"][0] > 6000 > t2["band_hz"][1]
+    rows = {row["name"]: row for row in data["taxels"]}
+    assert [rows[n]["model"] for n in ("t1", "t2", "t3", "t4")] == ["elastic_wall", "calibration", "elastic_wall",
+                                                                    "elastic_wall"]
+    assert rows["t2"]["unloaded_hz"] == pytest.approx(t2["band_hz"])
+    assert rows["t2"]["loaded_hz"][0] < 4600 < rows["t2"]["loaded_hz"][1] < 4800
+    band = dict(listening_bands(spec_mod.load(path)))["t2"]
+    assert band[0] < 4600 < band[1] and band[1] - band[0] < 80
+    _write_tone(tmp_path / "tone.wav", 4600.0)
+    code, out, err = run_cli("analyze", tmp_path / "tone.wav", "--spec", path, "--out", tmp_path / "a", "--json")
+    assert code == 0, err
+    heard = {t["taxel"]: t for t in json.loads(out)["taxels"]}
+    assert heard["t2"]["median_hz"] == pytest.approx(4600.0, abs=2.0)
+    low, high = heard["t2"]["listening_band_hz"]
+    assert low < band[0] and high > band[1] and high - low == pytest.approx(16 * FS / 8192)
+
