@@ -105,8 +105,9 @@ def truth_load(spec, state, f0: float, forces, level: int) -> list[float]:
     return [row[1] for row in at_forces(fc, forces)]
 
 
-def lab(seed: int, level: int, load: bool) -> dict:
-    """One lab: its hidden state, the measured taxel, and each design's truth and predictions."""
+def lab(seed: int, level: int, load: bool, designs=DESIGNS) -> dict:
+    """One lab: its hidden state, the measured taxel (as its [[measured]] entry), and each of ``designs``' truth
+    and predictions."""
     from matcad import spec as spec_mod
     from matcad.prediction import predict
     from matcad.spec.measured import Measured
@@ -124,7 +125,7 @@ def lab(seed: int, level: int, load: bool) -> dict:
     # as a spec file would hold it: the entry's drawing filled from the spec as loaded
     measured = spec_mod.from_dict(spec_mod.to_dict(dataclasses.replace(base, measured=(Measured(**entry),))))
     rows = []
-    for fields in DESIGNS:
+    for fields in designs:
         s = variant(measured, fields)
         truth, hybrid = truth_f0(variant(base, fields), state, level)
         p = predict(s, mechanics=False)
@@ -139,7 +140,8 @@ def lab(seed: int, level: int, load: bool) -> dict:
     recovered = {name: {"hidden": getattr(state, name), "low": lo, "high": hi, "inside": bool(lo <= getattr(state, name) <= hi)}
                  for name, _, lo, hi in inference.intervals()}
     return {"seed": seed, "level": level, "load": load, "hidden": dataclasses.asdict(state),
-            "measured_f0_hz": f_meas, "rows": rows, "recovered": recovered, "seconds": time.perf_counter() - t0}
+            "measured_f0_hz": f_meas, "measured": entry, "rows": rows, "recovered": recovered,
+            "seconds": time.perf_counter() - t0}
 
 
 def _errors(rows: list[dict], what: str) -> str:

@@ -29,6 +29,9 @@ FREQUENCY_KHZ_MAX = 100.0
 """Taxel tones are kHz; frequencies all below 100 "Hz" read as kHz (a unit slip: spec notes, `analyze --band`)."""
 EDGE_BINS = 2
 """A ridge within this many bins of a band's edge is refused as hugging it (the tone probably lies outside)."""
+BAND_BINS = 2 * EXCLUDE_BINS + 3
+"""The fewest bins a band must hold for the tracker: a line and its neighbours (±EXCLUDE_BINS), and a bin of floor
+either side."""
 
 
 def window_samples(fs: float) -> int:
@@ -44,6 +47,17 @@ def guard_hz(sample_rate_hz: float) -> float:
     of a band's edge is refused as hugging it; so the gap is (EXCLUDE_BINS + EDGE_BINS) bins of the tracker's
     zero-padded spectrum, fs / (ZERO_PAD · window). 43 Hz at 44.1 kHz (window 4096, 5.4 Hz bins)."""
     return (EXCLUDE_BINS + EDGE_BINS) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
+
+
+def trackable(band_hz: tuple[float, float], sample_rate_hz: float) -> tuple[float, float]:
+    """``band_hz`` (low, high Hz) widened about its centre to :data:`BAND_BINS` + 1 bins of the tracker's spectrum
+    at ``sample_rate_hz`` (Hz) when it is narrower (the extra bin: a band off the bin grid still holds
+    BAND_BINS bins); else as it is. A board taxel's loaded band, anchored to a tight calibration under a light
+    touch, can be narrower than the tracker needs (75 Hz at templates/mat-array-4.toml's 1 N; 81 Hz at 44.1 kHz)."""
+    width = (BAND_BINS + 1) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
+    low, high = band_hz
+    grow = max(0.0, width - (high - low)) / 2
+    return low - grow, high + grow
 
 
 class Margin(NamedTuple):

@@ -138,3 +138,27 @@ def test_joined_air_in_the_fem_agrees_with_the_transmission_line(level):
     assert fem == pytest.approx(line, rel=0.03)
     shift_fem, shift_line = fem / plain["fem"].f0_hz, line / plain["transmission_line"].f0_hz
     assert shift_fem == pytest.approx(shift_line, rel=0.04) and shift_fem < 0.8
+
+
+@pytest.mark.parametrize("seed,load", [(3, False), pytest.param(5, False, marks=pytest.mark.slow),
+                                       pytest.param(7, False, marks=pytest.mark.slow),
+                                       pytest.param(3, True, marks=pytest.mark.slow)])
+def test_virtual_lab_measured_beats_modelled(seed, load):
+    """A representative subset of benchmarks/virtual_lab.py (docs/inference.md has the full table): a lab with a
+    hidden as-built state builds the paper's taxel and four other designs, their truth from the coupled
+    elastic-cap + air FEM (level 2; with ``load``, f(F) from FElupe and the rigid FEM on the deformed cavities),
+    never from the closed-form models the inference uses. From the one measured taxel every other design is
+    predicted closer than the physics alone, inside its band, with a median error within 3 % (seed 3, f0 alone:
+    1.3-2.8 % against the physics' 39-68 %), and the hidden neck offset, joined air and static modulus lie inside
+    their 95 % intervals."""
+    from benchmarks.virtual_lab import DESIGNS, lab
+
+    one = lab(seed, 2, load, designs=DESIGNS[1:2] + DESIGNS[3:])
+    rows = one["rows"]
+    assert not any(r["hybrid"] for r in rows)  # the clear designs, where the 2 % target applies
+    for r in rows:
+        assert r["model"] == "as_built" and abs(r["as_built_error"]) < abs(r["physics_error"]), r
+        assert r["band_hz"][0] <= r["truth_hz"] <= r["band_hz"][1], r
+    assert np.median([abs(r["as_built_error"]) for r in rows]) < 0.03
+    for name in ("neck_offset_mm", "side_volume_mm3", "static_modulus_scale"):
+        assert one["recovered"][name]["inside"], (name, one["recovered"][name])

@@ -184,6 +184,7 @@ def test_build_writes_the_band_chart_and_its_numbers(tmp_path):
     report = json.loads((tmp_path / "kit" / "report.json").read_text())
     (row,) = report["bands"]["taxels"]
     band = taxel_band(s)
+    assert row["model"] == "calibration" and row["f0_hz"] == pytest.approx(4010.4, abs=0.1)  # the anchored band
     assert row["loaded_hz"] == pytest.approx(list(band.loaded_hz)) and row["rise"] == pytest.approx(band.rise)
     assert report["bands"]["guard_hz"] == pytest.approx(guard_hz(s.microphone.sample_rate_hz))
     png = tmp_path / "kit" / "plot_taxel_bands.png"

@@ -159,6 +159,7 @@ def test_taxels_bands_are_disjoint_inside_the_band_and_check_accepts(tmp_path, w
     assert len(board) == 3 and len({(t.x, t.y) for t in board}) == 3
     assert len({t.neck.diameter for t in board}) == 3  # each taxel solved for its own band
     bands = taxel_bands(written)  # recomputed from the written file, not the designer's numbers
+    assert {b.model for b in bands} == {"calibration"}  # allocated by the anchored bands
     assert conflicts(bands, guard_hz(written.microphone.sample_rate_hz)) == []
     assert all(3500 <= b.loaded_hz[0] < b.loaded_hz[1] <= 6500 for b in bands)
     assert "plot_taxel_bands.png" in data["written"] and (out / "plot_taxel_bands.png").stat().st_size > 5000

@@ -179,8 +179,8 @@ def _paper_anchor(d: Design, chosen: str, f0_hz: float, band_low_hz: float) -> l
     return [f"{chosen}: physics predicts {f0_hz:.0f} Hz for the paper's taxel; its one published measurement "
             f"(~{PAPER_MEASURED_HZ / 1000:.1f} kHz unloaded) lies {gap:.0f} % lower, {where}, and the paper's pitch "
             "per newton is 1.5x smaller than the cap mechanics give. Fed to the as-built inference, the paper's own "
-            "numbers (f0, Eq. 5, Fig. 8) are explained by air joined to the cavity (~35-60 mm^3: the guide's "
-            "clearance, gaps in the stack) with a silicone ~0.6x as stiff as the grade's; a narrower neck (the "
+            "f0 and Eq. 5 are explained by air joined to the cavity (~35-40 mm^3: the guide's clearance, gaps in "
+            "the stack), and its Fig. 8 F(x) asks for a silicone ~0.45x as stiff as the grade's; a narrower neck (the "
             "paper's 'd = 2.10 mm' may be the needle's distance y) or a thicker sheet explain the f0 alone, not the "
             "sensitivity (docs/paper.md). Record one taxel as [[measured]] and matcad predicts from it."]
 

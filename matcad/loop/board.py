@@ -33,7 +33,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from matcad.errors import LoopError
-from matcad.listening import EDGE_BINS, HARMONICS
+from matcad.listening import EDGE_BINS, HARMONICS, trackable
 from matcad.loop.segments import STEP_HZ
 from matcad.loop.voicing import MIN_RUN_HARMONIC, WEAK_DB
 from matcad.loop.analysis import Analysis
@@ -93,9 +93,10 @@ def taxels_dict(tracks, readings=None) -> list[dict]:
 
 def analyze_board(blocks, fs: float, named_bands, on_frame=None) -> list[TaxelTrack]:
     """Every taxel's track from sample blocks at ``fs`` (Hz), in one pass. ``named_bands``: (name, band Hz) per
-    taxel. ``on_frame`` is called as (taxel index, time s, frequency Hz or NaN, excess dB). Raises LoopError when
-    no taxel has a tone."""
-    bands = [tuple(band) for _, band in named_bands]
+    taxel, each widened to what the tracker needs (:func:`matcad.listening.trackable`). ``on_frame`` is called as
+    (taxel index, time s, frequency Hz or NaN, excess dB). Raises LoopError when no taxel has a tone."""
+    named_bands = [(name, trackable(tuple(band), fs)) for name, band in named_bands]
+    bands = [band for _, band in named_bands]
     hold = None if on_frame is None else TailHold(len(bands), on_frame)
     trackers, duration, mean_power = run_trackers(blocks, fs, bands, hold)
     tracks = []

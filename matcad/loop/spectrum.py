@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.listening import EXCLUDE_BINS, ZERO_PAD, window_samples
+from matcad.listening import BAND_BINS, ZERO_PAD, window_samples
 
 FLOOR_BINS = 63
 """Width of the running median that sets the local noise floor (≈ 340 Hz at 44.1 kHz)."""
@@ -118,7 +118,7 @@ class BandBins:
     def locate(cls, freqs: np.ndarray, fs: float, band_hz: tuple[float, float], reach_hz: float) -> "BandBins":
         """The bins of ``band_hz`` (Hz) among ``freqs`` (Hz) at ``fs`` (Hz), the slab reaching FLOOR_BINS/2 bins
         and ``reach_hz`` (Hz, plus 2 bins) beyond it, whichever is wider. ValueError when the band lies above
-        Nyquist or is narrower than a line and its neighbours (2·EXCLUDE_BINS + 3 bins)."""
+        Nyquist or is narrower than a line and its neighbours (:data:`matcad.listening.BAND_BINS`)."""
         nyquist = fs / 2
         lo, hi = max(0.0, band_hz[0]), min(band_hz[1], nyquist)
         if not lo < hi:
@@ -126,9 +126,9 @@ class BandBins:
                              f"(must lie below {nyquist:g} Hz)")
         df = float(freqs[1] - freqs[0])
         in_band = np.flatnonzero((freqs >= lo) & (freqs <= hi))
-        if len(in_band) < 2 * EXCLUDE_BINS + 3:
+        if len(in_band) < BAND_BINS:
             raise ValueError(f"band {lo:g}-{hi:g} Hz is narrower than the analysis needs "
-                             f"({(2 * EXCLUDE_BINS + 3) * df:.0f} Hz)")
+                             f"({BAND_BINS * df:.0f} Hz)")
         margin = max(FLOOR_BINS // 2, int(np.ceil(reach_hz / df)) + 2)
         slab = np.arange(max(0, in_band[0] - margin), min(len(freqs), in_band[-1] + margin + 1))
         return cls(freqs, fs, (lo, hi), df, in_band, slab, int(in_band[0] - slab[0]))

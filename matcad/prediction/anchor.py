@@ -134,14 +134,16 @@ class AsBuiltAnchor:
         from matcad.prediction.inference import infer
 
         self.inference = infer(spec)
+        self.level = float(self.inference.level_factors([self.inference.z])[0])
 
     def f0_hz(self, spec) -> float:
-        """The model on ``spec`` built in the most probable state (Hz; milliseconds): what a design search solves
-        with; :meth:`anchored` gives the posterior median, the same to a fraction of its band away from a doublet."""
+        """The model on ``spec`` built in the most probable state times that state's level factor (Hz;
+        milliseconds): what a design search solves with; :meth:`anchored` gives the posterior median, the same to a
+        fraction of its band away from a doublet."""
         from matcad.acoustics.design import design
         from matcad.prediction.measurements import f0_hz
 
-        return f0_hz(design(spec), self.inference.state, self.inference.model)
+        return f0_hz(design(spec), self.inference.state, self.inference.model) * self.level
 
     def anchored(self, spec) -> Anchored:
         p = self.inference.predict(spec)
