@@ -1,8 +1,8 @@
 """Hostile inputs and faults through the CLI, by category, printing tried / held / breaches per category.
 
 A run *holds* when it keeps the README's contract: an exit code of its category's table (never 70, the
-internal-error code, and no exception escaping ``main``), no traceback, a one-line message on exit 2, no
-temporary folder left over, and, for builds, a kit whose files match its manifest. Categories:
+internal-error code, and no exception escaping ``main``), no traceback, no numpy RuntimeWarning, a one-line message
+on exit 2, no temporary folder left over, and, for builds, a kit whose files match its manifest. Categories:
 
   specs       generated specs through `check` and `build` (tests/test_fuzz.py's strategy and read-back)
   extremes    every number, whole-number and [low, high] field at its bounds, one ulp inside, 5e-324, 1e-300,
@@ -61,15 +61,24 @@ class Breach(AssertionError):
 
 
 def run(argv: list[str], allowed=(0, 1, 2)) -> tuple[int, str]:
-    """``main(argv)`` in this process; a Breach unless the contract holds. Returns (code, stderr)."""
+    """``main(argv)`` in this process; a Breach unless the contract holds (a numpy RuntimeWarning, which a user's
+    terminal would show, is a breach too). Returns (code, stderr)."""
+    import warnings
+
     out, err = io.StringIO(), io.StringIO()
     try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), \
+                warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", RuntimeWarning)
             code = main([str(a) for a in argv])
     except SystemExit as exc:  # argparse usage errors are exit 2 by design
         code = exc.code
     except BaseException as exc:  # noqa: BLE001 - an escaping exception is a traceback for the user
         raise Breach(f"{argv}: {exc.__class__.__name__}: {exc}") from exc
+    leaked = [f"{w.filename.rsplit('/', 1)[-1]}:{w.lineno}: {w.message}" for w in caught
+              if issubclass(w.category, RuntimeWarning)]
+    if leaked:
+        raise Breach(f"{argv}: warnings on the terminal: {leaked[:3]}")
     text = err.getvalue()
     if code not in allowed or "Traceback" in text:
         raise Breach(f"{argv}: exit {code}: {text[-300:]}")
@@ -500,9 +509,9 @@ def cat_loop(n: int, rng: random.Random, work: Path):
 
         def one(a=argv):
             with warnings.catch_warnings(record=True) as caught:
-                warnings.simplefilter("always")
+                warnings.simplefilter("always", UserWarning)
                 _, text = run(a)
-            told = [str(w.message)[:120] for w in caught if issubclass(w.category, (RuntimeWarning, UserWarning))]
+            told = [str(w.message)[:120] for w in caught if issubclass(w.category, UserWarning)]
             if told or " nan" in text:
                 raise Breach(f"{a}: {told or text[-200:]}")
             _no_litter(work)
