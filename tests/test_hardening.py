@@ -638,6 +638,9 @@ def test_band_in_khz_gets_a_hint(tmp_path):
     code, _, err = run_cli("analyze", wav, "--band", "4.5", "5.5", "--out", tmp_path / "a")
     _assert_clean(code, err, 2, "kHz", "--band 4500 5500")
     assert not (tmp_path / "a").exists()
+    code, _, err = run_cli("analyze", wav, "--band", "0.001", "0.01", "--out", tmp_path / "a")  # 1-10 Hz in kHz:
+    _assert_clean(code, err, 2, "--band 0.001 0.01", "below 100 Hz as well")  # still below 100 Hz, no suggestion
+    assert "did you mean" not in err and not (tmp_path / "a").exists()
 
 
 @pytest.mark.parametrize("target", ["C:\\Users\\lab\\out", "D:/kits", "kits\\paper"])
