@@ -259,6 +259,22 @@ def test_dead_worker_fails_its_variants_not_the_sweep():
     assert [r["status"] for r in results] == ["ok"] * 3 + ["failed"] + ["ok"] * 4
 
 
+def test_a_killed_worker_fails_only_its_own_chunk_at_ci_cost():
+    """The property of the two slow tests around this one, on every CI run (~1 s of CPU: the chunk function lives in
+    a small module, so a spawned worker imports nothing heavy): a local worker killed mid-sweep (SIGKILL) fails only
+    its own chunk ("worker lost"); the chunks its death took down with the pool (still running or queued then) run
+    again and come back ok, in task order, from run and stream alike."""
+    from matcad.sweep.executor import run, stream
+    from tests.dying_worker import killed_on_index_1
+
+    tasks = [{"index": i} for i in range(4)]  # 2 workers x 4 chunks per worker: one task per chunk
+    for results in (run(killed_on_index_1, tasks, Executor(2)),
+                    [r for chunk in stream(killed_on_index_1, tasks, Executor(2)) for r in chunk]):
+        assert [r["index"] for r in results] == [0, 1, 2, 3]
+        assert [r["status"] for r in results] == ["ok", "failed", "ok", "ok"], results
+        assert "worker lost" in results[1]["reason"]
+
+
 @pytest.mark.slow
 def test_streamed_chunks_come_in_order_and_a_dead_worker_fails_only_its_own():
     from matcad.sweep.executor import stream
