@@ -130,8 +130,8 @@ def cli_table(max_points):
 
     print("\n`matcad calibrate` end to end on a CSV (force_n, frequency_hz, cycle; 10 cycles; peak RSS from "
           "/usr/bin/time -v):\n")
-    print("| rows | file [MB] | wall time [s] | peak RSS [MB] |")
-    print("|---:|---:|---:|---:|")
+    print("| rows | file [MB] | wall time [s] | CPU time [s] | peak RSS [MB] |")
+    print("|---:|---:|---:|---:|---:|")
     root = Path(__file__).resolve().parents[1]
     with tempfile.TemporaryDirectory() as tmp:
         for n in (n for n in (10 ** 3, 10 ** 5, 10 ** 6) if n <= max_points):
@@ -148,10 +148,12 @@ def cli_table(max_points):
             proc = subprocess.run(cmd, capture_output=True, text=True, cwd=root,
                                   env={**os.environ, "PYTHONPATH": str(root)})
             wall = time.perf_counter() - t0
-            rss = [ln for ln in proc.stderr.splitlines() if "Maximum resident set size" in ln]
-            peak = int(rss[0].split()[-1]) / 1024 if rss else float("nan")
+            told = dict(ln.strip().rsplit(": ", 1) for ln in proc.stderr.splitlines()
+                        if ln.startswith("\t") and ": " in ln)
+            peak = float(told.get("Maximum resident set size (kbytes)", "nan")) / 1024
+            cpu = float(told.get("User time (seconds)", "nan")) + float(told.get("System time (seconds)", "nan"))
             status = "" if proc.returncode == 0 else f" (exit {proc.returncode})"
-            print(f"| {n:.0e} | {path.stat().st_size / 1e6:.1f} | {wall:.1f}{status} | {peak:.0f} |")
+            print(f"| {n:.0e} | {path.stat().st_size / 1e6:.1f} | {wall:.1f}{status} | {cpu:.2f} | {peak:.0f} |")
 
 
 def main():

@@ -1,11 +1,12 @@
 """Hostile inputs and faults through the CLI, by category, printing tried / held / breaches per category.
 
 A run *holds* when it keeps the README's contract: an exit code of its category's table (never 70, the
-internal-error code, and no exception escaping ``main``), no traceback, a one-line message on exit 2, no
-temporary folder left over, and, for builds, a kit whose files match its manifest. Categories:
+internal-error code, and no exception escaping ``main``), no traceback, no numpy RuntimeWarning, a one-line message
+on exit 2, no temporary folder left over, and, for builds, a kit whose files match its manifest. Categories:
 
   specs       generated specs through `check` and `build` (tests/test_fuzz.py's strategy and read-back)
-  extremes    every number field at its bounds, one ulp inside, 5e-324, 1e-300, 1e300, pairs of them
+  extremes    every number, whole-number and [low, high] field at its bounds, one ulp inside, 5e-324, 1e-300,
+              1e300, pairs of them (a random N of the single-field cases when N is below their count)
   toml        parser tricks: deep nesting, >= 309-digit integers, long and newline-bearing strings, unicode
   files       non-regular and oversized inputs (FIFO, /dev/zero, folder, > limit) for every input kind
   wav         valid WAVs with random header bytes changed or cut at a random length
@@ -21,6 +22,9 @@ temporary folder left over, and, for builds, a kit whose files match its manifes
               nested, truncated, oversized, random bytes, bad lengths, other methods, garbage request lines,
               disconnects and resets; it holds when every reply is a status of its table with a JSON error, the
               server prints nothing and still answers a good prediction (issue 21)
+  sweep       `sweep` with malformed --scheduler addresses, hostile --vary and --workers (issue 21)
+  loop        float WAVs at any magnitude, tones of 20-400 ms, calibration CSVs with a cycle column and subnormal or
+              kHz frequencies: no numpy warning and no 'nan' in any message (issue 21)
 
 Every `--json` run must also leave exactly one JSON document on stdout, whatever its exit code.
 
@@ -57,15 +61,24 @@ class Breach(AssertionError):
 
 
 def run(argv: list[str], allowed=(0, 1, 2)) -> tuple[int, str]:
-    """``main(argv)`` in this process; a Breach unless the contract holds. Returns (code, stderr)."""
+    """``main(argv)`` in this process; a Breach unless the contract holds (a numpy RuntimeWarning, which a user's
+    terminal would show, is a breach too). Returns (code, stderr)."""
+    import warnings
+
     out, err = io.StringIO(), io.StringIO()
     try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), \
+                warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", RuntimeWarning)
             code = main([str(a) for a in argv])
     except SystemExit as exc:  # argparse usage errors are exit 2 by design
         code = exc.code
     except BaseException as exc:  # noqa: BLE001 - an escaping exception is a traceback for the user
         raise Breach(f"{argv}: {exc.__class__.__name__}: {exc}") from exc
+    leaked = [f"{w.filename.rsplit('/', 1)[-1]}:{w.lineno}: {w.message}" for w in caught
+              if issubclass(w.category, RuntimeWarning)]
+    if leaked:
+        raise Breach(f"{argv}: warnings on the terminal: {leaked[:3]}")
     text = err.getvalue()
     if code not in allowed or "Traceback" in text:
         raise Breach(f"{argv}: exit {code}: {text[-300:]}")
@@ -96,23 +109,33 @@ def _doc(**sections) -> dict:
 
 
 def _number_fields() -> list[tuple[str, str, dict]]:
+    """Every numeric spec field: numbers, whole numbers and [low, high] ranges (wall.khz_modulus_factor = 1e-300
+    and wall.loss_factor = 0 are ranges: issue 21)."""
     import dataclasses
 
     return [(section, f.name, dict(f.metadata)) for section, cls in spec_mod.SECTIONS.items()
-            for f in dataclasses.fields(cls) if f.metadata["kind"] == "number"]
+            for f in dataclasses.fields(cls) if f.metadata["kind"] in ("number", "integer", "range")]
+
+
+def _extremes(meta: dict) -> list:
+    """A field's bounds, one step inside them, and the numbers that broke fields before; a range gets each as both
+    of its ends, its bounds as a pair and that pair reversed; a whole number its bounds, one inside, 0, -1, 2^63."""
+    lo, hi = meta["lo"], meta["hi"]
+    if meta["kind"] == "integer":
+        return [lo, lo + 1, hi, hi - 1, 0, -1, 2 ** 63]
+    scalars = [lo, math.nextafter(lo, math.inf), hi, math.nextafter(hi, -math.inf), 5e-324, 1e-300, 1e300,
+               -0.0, -5e-324]
+    if meta["kind"] == "range":
+        return [[v, v] for v in scalars] + [[lo, hi], [hi, lo]]
+    return scalars
 
 
 def cat_extremes(n: int, rng: random.Random, work: Path):
     fields = _number_fields()
-
-    def values(meta):
-        lo, hi = meta["lo"], meta["hi"]
-        return [lo, math.nextafter(lo, math.inf), hi, math.nextafter(hi, -math.inf), 5e-324, 1e-300, 1e300,
-                -0.0, -5e-324]
-
-    cases = [[(s, k, v)] for s, k, m in fields for v in values(m)]
+    cases = [[(s, k, v)] for s, k, m in fields for v in _extremes(m)]
+    rng.shuffle(cases)  # N below their count tries a random N of them, not the first fields' alone
     while len(cases) < n:
-        cases.append([(s, k, rng.choice(values(m))) for s, k, m in rng.sample(fields, 2)])
+        cases.append([(s, k, rng.choice(_extremes(m))) for s, k, m in rng.sample(fields, 2)])
     for case in cases[:max(n, 1)]:
         doc = _doc()
         for s, k, v in case:
@@ -406,6 +429,95 @@ def cat_world(n: int, rng: random.Random, work: Path):
         yield one
 
 
+def cat_sweep(n: int, rng: random.Random, work: Path):
+    """`sweep` with malformed --scheduler addresses (refused before anything connects), hostile --vary and
+    --workers; valid grids run in this process (--workers 1) and read back as a table of their size."""
+    from matcad.sweep.executor import check_address
+
+    spec = ROOT / "templates" / "mat-laser-only.toml"
+    malformed = ["nonsense", "tcp://host:notaport", "tcp://127.0.0.1:99999", "localhost:8786x", "http://127.0.0.1:8786",
+                 "tcp://:8786", "tcp://127.0.0.1:0", "tcp://[::1:8786", "inproc://", "tcp://a b:1", ":", "", "x" * 5000]
+
+    def address() -> str:
+        while True:
+            text = rng.choice(malformed + ["".join(chr(rng.randint(32, 0x24F)) for _ in range(rng.randint(1, 30)))])
+            try:
+                check_address(text)
+            except ValueError:
+                return text  # only addresses refused before connecting (an unreachable one waits 10 s by design)
+
+    varies = ["cavity.length=3:6:4", "cavity.length=3,4", "neck.diameter=1.5,2.1", "cavity.length=3:x:4",
+              "cavity.lenght=3:6:4", "neck.mouth=1,2", "cavity.length=6:3:4", "cavity.length=3:6:0",
+              f"cavity.length=3:6:{10 ** 7}", "mold.count=1.5,2", "cavity.length=1e-300,1e300", "cavity.length=nan",
+              "cavity.length=" + "9" * 5000, "cavity.length", "=1,2", "cavity.length=3:6:4:5", "wall.loss_factor=0,1",
+              "wall.khz_modulus_factor=0.5,2", "mechanics.steps=1,200"]
+    for i in range(n):
+        out = work / f"s{i}"
+        argv = ["sweep", spec, "--out", out, "--no-rules"] if rng.random() < 0.7 else ["sweep", spec, "--out", out]
+        for _ in range(rng.randint(1, 2)):
+            argv += ["--vary", rng.choice(varies)]
+        kind = rng.choice(["scheduler", "workers", "plain"])
+        if kind == "scheduler":
+            argv += ["--scheduler", address()]
+        argv += ["--workers", rng.choice(["0", "-3", "x", "257", "1e3"]) if kind == "workers" else "1"]
+        argv += ["--json"] if rng.random() < 0.5 else []
+
+        def one(a=argv, o=out):
+            code, _ = run(a)
+            if code == 2 and o.exists():
+                raise Breach(f"{a}: refused, yet {o} was made")
+            _no_litter(work)
+        yield one
+
+
+def cat_loop(n: int, rng: random.Random, work: Path):
+    """The recording loop's inputs: float WAVs at any magnitude (±1e300, 1e-320, NaN, inf: refused, never a numpy
+    warning or a 'nan dB'), clean tones of 20-400 ms (too short is told as such), calibration CSVs with a `cycle`
+    column, subnormal or kHz frequencies and repeated forces (a studentized residual is a sane number or none)."""
+    import warnings
+
+    import numpy as np
+    from scipy.io import wavfile
+
+    spec = ROOT / "templates" / "mat-paper.toml"
+    rate = 44100
+    for i in range(n):
+        kind = rng.choice(["float", "short", "cycles"])
+        if kind == "float":
+            path = work / "f.wav"
+            x = np.sin(2 * np.pi * 4600 * np.arange(rate // 2) / rate)
+            x = x * rng.choice([1e300, 1e13, 1e12, 1.0, 1e-320, 0.0])
+            for _ in range(rng.randint(0, 3)):
+                x[rng.randrange(len(x))] = rng.choice([math.nan, math.inf, -math.inf, 1e300, -1e300])
+            wavfile.write(path, rate, x.astype(rng.choice([np.float64, np.float32])) if abs(x).max() < 3e38
+                          else x)
+            argv = ["analyze", path, "--band", "4000", "5500", "--out", work / "a"]
+        elif kind == "short":
+            path = work / "s.wav"
+            t = np.arange(int(rate * rng.uniform(0.02, 0.4))) / rate
+            wavfile.write(path, rate, (np.sin(2 * np.pi * 4600 * t) * 2e4).astype(np.int16))
+            argv = ["analyze", path, "--band", "4000", "5500", "--out", work / "a"]
+        else:
+            path = work / "c.csv"
+            cycles, points = rng.randint(1, 5), rng.randint(2, 12)
+            unit = rng.choice([1.0, 1.0, 1e-3, 1e-322])
+            rows = [(f, (4500 + 9 * f - 0.1 * f * f + rng.gauss(0, 2)) * unit, rng.choice(["c", "", "run "]) + str(c))
+                    for c in range(cycles) for f in np.linspace(0, rng.choice([0.0, 1e-9, 20.0]), points).tolist()]
+            path.write_text("force_n,frequency_hz,cycle\n" + "".join(f"{f},{h!r},{c}\n" for f, h, c in rows))
+            argv = ["calibrate", path, "--spec", spec, "--out", work / "c"]
+        argv += ["--json"] if rng.random() < 0.5 else []
+
+        def one(a=argv):
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", UserWarning)
+                _, text = run(a)
+            told = [str(w.message)[:120] for w in caught if issubclass(w.category, UserWarning)]
+            if told or " nan" in text:
+                raise Breach(f"{a}: {told or text[-200:]}")
+            _no_litter(work)
+        yield one
+
+
 def cat_serve(n: int, rng: random.Random, work: Path):
     """Hostile HTTP against one in-process server (deadline lowered to 1 s to keep the run short)."""
     import socket
@@ -526,7 +638,7 @@ def cat_serve(n: int, rng: random.Random, work: Path):
 
 CATEGORIES = {"specs": cat_specs, "extremes": cat_extremes, "toml": cat_toml, "files": cat_files, "wav": cat_wav,
               "csv": cat_csv, "calibration": cat_calibration, "out": cat_out, "faults": cat_faults,
-              "sets": cat_sets, "world": cat_world, "serve": cat_serve}
+              "sets": cat_sets, "world": cat_world, "serve": cat_serve, "sweep": cat_sweep, "loop": cat_loop}
 
 
 def main_(n: int, names: list[str]) -> None:

@@ -78,6 +78,26 @@ def test_kpa_metres_khz_and_rigid_default():
     assert "4700 Hz" in frequency_notes([4.0, 4.3, 4.7])[0] and frequency_notes([4000.0, 4700.0]) == []
 
 
+@pytest.mark.parametrize("key, value, reading", [
+    ("wall.shear_modulus_mpa", [1e6, 1e6], "[1000, 1000] MPa, outside 0.001-50 MPa"),
+    ("wall.shear_modulus_mpa", [0.001, 1e6], "[1e-06, 1000] MPa, outside 0.001-50 MPa"),
+    ("wall.shear_modulus_mpa", [0.2, 60.0], "[0.0002, 0.06] MPa, outside 0.001-50 MPa"),
+    ("air.temperature_c", 1000.0, "726.9 °C, above 150 °C"),
+    ("needle.theta_deg", 0.01, "0.573°, almost flat"),
+    ("microphone.sample_rate_hz", 0.1, "100 Hz, below 400 Hz")])
+def test_a_unit_slip_note_suggests_only_a_plausible_value(key, value, reading):
+    """wall.shear_modulus_mpa = 1e6 got "kPa entered? did you mean [1000, 1000]?" (still 1000 MPa) and
+    [0.001, 1e6] got [1e-06, 1000] (below the 1 kPa minimum): where the other unit's reading is no likelier, the
+    note says what is implausible about both and suggests nothing. A kHz-slip note on frequencies suggests no value
+    below 100 Hz (which would draw the note itself)."""
+    section, name = key.split(".")
+    data = spec_mod.to_dict(spec_mod.load(PAPER))
+    data[section][name] = value
+    (note,) = spec_notes(spec_mod.from_dict(data), data)
+    assert key in note and f"it would be {reading} as well" in note and "did you mean" not in note, note
+    assert frequency_notes([0.05, 0.09]) == [] and "100 Hz" in frequency_notes([0.1])[0]
+
+
 def test_option_names_are_distinct_and_fem_level_needs_fem():
     code, new, _ = run_cli("predict", PAPER, "--json", "--load", "0", "10")
     code_old, old, err = run_cli("predict", PAPER, "--json", "--force", "0", "10")

@@ -146,10 +146,11 @@ def test_garbage_files_are_exit_2(tmp_path):
         assert len(err.getvalue().strip().splitlines()) == 1
 
 
-@pytest.mark.parametrize("category", ["sets", "world", "serve"])
+@pytest.mark.parametrize("category", ["sets", "world", "serve", "sweep", "loop"])
 def test_fuzz_categories_of_issue_21_hold(category, tmp_path):
     """A fast slice of benchmarks/fuzz.py's issue-21 categories (--set values, files from the user's world, the
-    design server under hostile requests): every case keeps the contract (the benchmark runs hundreds)."""
+    design server under hostile requests, sweep's --scheduler/--vary/--workers, the recording loop's float WAVs,
+    short tones and cycle CSVs): every case keeps the contract (the benchmark runs hundreds)."""
     import random
 
     from benchmarks import fuzz

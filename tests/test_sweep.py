@@ -259,6 +259,22 @@ def test_dead_worker_fails_its_variants_not_the_sweep():
     assert [r["status"] for r in results] == ["ok"] * 3 + ["failed"] + ["ok"] * 4
 
 
+def test_a_killed_worker_fails_only_its_own_chunk_at_ci_cost():
+    """The property of the two slow tests around this one, on every CI run (~1 s of CPU: the chunk function lives in
+    a small module, so a spawned worker imports nothing heavy): a local worker killed mid-sweep (SIGKILL) fails only
+    its own chunk ("worker lost"); the chunks its death took down with the pool (still running or queued then) run
+    again and come back ok, in task order, from run and stream alike."""
+    from matcad.sweep.executor import run, stream
+    from tests.dying_worker import killed_on_index_1
+
+    tasks = [{"index": i} for i in range(4)]  # 2 workers x 4 chunks per worker: one task per chunk
+    for results in (run(killed_on_index_1, tasks, Executor(2)),
+                    [r for chunk in stream(killed_on_index_1, tasks, Executor(2)) for r in chunk]):
+        assert [r["index"] for r in results] == [0, 1, 2, 3]
+        assert [r["status"] for r in results] == ["ok", "failed", "ok", "ok"], results
+        assert "worker lost" in results[1]["reason"]
+
+
 @pytest.mark.slow
 def test_streamed_chunks_come_in_order_and_a_dead_worker_fails_only_its_own():
     from matcad.sweep.executor import stream
@@ -297,6 +313,8 @@ def test_unreachable_scheduler_is_bad_input(tmp_path):
     ("neck.mouth=1,2", ["neck.mouth", "not a numeric spec field"]),
     ("cavity.length=3:x:4", ["cavity.length", "finite number"]),
     ("mold.count=1.5,2", ["mold.count", "whole numbers"]),
+    ("mold.count=0,1", ["mold.count = 0:", "1 <= value <= 50"]),
+    ("mechanics.steps=1:200:3", ["mechanics.steps", "not all whole numbers", "(HI - LO) / (N - 1) whole"]),
 ])
 def test_bad_vary_is_exit_2_and_writes_nothing(tmp_path, vary, words):
     out = tmp_path / "sweep"
@@ -304,6 +322,23 @@ def test_bad_vary_is_exit_2_and_writes_nothing(tmp_path, vary, words):
     assert code == 2, err
     assert "Traceback" not in err and all(w in err for w in words), err
     assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_integer_fields_sweep_as_whole_numbers_from_their_lower_bound(tmp_path):
+    """An integer field's bounds are both inclusive, as the spec checks them (mold.count = 1 is valid): `--vary
+    mold.count=1,2` and `mechanics.steps=1,200` were refused ("1.0: outside the field's range: a whole number,
+    1 <= value <= 50"; the sweep read an open lower bound). Their values are ints: in the axis, the table, the JSON."""
+    axes = parse_axes(["mechanics.steps=1,200", "array.columns=1:4:4"])
+    assert [a.values for a in axes] == [(1, 200), (1, 2, 3, 4)]
+    assert all(type(v) is int for a in axes for v in a.values)
+    out = tmp_path / "s"
+    code, _, err = run_cli("sweep", ROOT / "templates" / "mat-laser-only.toml", "--vary", "mold.count=1,2",
+                           "--no-rules", "--workers", "1", "--out", out)
+    assert code == 0, err
+    with open(out / "sweep.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert [(r["mold.count"], r["status"]) for r in rows] == [("1", "ok"), ("2", "ok")]
+    assert json.loads((out / "sweep.json").read_text())["axes"][0]["values"] == [1, 2]
 
 
 def test_grid_cap_and_bad_model(tmp_path):

@@ -151,7 +151,8 @@ def modal_sum(rows: dict, f) -> np.ndarray:
     if "inverse_f2" not in rows:
         freqs = np.concatenate([rows["freqs"], rows["freqs"][:, -1:]], axis=-1)
         rest = np.maximum(rows["static"] - rows["comps"].sum(axis=-1), 0.0)
-        rows["inverse_f2"] = (1.0 / freqs**2)[:, None, :]
+        with np.errstate(over="ignore"):  # a mode beyond 1e154 Hz (a massless wall): f² = inf, 1/f² = 0, its limit
+            rows["inverse_f2"] = (1.0 / freqs**2)[:, None, :]
         rows["modal_c"] = np.concatenate([rows["comps"], rest[:, None]], axis=-1)[:, None, :]
     eta = rows["loss"][:, None, None]
     one_minus_u = 1.0 - (f * f)[..., None] * rows["inverse_f2"]

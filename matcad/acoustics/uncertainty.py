@@ -1,13 +1,13 @@
 """Uncertainty budget of a prediction: one line per source, combined root-sum-square into the band (Hz).
 
-Sources: the chosen model's own error (measured against the converged FEM by
-benchmarks/error_vs_runtime.py, stored in model_errors.json), fabrication (neck diameter as cut or drilled,
-sheet thickness per ISO 7823-1 unless measured, printed cavity diameter, core-pin draft), air temperature,
-viscous/thermal boundary layers (one-sided: every model here is lossless) and the silicone's kHz modulus
-(static range × kHz factor) and loss factor. Each line re-evaluates the chosen model (or, for the FEM, the cheap
-model it refines) with that one input moved to the ends of its tolerance; the silicone line samples the whole
-modulus × loss rectangle, because f is not monotonic in G when wall modes cross f. Lines are independent, so
-lows and highs add in quadrature separately, in ln f (relative shifts), which keeps a wide band above zero.
+Sources: the chosen model's own error (measured against the converged FEM by benchmarks/error_vs_runtime.py, stored
+in model_errors.json; an FEM whose checks fail reaches the cheap model it refines), fabrication (neck diameter as
+cut or drilled, sheet thickness per ISO 7823-1 unless measured, printed cavity diameter, core-pin draft), air
+temperature, viscous/thermal boundary layers (one-sided: every model here is lossless) and the silicone's kHz
+modulus (static range × kHz factor) and loss factor. Each line re-evaluates the chosen model (or, for the FEM, the
+cheap model it refines) with that one input moved to the ends of its tolerance; the silicone line samples the whole
+modulus × loss rectangle, because f is not monotonic in G when wall modes cross f. Lines are independent, so lows
+and highs add in quadrature separately, in ln f (relative shifts), which keeps a wide band above zero.
 
 The budget works on a :class:`~matcad.acoustics.design.Design` of floats (one prediction, with its lines' words)
 or of numpy arrays (a sweep's variants, every closed-form rung: the same numbers per variant, no words). Each
@@ -113,7 +113,8 @@ def _fold(values, better):
 def budget(d, res, model: str, f0_hz, valid=True, reference=None) -> list[BudgetLine]:
     """Every source's contribution for ``model`` at ``f0_hz`` (Hz) on design ``d`` (``res`` its resonator);
     ``valid`` False (the model's own checks fail) takes its error over every benchmark case, not only the valid
-    ones; ``reference`` is the measured :class:`~matcad.acoustics.design.Reference` of the 'relative' model."""
+    ones, and for the FEM (a failed check: the mode it solved may not be the taxel's) reaches the cheap rung's f0;
+    ``reference`` is the measured :class:`~matcad.acoustics.design.Reference` of the 'relative' model."""
     array = np.ndim(f0_hz) > 0
     cheap = registry.model(model if model in registry.cheap_models() else registry.CHOSEN[d.wall.model])
     relative = model == "relative"
@@ -147,8 +148,14 @@ def budget(d, res, model: str, f0_hz, valid=True, reference=None) -> list[Budget
         cases, where = error["cases"], "geometries where its checks pass"
         if not array and not valid and "max_abs_all" in error:
             cases, where = error["of"], "geometries, checks failing included"
-        lines.append(BudgetLine("model", words(lambda: f"{model}: max |error| {100 * worst:.2f} % vs FEM over {cases} "
-                                                       f"{where}"), -worst * f0_hz, worst * f0_hz))
+        low, high = -worst * f0_hz, worst * f0_hz
+        told = words(lambda: f"{model}: max |error| {100 * worst:.2f} % vs FEM over {cases} {where}")
+        if not array and not valid and cheap.name != model:  # a mesh rung's failed check: maybe not the taxel's mode
+            f_cheap = f0_hz / scale
+            low, high = min(low, f_cheap - f0_hz), max(high, f_cheap - f0_hz)
+            told = (f"{model}: its checks fail, so the mode it solved may not be the taxel's: the band reaches "
+                    f"{cheap.name}'s {f_cheap:.0f} Hz")
+        lines.append(BudgetLine("model", told, low, high))
     making = d.making
     drilled = making.neck_drilled
     d_tol, sheet_tol, cav_tol = fabrication_tolerances(making, d.neck_length)

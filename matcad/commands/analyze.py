@@ -30,8 +30,10 @@ def band(args, spec) -> tuple[float, float]:
         from matcad.listening import FREQUENCY_KHZ_MAX
 
         if hi < FREQUENCY_KHZ_MAX:  # a taxel sings at kHz; a band below 100 Hz is a band typed in kHz
+            hint = f"kHz entered? did you mean --band {lo * 1000:g} {hi * 1000:g}?" if hi * 1000 >= FREQUENCY_KHZ_MAX \
+                else f"read as kHz it would lie below {FREQUENCY_KHZ_MAX:g} Hz as well: a taxel sings at kHz"
             raise ValueError(f"--band {lo:g} {hi:g} invalid: the band is in Hz and lies below {FREQUENCY_KHZ_MAX:g} "
-                             f"Hz: kHz entered? did you mean --band {lo * 1000:g} {hi * 1000:g}?")
+                             f"Hz: {hint}")
         return lo, hi
     if spec is not None:
         from matcad.listening import PREDICTED_MARGIN, listening_band

@@ -119,8 +119,9 @@ SEGMENTS_END = 5
 @dataclass(frozen=True)
 class Frames:
     """Every frame of one band as the tracker decided it: time (s), the ridge's frequency (Hz) and excess over the
-    floor (dB), voicing state (1 voiced, else 0), and the strongest other line in the band (bin, excess dB, level
-    relative to the ridge dB; −inf where none)."""
+    floor (dB), voicing state (1 voiced, else 0), the strongest other line in the band (bin, excess dB, level
+    relative to the ridge dB; −inf where none), and whether a harmonic sound was heard below the band
+    (:mod:`matcad.loop.harmonic`)."""
 
     times_s: np.ndarray
     track_hz: np.ndarray
@@ -129,20 +130,34 @@ class Frames:
     other_bin: np.ndarray
     other_excess_db: np.ndarray
     other_level_db: np.ndarray
+    harmonic: np.ndarray
 
 
-def _why_unvoiced(excess: np.ndarray, fs: float) -> str:
+def _why_unvoiced(frames: Frames, fs: float) -> str:
     """Why no frame counted as the tone: a recording too short for the shortest run that can count
-    (:data:`STRONG_RUN` frames), or no line strong or steady enough (levels dB over the floor)."""
+    (:data:`STRONG_RUN` frames); a harmonic sound below the band while no run reached :data:`MIN_RUN_HARMONIC`
+    frames; or no line strong or steady enough (levels dB over the floor)."""
+    excess = frames.excess_db
     hop = window_samples(fs) // 2
-    run_ms = 1e3 * (window_samples(fs) + (STRONG_RUN - 1) * hop) / fs
+
+    def run_ms(n: int) -> float:
+        return 1e3 * (window_samples(fs) + (n - 1) * hop) / fs
+
     best = f"best frame {np.max(excess):.1f} dB"
     if len(excess) < STRONG_RUN:
         return (f"the recording holds {len(excess)} analysis frame ({WINDOW_S * 1e3:.0f} ms), too short for a run of "
-                f"{STRONG_RUN} frames ({run_ms:.0f} ms) at >= {STRONG_DB:g} dB, the least a tone needs to count (a lone "
-                f"frame is as often a noise peak; {best}): record longer")
-    return (f"no frame has a line >= {STRONG_DB:g} dB over the local noise floor, nor >= {WEAK_DB:g} dB steady for "
-            f"{MIN_RUN} frames ({best})")
+                f"{STRONG_RUN} frames ({run_ms(STRONG_RUN):.0f} ms) at >= {STRONG_DB:g} dB, the least a tone needs to "
+                f"count (a lone frame is as often a noise peak; {best}): record longer")
+    longest = longest_run(excess >= WEAK_DB)
+    heard = int(np.count_nonzero(frames.harmonic))
+    if heard and longest < MIN_RUN_HARMONIC:
+        return (f"a harmonic sound (a voice, a buzz, music; or the periodic rounding error of a synthesised tone) "
+                f"was heard below the band in {heard} of {len(excess)} frames, and near one a tone needs a run of "
+                f"{MIN_RUN_HARMONIC} frames ({run_ms(MIN_RUN_HARMONIC):.0f} ms) to count, as a voice leaves "
+                f"steady-looking lines of 2-8 frames in the band; the longest run here is {longest} frames ({best}): "
+                "record longer or away from the sound")
+    return (f"no run of frames holds a steady line (within ±{STABLE_BINS} bins) >= {STRONG_DB:g} dB over the local "
+            f"noise floor for {STRONG_RUN} frames, nor >= {WEAK_DB:g} dB for {MIN_RUN} frames ({best})")
 
 
 def conclude(frames: Frames, bins: BandBins, duration_s: float, loudest: str = "", plot=(None, None)) -> Analysis:
@@ -158,7 +173,7 @@ def conclude(frames: Frames, bins: BandBins, duration_s: float, loudest: str = "
         raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz: the recording is shorter than one "
                         f"{WINDOW_S * 1e3:.0f} ms analysis window")
     if not np.any(state == 1):
-        raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz: {_why_unvoiced(excess, bins.fs)}{hint}")
+        raise LoopError(f"no tone in {lo:.0f}-{hi:.0f} Hz: {_why_unvoiced(frames, bins.fs)}{hint}")
     # the taxel's line through hops and crossings of two tones
     ident = crossing.follow_taxel(times, track, state, frames.other_bin, frames.other_excess_db,
                                   frames.other_level_db, excess, band_freqs)

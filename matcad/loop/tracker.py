@@ -159,5 +159,6 @@ class BandTracker:
                                         float(self.band_peak_power.max() / len(self.times)))
         frames = Frames(np.array(self.times), np.array(self.track), np.array(self.excess),
                         np.array(self._voicing.state, dtype=int), np.array(self.other_bin),
-                        np.array(self.other_excess), np.array(self.other_level))
+                        np.array(self.other_excess), np.array(self.other_level),
+                        self._voicing.heard[:len(self.times)])
         return replace(conclude(frames, self.bins, duration_s, loudest, plot), frame_level_db=np.array(self.peak_db))

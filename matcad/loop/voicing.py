@@ -121,6 +121,11 @@ class Voicing:
         """Whether a harmonic sound is present (:func:`matcad.loop.harmonic.harmonic_frames`), per frame."""
         self._harmonic_sound.extend(harmonic_sound)
 
+    @property
+    def heard(self) -> np.ndarray:
+        """Per frame heard so far: whether a harmonic sound was present."""
+        return np.array(self._harmonic_sound, dtype=bool)
+
     def step(self, excess_db: float, position_bins: float, shift_db: float) -> int:
         """Voice the next frame: its ridge's ``excess_db`` over the floor (−inf when the line is one of a harmonic
         comb), its ``position_bins`` in the band and the clutter's ``shift_db`` (:meth:`Clutter.shift_db`).

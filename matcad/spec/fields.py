@@ -28,8 +28,9 @@ def param(doc: str, unit: str = "", default: Any = dataclasses.MISSING, *, kind:
           lo: float | None = None, hi: float | None = None, lo_open: bool = True,
           choices: tuple[str, ...] = (), section: type | None = None) -> Any:
     """Declare one spec field. ``kind`` is number | integer | bool | text | range | vector (a list of numbers) |
-    vector9 | choice | name | section (a sub-table validated as the Section class ``section``)."""
-    meta = {"doc": doc, "unit": unit, "kind": kind, "lo": lo, "hi": hi, "lo_open": lo_open,
+    vector9 | choice | name | section (a sub-table validated as the Section class ``section``). A number's lower
+    bound is open unless ``lo_open`` is False; an integer's bounds are both inclusive (``lo <= value <= hi``)."""
+    meta = {"doc": doc, "unit": unit, "kind": kind, "lo": lo, "hi": hi, "lo_open": lo_open and kind != "integer",
             "choices": choices, "section": section}
     return field(default=default, metadata=meta)
 

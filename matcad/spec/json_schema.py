@@ -19,7 +19,7 @@ TEXT_PATTERN = "^[ -~]{0,40}$"
 def _bounded(row: dict, json_type: str = "number") -> dict:
     out: dict = {"type": json_type}
     if row["lo"] is not None:
-        out["exclusiveMinimum" if row["lo_open"] and json_type == "number" else "minimum"] = row["lo"]
+        out["exclusiveMinimum" if row["lo_open"] else "minimum"] = row["lo"]
     if row["hi"] is not None:
         out["maximum"] = row["hi"]
     return out

@@ -27,7 +27,7 @@ VARIABLE_KINDS = ("number", "integer")
 
 @dataclass(frozen=True)
 class Axis:
-    """One varied spec field: its dotted key, unit and values (in the field's unit)."""
+    """One varied spec field: its dotted key, unit and values (in the field's unit; ints for an integer field)."""
 
     field: str
     unit: str
@@ -70,17 +70,20 @@ def _number(field: str, text: str) -> float:
 def _in_range(field: str, value: float, row: dict) -> None:
     lo, hi = row["lo"], row["hi"]
     lo_ok = value > lo if row["lo_open"] else value >= lo
+    whole = row["kind"] == "integer" and value.is_integer() and abs(value) < 2 ** 53  # exact in a float
+    shown = int(value) if whole else value  # a count as typed: 0, not 0.0
     if not (lo_ok and value <= hi):
-        raise _error(field, value, f"outside the field's range: {row['allowed']}")
+        raise _error(field, shown, f"outside the field's range: {row['allowed']}")
     if row["kind"] == "integer" and value != int(value):
-        raise _error(field, value, f"must be whole numbers: {row['allowed']}")
+        raise _error(field, shown, f"must be whole numbers: {row['allowed']}")
 
 
 def parse_axis(text: str) -> Axis:
     """``FIELD=LO:HI:N`` (N evenly spaced values, both ends included) or ``FIELD=a,b,c`` → an :class:`Axis`.
 
     Raises SpecError naming the field, the value and what is allowed: an unknown or non-numeric field (with a
-    did-you-mean), N < 1 or > :data:`MAX_POINTS`, LO > HI, a value outside the field's range (``matcad schema``).
+    did-you-mean), N < 1 or > :data:`MAX_POINTS`, LO > HI, a value outside the field's range (``matcad schema``),
+    a fraction for an integer field.
     """
     field, sep, raw = text.partition("=")
     field, raw = field.strip(), raw.strip()
@@ -108,6 +111,9 @@ def parse_axis(text: str) -> Axis:
         if n == 1 and lo != hi:
             raise _error(field, raw, "N = 1 needs LO = HI (or give the one value as FIELD=a)")
         values = tuple(float(v) for v in np.linspace(lo, hi, n))
+        if row["kind"] == "integer" and any(v != round(v) for v in values):
+            raise _error(field, raw, f"{n} values from {lo:g} to {hi:g} are not all whole numbers, which the field "
+                                     f"takes ({row['allowed']}): choose N with (HI - LO) / (N - 1) whole")
     else:
         values = tuple(_number(field, v) for v in raw.split(","))
         if len(values) > MAX_POINTS:
@@ -116,7 +122,8 @@ def parse_axis(text: str) -> Axis:
             raise _error(field, raw, "each value at most once")
     for v in values:
         _in_range(field, v, row)
-    return Axis(field, row["unit"], values, row["kind"] == "integer")
+    integer = row["kind"] == "integer"
+    return Axis(field, row["unit"], tuple(int(v) for v in values) if integer else values, integer)
 
 
 def parse_axes(texts) -> tuple[Axis, ...]:

@@ -1,0 +1,19 @@
+"""A chunk function for the sweep executor's fast dead-worker test, in a module of its own: a spawned worker imports
+only this one (the test module would cost each worker numpy, scipy and matcad's prediction, ~0.7 s of CPU)."""
+
+import os
+import signal
+import time
+
+BUSY_S = 0.3
+"""How long a surviving variant takes (s of sleep, no CPU): long enough that its chunk is still running or queued
+when the other worker is killed, so a pool that breaks loses it."""
+
+
+def killed_on_index_1(tasks):
+    """Chunk function (list of task dicts → result dicts) whose worker process is killed on variant 1 (SIGKILL, as
+    the out-of-memory killer does); other variants come back ok after :data:`BUSY_S`."""
+    if any(t["index"] == 1 for t in tasks):
+        os.kill(os.getpid(), signal.SIGKILL)
+    time.sleep(BUSY_S)
+    return [{"index": t["index"], "status": "ok", "reason": ""} for t in tasks]
