@@ -341,7 +341,8 @@ def test_sheets_pdf_prints_every_sheet_at_one_to_one(built, tmp_path):
 def test_print_job_3mf_read_back(built):
     """The 3MF print job(s) read back by trimesh's 3MF reader: every printed STL once, the same volume, flat on the
     bed (z from 0) inside the printer's bed, footprints apart; each object's slicer settings are its print
-    profile's; an FDM mold base carries its nut pause at a layer boundary above the pockets."""
+    profile's; an FDM mold base carries its nut pause at a layer boundary above the pockets, and the job's notes
+    say how the mold base's captive nuts go in on either printer (at the pause, or pressed in after printing)."""
     import zipfile
 
     from matcad.export.threemf import BED_MM
@@ -377,6 +378,15 @@ def test_print_job_3mf_read_back(built):
             config = ET.fromstring(z.read("Metadata/Slic3r_PE_model.config"))
             pauses = (ET.fromstring(z.read("Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml"))
                       if "Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml" in z.namelist() else None)
+            notes = z.read("Metadata/matcad_print_notes.txt").decode()
+        doings = [line.strip() for line in notes.splitlines() if line.strip().startswith(("PAUSE", "AFTER"))]
+        if "end_cap_mold_base" in scene.geometry:  # the SLA traps' nuts were only in report.md's print step
+            n, bolt = len(end_cap_mold_layout(spec).bolts), end_cap_mold_layout(spec).clamp.bolt
+            want = (f"PAUSE after the layer at z = {f['pauses'][0]['after_layer_z_mm']:.2f} mm: insert {n} {bolt} nuts"
+                    if printer == "fdm" else f"AFTER PRINTING: press an {bolt} nut into each of the {n} hex traps")
+            assert len(doings) == 1 and doings[0].startswith(want), (doings, want)
+        else:
+            assert not doings, notes
         for obj in config.iter("object"):
             meta = {m.get("key"): m.get("value") for m in obj.iter("metadata") if m.get("type") == "object"}
             p = profile(printer, meta["name"])
