@@ -357,9 +357,11 @@ def test_print_job_3mf_read_back(built):
         return
     printer = spec.machine.printer
     assert job["printer"] == printer
-    seen = []
+    seen, holders = [], []
     for f in job["files"]:
         scene = trimesh.load(out / f["file"])
+        if {"end_cap_mold_base", "end_cap_mold_lid"} & set(scene.geometry):
+            holders.append(f["file"])
         boxes = []
         for node in scene.graph.nodes_geometry:
             transform, name = scene.graph[node]
@@ -404,7 +406,9 @@ def test_print_job_3mf_read_back(built):
             assert layers == pytest.approx(round(layers), abs=1e-6)
             assert float(code.get("print_z")) == pytest.approx(pause["after_layer_z_mm"] + p.layer_mm / 2)
     assert sorted(seen) == stls
-    if spec.outputs.end_cap_mold:
+    if spec.outputs.end_cap_mold:  # the casting guide names the job files that hold the mold (mat-array-4:
+        named = re.findall(r"print_\w+\.3mf", report["casting"]["steps"][0])  # print_sla_1.3mf, no print_sla.3mf)
+        assert named == holders, (named, holders)
         c = end_cap_mold_layout(spec).clamp
         assert bool(c.pause_print_z) == (printer == "fdm") and (not c.open_below) == (printer == "fdm")
 
