@@ -282,7 +282,9 @@ def assert_casts_only_the_caps(spec, out: Path, report: dict) -> list[dict]:
     """The closed mold read back from its STLs casts each cap and nothing else inside it: the space under the
     parting plane at each position is that cap's volume in end_cap.stl (a vent down a core pin would add the
     thread it casts inside the cavity, 3.74 mm³ for the paper's taxel), and the space in the lid over it is the
-    sprues the cavity-appendage rule counts, which it reports with 0 mm³ inside the cavity. Returns the rows."""
+    sprues the cavity-appendage rule counts, which it reports with 0 mm³ inside the cavity; the casting guide fills
+    until silicone stands in the vents the lid has over each cap and trims their sprues and the fill port's off
+    the sealing face. Returns the rows."""
     from matcad.parts.mold_layout import appendages
 
     rows = cast_volumes(spec, out, report)
@@ -293,4 +295,18 @@ def assert_casts_only_the_caps(spec, out: Path, report: dict) -> list[dict]:
         assert rule["inside_cavity_mm3"] == 0.0
     found = next(f for f in report["findings"] if f["id"] == "mold.cavity_appendage")
     assert found["level"] == "info" and found["value"] == 0.0
+    # the pour and trim wording counts what the lid has: the fill port and N vents over each cap, N + 1 sprues
+    from matcad.spec import cap_flange_diameter_mm, taxel_spec
+
+    lid = design_frame(out, report, "end_cap_mold_lid.stl")
+    holes = section_circles(lid, spec.mold.lid_thickness / 2)
+    casting = report["casting"]
+    for taxel, x, _ in slot_caps(spec, out, report):
+        flange = cap_flange_diameter_mm(taxel_spec(spec, taxel)) / 2
+        over = sorted(round(2 * r, 2) for cx, cy, r in holes if np.hypot(cx - x, cy) < flange and r < flange / 2)
+        vents = len(over) - 1
+        assert over == [round(spec.mold.vent, 2)] * vents + [round(spec.mold.fill_port, 2)], (taxel.name, over)
+        assert f"silicone stands in every one of its {vents} vents" in " ".join(casting["steps"])
+        assert casting["trim"][0].startswith(f"{vents + 1} sprues per cap (the fill port's and {vents} vents') "
+                                             "stand on the cap's base face")
     return rows
