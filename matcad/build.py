@@ -167,8 +167,9 @@ def write_sheets(plans, spec, folder: Path) -> list[dict]:
 
 def write_print_job(spec, folder: Path, meshes: dict) -> dict | None:
     """The printer's 3MF (:mod:`matcad.export.threemf`) from the printed STLs just written (their print poses),
-    each with its print profile; an FDM mold base with the pause for its captive nuts; one file per bed load.
-    Returns the printer and each file's objects and pauses; None without printed parts."""
+    each with its print profile; an FDM mold base with the pause for its captive nuts, an SLA one with the note to
+    press them in after printing; one file per bed load. Returns the printer and each file's objects, pauses and
+    after-print notes; None without printed parts."""
     from matcad.export.mesh import load_stl
     from matcad.export.threemf import PrintPart, plates, write_3mf
     from matcad.parts.print_profile import profile
@@ -181,15 +182,16 @@ def write_print_job(spec, folder: Path, meshes: dict) -> dict | None:
             continue
         name = Path(stl).stem
         mesh = load_stl(folder / stl)  # read once by the mesh checks
-        pause = None
-        if name == "end_cap_mold_base" and printer == "fdm":
+        pause = after = None
+        if name == "end_cap_mold_base":
             from matcad.parts.mold_layout import layout
 
             lay = layout(spec)
-            c = lay.clamp
-            pause = (round(c.pocket_top_z + lay.base_height, 6), f"insert {len(lay.bolts)} {c.bolt} nuts into the "
-                     "mold base's hex pockets")
-        parts.append(PrintPart(name, mesh.vertices, mesh.faces, profile(printer, name), pause))
+            if lay.clamp.open_below:
+                after = lay.nut_insert
+            else:
+                pause = (round(lay.clamp.pocket_top_z + lay.base_height, 6), lay.nut_insert)
+        parts.append(PrintPart(name, mesh.vertices, mesh.faces, profile(printer, name), pause, after))
     if not parts:
         return None
     loads = plates(parts, printer)

@@ -253,6 +253,23 @@ def test_mold_lid_carries_four_core_pins_of_each_cavity(solid_build):
                 assert r == pytest.approx(t.cavity.diameter / 2, abs=0.01) and abs(cy) < 0.01
 
 
+def test_board_mold_vents_every_cap_and_casts_nothing_inside_a_cavity(solid_build):
+    """The board's mold read back from its STLs as tests/test_mold_venting.py reads a single taxel's: every
+    ceiling of its four different caps within the vent reach (the base face by its slot's plan, the pin's end
+    by its own tip radius: t4's 1.25 mm), and under the parting plane each position casts its own cap's volume
+    and nothing more (no silicone inside a cavity)."""
+    from tests.readback import assert_casts_only_the_caps, assert_vented
+
+    spec, out = solid_build
+    report = json.loads((out / "report.json").read_text())
+    slots = layout(spec).slots
+    reaches = assert_vented(spec, out, report)
+    assert sorted((name, z) for name, z, _ in reaches) == sorted(
+        [(t.name, 0.0) for t in slots] + [(t.name, -t.cavity.length) for t in slots])
+    rows = assert_casts_only_the_caps(spec, out, report)
+    assert [r["taxel"] for r in rows] == [t.name for t in slots]
+
+
 def test_needle_mount_has_one_bore_per_taxel_aimed_at_its_neck(solid_build):
     from build123d import GeomType, Pos, import_step
 

@@ -341,7 +341,8 @@ def test_sheets_pdf_prints_every_sheet_at_one_to_one(built, tmp_path):
 def test_print_job_3mf_read_back(built):
     """The 3MF print job(s) read back by trimesh's 3MF reader: every printed STL once, the same volume, flat on the
     bed (z from 0) inside the printer's bed, footprints apart; each object's slicer settings are its print
-    profile's; an FDM mold base carries its nut pause at a layer boundary above the pockets."""
+    profile's; an FDM mold base carries its nut pause at a layer boundary above the pockets, and the job's notes
+    say how the mold base's captive nuts go in on either printer (at the pause, or pressed in after printing)."""
     import zipfile
 
     from matcad.export.threemf import BED_MM
@@ -356,9 +357,11 @@ def test_print_job_3mf_read_back(built):
         return
     printer = spec.machine.printer
     assert job["printer"] == printer
-    seen = []
+    seen, holders = [], []
     for f in job["files"]:
         scene = trimesh.load(out / f["file"])
+        if {"end_cap_mold_base", "end_cap_mold_lid"} & set(scene.geometry):
+            holders.append(f["file"])
         boxes = []
         for node in scene.graph.nodes_geometry:
             transform, name = scene.graph[node]
@@ -377,6 +380,15 @@ def test_print_job_3mf_read_back(built):
             config = ET.fromstring(z.read("Metadata/Slic3r_PE_model.config"))
             pauses = (ET.fromstring(z.read("Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml"))
                       if "Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml" in z.namelist() else None)
+            notes = z.read("Metadata/matcad_print_notes.txt").decode()
+        doings = [line.strip() for line in notes.splitlines() if line.strip().startswith(("PAUSE", "AFTER"))]
+        if "end_cap_mold_base" in scene.geometry:  # the SLA traps' nuts were only in report.md's print step
+            n, bolt = len(end_cap_mold_layout(spec).bolts), end_cap_mold_layout(spec).clamp.bolt
+            want = (f"PAUSE after the layer at z = {f['pauses'][0]['after_layer_z_mm']:.2f} mm: insert {n} {bolt} nuts"
+                    if printer == "fdm" else f"AFTER PRINTING: press an {bolt} nut into each of the {n} hex traps")
+            assert len(doings) == 1 and doings[0].startswith(want), (doings, want)
+        else:
+            assert not doings, notes
         for obj in config.iter("object"):
             meta = {m.get("key"): m.get("value") for m in obj.iter("metadata") if m.get("type") == "object"}
             p = profile(printer, meta["name"])
@@ -394,7 +406,9 @@ def test_print_job_3mf_read_back(built):
             assert layers == pytest.approx(round(layers), abs=1e-6)
             assert float(code.get("print_z")) == pytest.approx(pause["after_layer_z_mm"] + p.layer_mm / 2)
     assert sorted(seen) == stls
-    if spec.outputs.end_cap_mold:
+    if spec.outputs.end_cap_mold:  # the casting guide names the job files that hold the mold (mat-array-4:
+        named = re.findall(r"print_\w+\.3mf", report["casting"]["steps"][0])  # print_sla_1.3mf, no print_sla.3mf)
+        assert named == holders, (named, holders)
         c = end_cap_mold_layout(spec).clamp
         assert bool(c.pause_print_z) == (printer == "fdm") and (not c.open_below) == (printer == "fdm")
 
@@ -466,6 +480,69 @@ def test_board_drilling_by_taxel_in_files_steps_and_bom(built):
             nx, ny = min(max(x, box[0]), box[2]), min(max(y, box[1]), box[3])
             assert math.hypot(nx - x, ny - y) > r, (e.text, (x, y, r))
     assert sum(e.text.split()[0] in {t.name for t in board} for e in flat.engrave) == len(board)
+
+
+def _loop_area(loop) -> float:
+    return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(loop, loop[1:] + loop[:1]))) / 2
+
+
+def _label_area(loops, engraving) -> float:
+    """Area of the even-odd regions drawn by the closed ``loops`` lying within an engraving's glyph box (mm²)."""
+    from matcad.parts.flat import even_odd_faces
+    from matcad.parts.labels import engraving_box
+
+    x0, y0, x1, y1 = engraving_box(engraving)
+    inside = [loop for loop in loops if all(x0 - 0.5 <= x <= x1 + 0.5 and y0 - 0.5 <= y <= y1 + 0.5 for x, y in loop)]
+    return sum(_loop_area(outer) - sum(_loop_area(h) for h in holes) for outer, holes in even_odd_faces(inside))
+
+
+def _recessed_mm2(mesh, z: float, engraving) -> float:
+    """Open area of a printed part's section at height z within an engraving's box: its recessed glyphs (mm²)."""
+    section = mesh.section(plane_origin=[0.0, 0.0, z], plane_normal=[0.0, 0.0, 1.0])
+    return _label_area([[tuple(p[:2]) for p in loop[:-1]] for loop in section.discrete], engraving)
+
+
+def test_board_taxel_names_read_back_from_mold_mount_and_guides(built):
+    """A board's taxel names read back from the files: recessed (half the label depth down) in the mold base's
+    parting face, the lid's top face and the mount's top face, engraved in each guide's DXF, each the glyph area
+    of its own name (t1 … t4 differ) and nearest its own pocket, bore mouth or cap hole."""
+    from matcad.parts import end_cap_mold
+    from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM, engraving_box
+    from matcad.parts.needle_mount import bore_mouth_mm, mount_labels
+    from tests.readback import design_frame
+
+    spec, out, _ = built
+    board = taxels(spec)
+    if len(board) < 2:
+        return
+    report = json.loads((out / "report.json").read_text())
+
+    def check(labels, area, anchors):
+        assert sorted(e.text for e in labels) == sorted(t.name for t in board)
+        for e in labels:
+            assert area(e) == pytest.approx(_glyph_area(e), rel=1e-3), e.text
+            x0, y0, x1, y1 = engraving_box(e)
+            own = min(anchors, key=lambda a: math.hypot(a[1] - (x0 + x1) / 2, a[2] - (y0 + y1) / 2))
+            assert own[0] == e.text, (e, own)
+
+    half = PRINTED_LABEL_DEPTH_MM / 2
+    if spec.outputs.end_cap_mold:
+        lay = end_cap_mold_layout(spec)
+        pockets = [(t.name, x, 0.0) for x, t in zip(lay.cap_x, lay.slots)]
+        base, lid = (design_frame(out, report, f"end_cap_mold_{p}.stl") for p in ("base", "lid"))
+        check(end_cap_mold.base_labels(spec), lambda e: _recessed_mm2(base, -half, e), pockets)
+        check(end_cap_mold.lid_labels(spec), lambda e: _recessed_mm2(lid, spec.mold.lid_thickness - half, e),
+              pockets)
+    if spec.outputs.needle_mount:
+        mount = design_frame(out, report, "needle_mount.stl")  # the assembly frame: top face at -spacer.height
+        mouths = [(t.name, *bore_mouth_mm(spec, t)[:2]) for t in board]
+        check(mount_labels(spec), lambda e: _recessed_mm2(mount, -spec.spacer.height - half, e), mouths)
+    names = {t.name for t in board}
+    for flat in (f for f in laser_parts(spec) if f.name.startswith("guide_")):
+        msp = ezdxf.readfile(out / f"{flat.name}.dxf").modelspace()
+        loops = [[tuple(p[:2]) for p in e.get_points("xy")] for e in msp.query("LWPOLYLINE[layer=='ENGRAVE']")]
+        check([e for e in flat.engrave if e.text in names], lambda e: _label_area(loops, e),
+              [(t.name, t.x, t.y) for t in board])
 
 
 def test_bom_agrees_with_the_casting_guide_and_stock(built):

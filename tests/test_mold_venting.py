@@ -1,22 +1,20 @@
 """Venting measured from the exported meshes: the caps as they sit in the closed mold (pour orientation), their
 ceilings (up-facing silicone surface), the lid's openings found by casting rays straight up through the lid STL,
-and the farthest ceiling point from an opening, against what the report claims."""
+and the farthest ceiling point from an opening, against what the report claims; and what the closed mold casts
+(the cap and its sprues, nothing inside the cavity). A board's mold is read back the same way in test_board.py."""
 
 import json
 import math
 
 import numpy as np
 import pytest
-import trimesh
-from scipy.spatial import cKDTree
 
 from matcad import spec as spec_mod
 from matcad.build import build
-from matcad.parts.mold_layout import CEILING_TILT_DEG
 from tests.conftest import SINGLE_TEMPLATES
+from tests.readback import assert_casts_only_the_caps, assert_vented, design_frame
 
 MOLD_TEMPLATES = [p for p in SINGLE_TEMPLATES if spec_mod.load(p).outputs.end_cap_mold]
-SAMPLE_MM = 0.08
 
 
 @pytest.fixture(scope="module", params=MOLD_TEMPLATES, ids=lambda p: p.stem)
@@ -27,89 +25,15 @@ def built(request, tmp_path_factory):
     return spec, out, json.loads((out / "report.json").read_text())
 
 
-def _design_frame(out, report, name):
-    mesh = trimesh.load_mesh(out / name)
-    mesh.apply_transform(np.linalg.inv(np.array(report["meshes"][name]["design_to_print"])))
-    return mesh
-
-
-def _ceiling_components(cap):
-    """Connected groups of up-facing faces (flatter than CEILING_TILT_DEG) of one cap in the mold frame."""
-    up = np.flatnonzero(cap.face_normals[:, 2] >= math.cos(math.radians(CEILING_TILT_DEG)))
-    sub = cap.submesh([up], append=True, repair=False)
-    groups = trimesh.graph.connected_components(sub.face_adjacency, nodes=np.arange(len(sub.faces)),
-                                                engine="scipy")
-    return [sub.submesh([g], append=True, repair=False) for g in groups]
-
-
-def _grid_points(component, step):
-    """Points on a step-mm grid whose xy falls inside a triangle of the (horizontal) component, at its height."""
-    lo, hi = component.bounds[:, :2]
-    xs, ys = np.meshgrid(np.arange(lo[0], hi[0] + step, step), np.arange(lo[1], hi[1] + step, step))
-    p = np.column_stack([xs.ravel(), ys.ravel()])
-    inside = np.zeros(len(p), dtype=bool)
-    for a, b, c in component.triangles[:, :, :2]:
-        d = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1])
-        u = ((b[1] - c[1]) * (p[:, 0] - c[0]) + (c[0] - b[0]) * (p[:, 1] - c[1])) / d
-        v = ((c[1] - a[1]) * (p[:, 0] - c[0]) + (a[0] - c[0]) * (p[:, 1] - c[1])) / d
-        inside |= (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9)
-    z = component.vertices[:, 2].mean()
-    return np.column_stack([p[inside], np.full(inside.sum(), z)])
-
-
-def _rim_points(component, step):
-    """Points every ``step`` mm along the boundary of a ceiling component (edges owned by one face) (mm)."""
-    edges = component.edges_sorted
-    unique, counts = np.unique(edges, axis=0, return_counts=True)
-    rim = unique[counts == 1]
-    pts = []
-    for a, b in component.vertices[rim]:
-        n = max(2, int(np.ceil(np.linalg.norm(b - a) / step)) + 1)
-        pts.append(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a))
-    return np.vstack(pts)
-
-
-def measured_reaches(spec, out, report):
-    """Farthest distance (mm) from a ceiling point to an escape, per ceiling (per cap: base face, pin end). The
-    base face escapes through the lid's openings above it; the core pin's end face has none (a channel through
-    the pin would cast a thread inside the cavity): its escape is its rim, where the pin's side rises."""
-    from matcad.parts.end_cap_mold import layout
-
-    lid = _design_frame(out, report, "end_cap_mold_lid.stl")
-    cap_own = _design_frame(out, report, "end_cap.stl")
-    reaches = []
-    for x in layout(spec).cap_x:
-        cap = cap_own.copy()
-        cap.apply_transform(trimesh.transformations.rotation_matrix(math.pi, [1, 0, 0]))
-        cap.apply_translation([x, 0, 0])
-        for component in _ceiling_components(cap):
-            pts = _grid_points(component, SAMPLE_MM)
-            assert len(pts) > 50
-            rays = pts + [0, 0, 1e-3]
-            blocked = lid.ray.intersects_any(rays, np.tile([0.0, 0.0, 1.0], (len(rays), 1)))
-            opened = pts[~blocked]
-            z = round(float(pts[0, 2]), 3)
-            if z < -1e-6:  # the pin's end face: solid pin above every point of it, escape at its rim
-                assert not len(opened), f"{len(opened)} points of the pin end face see an opening through the pin"
-                gap, _ = cKDTree(_rim_points(component, SAMPLE_MM / 4)[:, :2]).query(pts[:, :2])
-            else:
-                assert len(opened), f"a ceiling at z = {z:.2f} with no opening above it"
-                gap, _ = cKDTree(opened[:, :2]).query(pts[blocked][:, :2]) if blocked.any() else (np.zeros(1), None)
-            reaches.append((z, float(gap.max())))
-    return reaches
-
-
 def test_every_ceiling_reaches_an_opening_within_the_stated_distance(built):
     spec, out, report = built
-    venting = report["casting"]["venting"]
-    reaches = measured_reaches(spec, out, report)
-    print(spec.name, "ceiling (z, farthest distance to an opening) mm:", reaches)
+    reaches = assert_vented(spec, out, report)
     assert len(reaches) == 2 * spec.mold.count  # base face and core-pin end of every cap
-    for z, reach in reaches:
-        assert reach <= venting["vent_reach_mm"] + SAMPLE_MM, (z, reach)
-        claimed = venting["base_face_reach_mm"] if abs(z) < 1e-6 else venting["pin_end_reach_mm"]
-        assert reach == pytest.approx(claimed, abs=2 * SAMPLE_MM + 0.02), (z, reach, claimed)
-    assert {z for z, _ in reaches} == {0.0, -spec.cavity.length}
+    assert {z for _, z, _ in reaches} == {0.0, -spec.cavity.length}
+
+
+def test_the_closed_mold_casts_the_cap_and_its_sprues_only(built):
+    assert_casts_only_the_caps(*built)
 
 
 def test_pour_guide_in_the_report(built):
@@ -133,7 +57,7 @@ def test_nothing_is_cast_inside_any_cavity(built):
     from matcad.parts.mold_layout import pin_tip_radius_mm
 
     spec, out, report = built
-    lid = _design_frame(out, report, "end_cap_mold_lid.stl")
+    lid = design_frame(out, report, "end_cap_mold_lid.stl")
     step, r = 0.2, pin_tip_radius_mm(spec) - 0.05  # the drafted pin is narrowest at its tip
     g = np.arange(-r, r + 1e-9, step)
     xs, ys, zs = np.meshgrid(g, g, np.arange(-spec.cavity.length + 0.05, -0.05, step))

@@ -1,7 +1,8 @@
 """A 3MF print job per printer (print_fdm.3mf, print_sla.3mf): every printed part of the kit as exported (its
 print pose, on its bed face), laid out on the bed, each with its own slicer settings — layer height, walls,
-infill, solid layers — and the material, and for an FDM mold base the pause that drops its captive nuts in. Parts
-that do not fit one bed go to further plates (print_sla_1.3mf, print_sla_2.3mf, ...), each a job of its own.
+infill, solid layers — and the material, and for the mold base how its captive nuts go in (on FDM a pause, on
+SLA a note to press them in after printing). Parts that do not fit one bed go to further plates
+(print_sla_1.3mf, print_sla_2.3mf, ...), each a job of its own.
 
 3MF Core 2015/02 (mm) with PrusaSlicer's metadata, which PrusaSlicer, SuperSlicer and OrcaSlicer read:
 ``Metadata/Slic3r_PE.config`` (the project's printer technology, material and defaults),
@@ -43,14 +44,15 @@ PAUSE = 1
 @dataclass(frozen=True)
 class PrintPart:
     """One part of the job: its name, its mesh in the print pose (vertices mm, triangles), its print profile
-    (:class:`matcad.parts.print_profile.PrintProfile`) and, for an FDM mold base, a pause: (print height of the
-    last layer before it, message)."""
+    (:class:`matcad.parts.print_profile.PrintProfile`), for an FDM mold base a pause: (print height of the last
+    layer before it, message), and what to do to the part once printed (an SLA mold base's nuts)."""
 
     name: str
     vertices: object
     faces: object
     profile: object
     pause: tuple[float, str] | None = None
+    after: str | None = None
 
 
 def _footprint(part: PrintPart) -> tuple[float, float]:
@@ -179,6 +181,8 @@ def notes(parts: list[PrintPart], printer: str) -> str:
         lines.append(f"{part.name}: {settings}; {p.material}. {p.why}.")
         if part.pause:
             lines.append(f"  PAUSE after the layer at z = {part.pause[0]:.2f} mm: {part.pause[1]}")
+        if part.after:
+            lines.append(f"  AFTER PRINTING: {part.after}")
     return "\n".join(lines) + "\n"
 
 
@@ -210,4 +214,5 @@ def write_3mf(parts: list[PrintPart], printer: str, path: Path) -> dict:
             "objects": [{"name": p.name, "x_mm": x, "y_mm": y, "settings": object_settings(p, printer),
                          "material": p.profile.material} for p, (x, y) in zip(parts, places)],
             "pauses": [{"part": p.name, "after_layer_z_mm": p.pause[0], "message": p.pause[1]}
-                       for p in parts if p.pause]}
+                       for p in parts if p.pause],
+            "after_printing": [{"part": p.name, "message": p.after} for p in parts if p.after]}

@@ -79,8 +79,10 @@ class CastingGuide:
         return asdict(self)
 
 
-def casting_guide(spec: Spec) -> CastingGuide:
-    """The pour for ``spec``: batch = max(cast volume × waste factor × density, :data:`MIN_BATCH_G`) (g)."""
+def casting_guide(spec: Spec, jobs: tuple[str, ...] = ()) -> CastingGuide:
+    """The pour for ``spec``: batch = max(cast volume × waste factor × density, :data:`MIN_BATCH_G`) (g). ``jobs``
+    are the 3MF files written that hold the mold halves (named in the print step; before a build, the printer's
+    job file and its numbered siblings)."""
     from matcad.spec import taxel_spec, taxels
 
     g = grade(spec.silicone.grade)
@@ -100,11 +102,13 @@ def casting_guide(spec: Spec) -> CastingGuide:
     nuts = (f"the {len(lay.bolts)} captive {c.bolt} nuts in the base (pressed into the traps under it after "
             "printing)" if c.open_below else f"the {len(lay.bolts)} {c.bolt} nuts the base print captured at its pause")
     board = len(taxels(spec)) > 1
+    held_by = (f"{' and '.join(jobs)} {'hold' if len(jobs) > 1 else 'holds'}" if jobs else
+               f"{PRINT_FILE.format(printer=spec.machine.printer)}, or its _1, _2, ... files when the parts take "
+               "more than one bed, holds")
     steps = (
         f"Print the mold ({mold.label}): end_cap_mold_base and end_cap_mold_lid as exported "
-        f"({PRINT_FILE.format(printer=spec.machine.printer)}, or its _1, _2, ... files when the parts take more "
-        "than one bed, holds them oriented with their settings; or the STLs, flat face down, no supports). Clear every vent with a "
-        f"{spec.mold.vent:g} mm drill or pin.",
+        f"({held_by} them oriented with their settings; or the STLs, flat face down, no supports). Clear every "
+        f"vent with a {spec.mold.vent:g} mm drill or pin.",
         *(("SLA: post-cure the printed mold fully, or barrier-coat it, and cast a test drop (cure inhibition, "
            "above).",) if mold.inhibition else ()),
         f"Release: {RELEASE_AGENT}.",

@@ -111,6 +111,16 @@ class MoldLayout:
         """The slot whose base face vents worst (every slot's, for a mold of identical caps)."""
         return max(self.plans, key=lambda p: (not p.feasible, p.reach_base_mm, p.reach_tip_mm))
 
+    @property
+    def nut_insert(self) -> str:
+        """How the captive clamp nuts go into the printed base: dropped into the FDM pockets at the print's pause,
+        or pressed into the SLA traps once the base is printed (the print job's note and the print step)."""
+        c = self.clamp
+        if c.open_below:
+            return (f"press an {c.bolt} nut into each of the {len(self.bolts)} hex traps under the mold base, up to "
+                    "the trap's top")
+        return f"insert {len(self.bolts)} {c.bolt} nuts into the mold base's hex pockets"
+
 
 def fill_radius_mm(spec) -> float:
     """Fill port (and inner vent ring) radius: the middle of the body wall (mm)."""

@@ -119,15 +119,18 @@ def drill_bom(spec) -> list[dict]:
             for d, names in sorted(sizes.items())]
 
 
-def casting(spec, mold: MoldLayout | None) -> dict | None:
-    """The pour guide and the venting of the mold laid out as ``mold`` (mm, g, min, h, °C); None without a mold."""
+def casting(spec, mold: MoldLayout | None, job: dict | None = None) -> dict | None:
+    """The pour guide and the venting of the mold laid out as ``mold`` (mm, g, min, h, °C), naming the files of
+    the print ``job`` that hold the mold halves; None without a mold."""
     if mold is None:
         return None
     from matcad.parts.casting import casting_guide
     from matcad.parts.mold_layout import appendages
 
     plan = mold.plan
-    out = casting_guide(spec).to_dict() | {"venting": {
+    jobs = tuple(f["file"] for f in (job or {}).get("files", ())
+                 if any(o["name"].startswith("end_cap_mold_") for o in f["objects"]))
+    out = casting_guide(spec, jobs).to_dict() | {"venting": {
         "vent_reach_mm": spec.mold.vent_reach, "base_face_reach_mm": plan.reach_base_mm,
         "pin_end_reach_mm": plan.reach_tip_mm, "base_face_vents_per_cap": len(plan.inner) + len(plan.outer),
         "pin_vents_per_cap": 0, "vent_diameter_mm": spec.mold.vent}, "appendages": appendages(spec, mold)}
@@ -204,7 +207,7 @@ def make_report(spec, prediction, findings, holes, meshes, folder: Path, *, flat
         "findings": [f.to_dict() for f in findings],
         "verdict": "fail" if any(f.level == "error" for f in findings) else "pass",
         "bom": bill_of_materials(spec, flats, mold),
-        "casting": casting(spec, mold),
+        "casting": casting(spec, mold, job),
         "fabrication": fabrication(spec, flats, job),
         "meshes": meshes,
         "files": manifest(folder),

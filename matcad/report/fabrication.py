@@ -182,8 +182,7 @@ def _print_text(spec: Spec, names: list[str], jobs: list[str]) -> str:
         text += (f"; the mold base pauses when its layers reach {c.pocket_top_z + lay.base_height:.2f} mm: drop an "
                  f"{c.bolt} nut into each of its {len(lay.bolts)} hex pockets and resume (the next layer closes "
                  "them over the nuts)" if not c.open_below else
-                 f"; after printing press an {c.bolt} nut into each of the {len(lay.bolts)} hex traps under the mold "
-                 "base, up to the trap's top")
+                 f"; after printing {lay.nut_insert}")
     return text + ". No supports: the STLs are the same parts in the same poses"
 
 

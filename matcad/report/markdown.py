@@ -118,6 +118,8 @@ def _files_to_make_markdown(sheets: list[dict] | None, job: dict | None) -> list
                   f"{cell(o['material'])} |" for f in job["files"] for o in f["objects"]]
         lines += [f"- pause after the layer at z = {p['after_layer_z_mm']:.2f} mm ({p['part']}): {p['message']}"
                   for f in job["files"] for p in f["pauses"]]
+        lines += [f"- after printing ({p['part']}): {p['message']}" for f in job["files"]
+                  for p in f["after_printing"]]
     return lines
 
 
