@@ -49,6 +49,7 @@ def test_pour_guide_in_the_report(built):
         assert "PLA" in md and "inhibition" not in md
 
 
+@pytest.mark.slow  # 50-190 s of trimesh.contains; the cast-volume test above proves the same property in ~2 s
 def test_nothing_is_cast_inside_any_cavity(built):
     """The cavity (the acoustic volume) read back from the lid STL: a 0.2 mm grid filling each core pin's footprint
     over its length lies inside the lid's solid, so no silicone can be cast there (a vent through the pin cast a
