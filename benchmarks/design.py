@@ -8,7 +8,11 @@ passes, and each taxel tracked on a synthetic board recording (matcad.loop.synth
 listening band with 2f/3f at -20/-30 dB, presses to F on every third, a room; 5 seeds) — the per-taxel |mean error|
 and track RMS (Hz) over voiced frames, and per seed how many taxels are within 1 Hz and the worst one.
 
-Prints numbers, asserts nothing. Run: OMP_NUM_THREADS=1 .venv/bin/python benchmarks/design.py [--capacity-only]
+Capacity figure (``--figure docs/capacity.png``): the most taxels that fit below 0.45 fs against the max force per
+taxel, at 44.1 and 96 kHz, for two routes with buildable caps (no tracking), and every design's loaded bands.
+
+Prints numbers, asserts nothing. Run: OMP_NUM_THREADS=1 .venv/bin/python benchmarks/design.py [--capacity-only |
+--figure PNG]
 """
 
 import dataclasses
@@ -114,7 +118,7 @@ def _most_that_fit(s, n, band, vary):
     while n >= 2:
         try:
             return allocate(s, n, *band, vary), why
-        except Unreachable as exc:
+        except (Unreachable, RulesFailed) as exc:  # the top band breaking acoustic.band_high, too
             why = why or str(exc)
             hit = re.search(r"taxel (\d+) of", str(exc))
             n = min(n - 1, int(hit.group(1)) - 1) if hit else n - 1
@@ -182,14 +186,99 @@ def capacity(forces=(5.0,), seeds=5):
                 print(f"    ({n} asked: {why[:260]})")
 
 
+SWEEP = ((44100.0, (1700.0, 19800.0), 1.5875, 40), (96000.0, (1700.0, 43000.0), 0.8, 48))
+"""(sample rate Hz, band Hz up to 0.45 fs, sheet mm, taxels asked: more than fit) of the capacity figure."""
+ROUTES = {("neck.diameter=0.5:7", "cavity.length", "cavity.diameter"): "neck, cavity diameter and length",
+          tuple(LENGTH): "cavity length alone"}
+"""The --vary routes of the capacity figure, with their legend text: the cavity diameter in its default range,
+which leaves a silicone wall that demolds (CAPACITY's THREE lets it reach 12 mm: the 12- and 16-taxel designs there
+have five caps each with walls under 1 mm, `cap.wall`)."""
+
+
+def capacity_sweep(forces, path):
+    """Taxels per microphone against the max force per taxel (N), at 44.1 and 96 kHz, for each route of
+    :data:`ROUTES` (the most that fit of :data:`SWEEP`'s ask; no tracking): a table, and the figure at ``path``
+    (:func:`capacity_figure`)."""
+    import tomllib
+
+    print("\ncapacity sweep: the most taxels that fit below 0.45 fs (rigid walls, Eq. 5 rise, calipered sheet)")
+    print("| rate [kHz] | vary | max force [N] | fit | reach [Hz] | design [s] |")
+    print("|---:|---|---:|---:|---|---:|")
+    results = []
+    for rate, band, sheet, ask in SWEEP:
+        for vary in ROUTES:
+            for force in forces:
+                s = spec_mod.from_dict(tomllib.loads(BOARD_BASE.format(sheet=sheet, force=force, rate=rate)))
+                t0 = time.perf_counter()
+                a, _ = _most_that_fit(s, ask, band, parse_vary(s, list(vary)))
+                bands = () if a is None else tuple(b.loaded_hz for b in a.bands)
+                results.append((rate, vary, force, bands))
+                reach = f"{bands[0][0]:.0f}-{bands[-1][1]:.0f}" if bands else "-"
+                print(f"| {rate / 1e3:g} | {' '.join(vary)} | {force:g} | {len(bands)} | {reach} | "
+                      f"{time.perf_counter() - t0:.0f} |", flush=True)
+    capacity_figure(results, path)
+
+
+def capacity_figure(results, path):
+    """The capacity figure (issue 24): left, taxels per microphone against the max force per taxel, per sample
+    rate and route (the guard in the legend); right, every design's loaded bands (Hz, log axis) at the first
+    force, with the microphone's top, 0.45 fs (:data:`matcad.rules.acoustic.NYQUIST_MARGIN`). ``results``:
+    (rate Hz, --vary, max force N, loaded bands Hz) per design."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+
+    from matcad.listening import guard_hz
+    from matcad.rules.acoustic import NYQUIST_MARGIN
+
+    fig, (left, right) = plt.subplots(1, 2, figsize=(12, 5), gridspec_kw={"width_ratios": [1, 1.6]})
+    first = results[0][2]
+    rows = [r for r in results if r[2] == first]
+    for k, (rate, vary, _, bands) in enumerate(rows):
+        colour = f"C{k}"
+        same = sorted((force, len(b)) for r, v, force, b in results if r == rate and v == vary)
+        left.plot(*zip(*same), marker="o", color=colour,
+                  label=f"{rate / 1e3:g} kHz, {ROUTES[vary]} (guard {guard_hz(rate):.0f} Hz)")
+        for lo, hi in bands:
+            right.plot([lo, hi], [k, k], color=colour, linewidth=7, solid_capstyle="butt")
+        top = NYQUIST_MARGIN * rate
+        right.plot([top, top], [k - 0.35, k + 0.35], color="black", linewidth=2)
+        right.annotate(f"{len(bands)}", (bands[-1][1] if bands else top, k), xytext=(4, -4),
+                       textcoords="offset points", fontsize=9)
+    left.set(xlabel="max force per taxel [N]", ylabel="taxels on one microphone",
+             title="design --taxels: rigid walls, Eq. 5 rise", ylim=(0, None))
+    left.legend(fontsize=7)
+    left.grid(True, alpha=0.3)
+    ticks = [1e3, 2e3, 5e3, 1e4, 2e4, 5e4]
+    right.set(xscale="log", xlabel="loaded band [Hz]", yticks=range(len(rows)),
+              yticklabels=[f"{r / 1e3:g} kHz\n{ROUTES[v]}" for r, v, _, _ in rows],
+              title=f"loaded bands to {first:g} N (black: 0.45 fs, the microphone's top)")
+    right.set_xticks(ticks, [f"{t / 1e3:g} k" for t in ticks])  # after the log scale, which resets them
+    right.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    right.grid(True, which="both", axis="x", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    print(f"figure: {path}")
+
+
 if __name__ == "__main__":
     import argparse
 
     parser = argparse.ArgumentParser()
     parser.add_argument("--capacity-only", action="store_true")
     parser.add_argument("--seeds", type=int, default=5, help="synthetic board recordings per design")
+    parser.add_argument("--figure", metavar="PNG", help="only the capacity sweep (--forces) and its figure "
+                                                        "(docs/capacity.png)")
+    parser.add_argument("--forces", type=float, nargs="+", default=[5.0, 2.0, 20.0],
+                        help="max forces per taxel (N) of the sweep; the figure's bands at the first")
     args = parser.parse_args()
-    if not args.capacity_only:
-        inverse_design()
-        allocation()
-    capacity(seeds=args.seeds)
+    if args.figure:
+        capacity_sweep(args.forces, args.figure)
+    else:
+        if not args.capacity_only:
+            inverse_design()
+            allocation()
+        capacity(seeds=args.seeds)

@@ -78,6 +78,20 @@ def test_unreachable_and_rule_failures():
     assert any(f.id == "laser.feature" for f in err.value.findings)
 
 
+def test_the_default_cavity_range_leaves_a_silicone_wall_that_demolds():
+    """Deliberate fault caught: the default cavity.diameter range ran to the cap's outside, so a low target was
+    met by a cap whose wall `check` says tears on demolding (issue 24: 0.09 mm walls on the 12-taxel board; here
+    2600 Hz gave a 0.57 mm wall). It stops at the thinnest wall that demolds; the message names the range."""
+    from matcad.rules.printing import MIN_SILICONE_WALL_MM
+
+    s = spec_mod.load(LASER)
+    top = s.end_cap.outer_diameter - 2 * MIN_SILICONE_WALL_MM
+    r = solve(s, 3000.0, parse_vary(s, ["cavity.diameter"]))
+    assert r.spec.cavity.diameter <= top + 1e-9 and not [f for f in check(r.spec) if f.id == "cap.wall"]
+    with pytest.raises(Unreachable, match=f"cavity.diameter 2.1-{top:g} mm"):
+        solve(s, 2600.0, parse_vary(s, ["cavity.diameter"]))
+
+
 @pytest.mark.parametrize("items,words", [
     (["neck.width"], "must be one of neck.diameter"), (["neck.diameter=3:1"], "0 < LO < HI"),
     (["neck.length=1:2"], "stock"), (["neck.diameter", "neck.diameter"], "twice")])

@@ -87,14 +87,17 @@ def with_fields(spec, values: dict):
 
 def default_range(spec, path: str) -> tuple[float, float]:
     """The search range of one field (mm) when the user gives none: the neck between the laser's smallest feature
-    and the cavity; the cavity between the neck and the cap's outside; its length from the flat-cavity limit of the
-    1-D models (L/D = 0.3) to :data:`DEFAULT_LENGTH_SPAN` × the start."""
+    and the cavity; the cavity between the neck and the cap's outside less the thinnest silicone wall that demolds
+    (:data:`matcad.rules.printing.MIN_SILICONE_WALL_MM` each side: issue 24's 12-taxel design had caps with 0.09 mm
+    walls); its length from the flat-cavity limit of the 1-D models (L/D = 0.3) to :data:`DEFAULT_LENGTH_SPAN` × the
+    start."""
     from matcad.acoustics.checks import PANCAKE_L_OVER_D
+    from matcad.rules.printing import MIN_SILICONE_WALL_MM
 
     if path == "neck.diameter":
         return spec.machine.laser_min_feature, spec.cavity.diameter
     if path == "cavity.diameter":
-        return spec.neck.diameter, spec.end_cap.outer_diameter
+        return spec.neck.diameter, spec.end_cap.outer_diameter - 2 * MIN_SILICONE_WALL_MM
     if path == "cavity.length":
         return PANCAKE_L_OVER_D * spec.cavity.diameter, DEFAULT_LENGTH_SPAN * spec.cavity.length
     raise AssertionError(path)
