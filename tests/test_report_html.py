@@ -212,6 +212,10 @@ def test_headline_and_band_chart_agree_on_an_invalid_chosen_model(kit, tmp_path)
     finally:
         canvas.Axes.frame = real_frame
     assert any(status in t for t in titles)
+    import matplotlib.image as mpimg
+
+    dark = (mpimg.imread(tmp_path / "band.png")[..., :3] < 0.85).any(axis=2)  # the longer title is not clipped
+    assert not (dark[0].any() or dark[-1].any() or dark[:, 0].any() or dark[:, -1].any())
 
 
 def test_no_picture_is_clipped_at_its_edge(kit):
