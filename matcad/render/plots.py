@@ -22,6 +22,16 @@ def chosen_model_status(p: dict) -> str:
     return f"chosen model {p['model']} invalid" + (f" ({failed})" if failed else "")
 
 
+def chosen_models_status(r: dict) -> str:
+    """:func:`chosen_model_status` of a report: a single taxel's; a board's names every taxel whose chosen model
+    fails ("t1: chosen model elastic_wall invalid (no_wall_mode_near_f); t3: ..."), '' when all hold. The report's
+    headline and the build's verdict line say this (a board's band chart is its first taxel's)."""
+    board = r.get("taxels")
+    if not board:
+        return chosen_model_status(r["prediction"])
+    return "; ".join(f"{t['name']}: {status}" for t in board if (status := chosen_model_status(t["prediction"])))
+
+
 def band_plot(p: dict, path: Path) -> dict:
     """Every model's f0 (dot; cross when invalid), the chosen band (orange) and each budget line's shift (Hz) as a
     bar from f0 (blue), f0 dotted; drawn with :mod:`matcad.canvas` (no matplotlib on the build's path)."""
