@@ -7,6 +7,7 @@ from __future__ import annotations
 import base64
 import io
 import json
+import re
 import threading
 import tomllib
 import urllib.error
@@ -18,6 +19,7 @@ import pytest
 
 from matcad import spec as spec_mod
 from matcad.prediction.board import predict_board
+from matcad.render.plots import chosen_models_status
 from matcad.serve import make_server
 from matcad.serve.builds import STAGES, stage_of
 from tests.browser import chromium, console_errors
@@ -256,7 +258,8 @@ def test_board_template_on_the_page(url):
 
 def test_board_kit_built_from_the_page_with_progress(url):
     """The board, laser parts only (fast): the kit's report carries all four taxels and their bands, the neck
-    plate its four necks; the page showed the build's stages while it ran."""
+    plate its four necks; the page showed the build's stages while it ran, and says after the verdict which
+    taxels' chosen models fail their checks, as the report's headline does."""
     from selenium.webdriver.common.by import By
     from selenium.webdriver.support.ui import WebDriverWait
 
@@ -272,7 +275,11 @@ def test_board_kit_built_from_the_page_with_progress(url):
         wait.until(lambda d: d.find_element(By.ID, "download").is_displayed())
         kit = _kit(driver)
         stages = driver.execute_script("return window.matcad.stages")
+        built = driver.find_element(By.ID, "build-status").text
     report = json.loads(kit.read("mat-array-4/report.json"))
+    status = chosen_models_status(report)
+    assert status.startswith("t1: chosen model")
+    assert re.fullmatch(rf"\d+ files, verdict {report['verdict']} \(design rules\); {re.escape(status)}", built)
     assert [t["name"] for t in report["taxels"]] == ["t1", "t2", "t3", "t4"]
     assert len(report["bands"]["taxels"]) == 4
     assert [(t["x_mm"], t["y_mm"]) for t in report["taxels"]] == [(e["x"], e["y"]) for e in raw["taxel"]]

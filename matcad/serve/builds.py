@@ -129,8 +129,10 @@ class Builds:
 
 
 def build_json(payload: dict, builds: Builds) -> tuple[int, dict]:
-    """Build the request's spec with `matcad build` in a temporary folder: the kit as a base64 zip and the previews
-    as data URIs; a design-rule failure as 422 with its findings."""
+    """Build the request's spec with `matcad build` in a temporary folder: the kit as a base64 zip, the previews
+    as data URIs, the verdict and, as the report's headline says it, each taxel whose chosen model fails its checks;
+    a design-rule failure as 422 with its findings."""
+    from matcad.render.plots import chosen_models_status
     from matcad.report import KIT_ARCHIVE
 
     spec = spec_of(payload)  # a bad spec is told at once, before a process starts
@@ -165,7 +167,8 @@ def build_json(payload: dict, builds: Builds) -> tuple[int, dict]:
                      "src": f"data:{MIME[Path(fig['file']).suffix]};base64,"
                             f"{base64.b64encode((kit / fig['file']).read_bytes()).decode()}"}
                     for fig in report.get("figures", ())]
-        return 200, {"name": spec.name, "verdict": report["verdict"], "files": result["written"],
+        return 200, {"name": spec.name, "verdict": report["verdict"], "model_status": chosen_models_status(report),
+                     "files": result["written"],
                      "zip": base64.b64encode(buf.getvalue()).decode(), "previews": previews,
                      "findings": [f for f in result["findings"] if f["level"] != "info"]}
     finally:

@@ -261,7 +261,7 @@ async function predict() {
     $("band").textContent = `f0 ${data.taxels.map((t) => `${t.name} ${t.f0_hz.toFixed(0)}`).join(", ")} Hz`;
   } else {
     $("f0").textContent = `f0 = ${data.f0_hz.toFixed(0)} Hz`;
-    $("model").textContent = `(${data.model})`;
+    $("model").textContent = `(${data.model}${data.models[data.model]?.valid === false ? ", outside its checks" : ""})`;
     $("band").textContent = `band ${data.band_hz[0].toFixed(0)}–${data.band_hz[1].toFixed(0)} Hz`;
   }
   drawBands(data);
@@ -513,7 +513,8 @@ async function buildKit() {
   link.href = URL.createObjectURL(new Blob([bytes], {type: "application/zip"}));
   link.download = data.name + ".zip";
   link.hidden = false;
-  $("build-status").textContent = `${data.files.length} files, verdict ${data.verdict}`;
+  $("build-status").textContent = `${data.files.length} files, verdict ${data.verdict}` +
+    (data.model_status ? ` (design rules); ${data.model_status}` : "");
   list("findings", data.findings.map((f) => `${f.level} ${f.id}: ${f.message}`));
   $("previews").replaceChildren(...data.previews.map((p) => {
     const fig = document.createElement("figure");
