@@ -489,6 +489,7 @@ async function buildKit() {
     const response = await fetch("/progress?build=" + id);
     if (response.status !== 200) return;
     const p = await response.json();
+    if (!p.running) return;  // not started yet (waiting for the build slot) or just finished
     $("build-bar").max = p.of;
     $("build-bar").value = p.index;
     $("build-stage").textContent = `${p.index}/${p.of} ${p.text} — ${p.files} files, ${p.elapsed_s.toFixed(0)} s`;
