@@ -82,7 +82,7 @@ def test_board_prediction_is_predict_boards(url):
         assert got["loaded_hz"] == pytest.approx(list(b.loaded_hz), rel=1e-12)
         assert (got["x_mm"], got["y_mm"]) == (b.x_mm, b.y_mm)
         assert got["budget"] and got["models"][got["model"]]["f0_hz"] == pytest.approx(b.f0_hz, rel=1e-12)
-    assert data["conflicts"] == want.summary["conflicts"]
+    assert data["conflicts"] == want.summary["conflicts"] and data["layout"] == []  # its taxels fit the plate
     raw["taxel"][1]["neck_diameter"] = 2.2  # a narrower neck sings lower (Helmholtz: f ~ d)
     _, edited = _post(url, "/predict", {"spec": raw})
     assert edited["taxels"][1]["f0_hz"] < data["taxels"][1]["f0_hz"]
@@ -98,6 +98,21 @@ def test_an_array_grid_is_predicted_too(url):
     status, data = _post(url, "/predict", {"spec": raw})
     assert status == 200, data
     assert [(t["name"], t["x_mm"], t["y_mm"]) for t in data["taxels"]] == [("t1", -6.0, 0.0), ("t2", 6.0, 0.0)]
+
+
+def test_a_taxel_placed_badly_is_told_with_the_prediction(url):
+    """A fifth taxel 7 mm below t4 (where the page's "add taxel" puts it): the reply carries the board rules'
+    errors (its flange over t4's, past the plate's edge, on a bolt hole) as `matcad check` gives them."""
+    from matcad.rules import check
+
+    raw = _raw(BOARD)
+    raw["taxel"].append({k: v for k, v in raw["taxel"][-1].items() if k != "name"} | {"y": -17.5})
+    status, data = _post(url, "/predict", {"spec": raw})
+    assert status == 200 and len(data["taxels"]) == 5
+    want = [f.to_dict() for f in check(spec_mod.from_dict(raw)) if f.id.startswith("board.") and f.level != "info"]
+    assert sorted(data["layout"], key=str) == sorted(want, key=str)
+    assert {f["id"] for f in data["layout"] if f["level"] == "error"} == {"board.outside", "board.on_fastener",
+                                                                           "board.spacing"}
 
 
 def test_a_bad_taxel_field_is_named(url):
@@ -218,7 +233,8 @@ def _type(driver, element_id: str, text: str) -> None:
 def test_board_template_on_the_page(url):
     """mat-array-4 opens with its four taxels in the table and four bands on the chart, each predict_board's;
     editing t2's neck moves t2's band alone; a bad taxel field is told next to the table; adding and removing a
-    taxel adds and removes a band; moving one moves it on the plan."""
+    taxel adds and removes a band, and the added one's overlap with t4 is told under the table; moving one moves
+    it on the plan."""
     from selenium.webdriver.common.by import By
     from selenium.webdriver.support.ui import WebDriverWait
 
@@ -244,10 +260,13 @@ def test_board_template_on_the_page(url):
         assert "bad" in driver.find_element(By.ID, "in-taxel[3].cavity_length").get_attribute("class")
         _type(driver, "in-taxel[3].cavity_length", "2.3")
         wait.until(lambda d: error() == "" and len(_bands(d)) == 4)
+        layout = lambda: driver.find_element(By.ID, "layout").text  # noqa: E731
+        assert layout() == ""
         driver.find_element(By.ID, "add-taxel").click()
         wait.until(lambda d: len(_bands(d)) == 5)
+        wait.until(lambda d: "error board.spacing: t4 and t5" in layout())  # told at once, not at the build
         driver.find_elements(By.CSS_SELECTOR, "#taxels .remove-taxel")[4].click()
-        wait.until(lambda d: len(_bands(d)) == 4)
+        wait.until(lambda d: len(_bands(d)) == 4 and layout() == "")
         circle = "return document.querySelector('#plan g[data-taxel=t1] circle').getAttribute('cx')"
         assert float(driver.execute_script(circle)) == -7.5
         _type(driver, "in-taxel[1].x", "-8.5")

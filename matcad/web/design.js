@@ -251,7 +251,7 @@ async function predict() {
     $("f0").textContent = "—";
     $("model").textContent = $("band").textContent = "";
     $("bandchart").replaceChildren();
-    for (const id of ["warnings", "notes", "conflicts"]) list(id, []);
+    for (const id of ["warnings", "notes", "conflicts", "layout"]) list(id, []);
     return;
   }
   lastPrediction = data;
@@ -267,6 +267,7 @@ async function predict() {
   drawBands(data);
   if (window.matcad.bandsShownMs === null) window.matcad.bandsShownMs = performance.now();
   list("conflicts", data.conflicts.map((c) => "conflict: " + c.message));
+  list("layout", data.layout.map((f) => `${f.level} ${f.id}: ${f.message}`));  // a board's taxels on the plate
   list("warnings", data.warnings);
   list("notes", data.notes);
   showDetails();
