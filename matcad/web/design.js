@@ -11,8 +11,8 @@ const inputs = {};
 let taxelRows = [];      // [{cells: {column: input}, extra: {...}}]: extra keeps what the table does not edit
 let preserved = {};      // other arrays of tables ([[measured]], ...) passed through unchanged
 let INITIAL = BOOT.initial;
-window.matcad = {stages: [], bandsShownMs: null, previewMs: [], editToSectionMs: [], meshMs: null, moldMs: null,
-                 editAt: null};
+window.matcad = {stages: [], bandsShownMs: null, riseShownMs: null, previewMs: [], editToSectionMs: [], meshMs: null,
+                 moldMs: null, editAt: null};
 
 function initialValue(key) {
   let node = INITIAL;
@@ -236,23 +236,48 @@ function list(id, items) {
 // ---- prediction ---------------------------------------------------------------------------------------------------
 
 let timer = null, generation = 0, lastPrediction = null;
+let riseBusy = false, riseWanted = null;
 function schedulePredict() { clearTimeout(timer); timer = setTimeout(predict, 200); }
 
-async function predict() {
+async function predict() {  // the bands at once (a board's without its caps' rise under load), then the rises
   const mine = ++generation;
   $("status").textContent = "predicting…";
   const spec = collect();
-  const [status, data] = await post("/predict", {spec});
+  const [status, data] = await post("/predict", {spec, mechanics: false});
   if (mine !== generation) return;  // a newer edit is on its way
-  clearErrors();
   $("status").textContent = "";
+  if (!show(status, data)) return;
+  schedulePreview(spec);
+  if (data.rise_pending) { riseWanted = {spec, mine}; askRise(); }
+}
+
+async function askRise() {  // one request at a time, for the newest edit: a new cap costs a FElupe run (seconds)
+  if (riseBusy || riseWanted === null) return;
+  const {spec, mine} = riseWanted;
+  riseWanted = null;
+  riseBusy = true;
+  $("status").textContent = "computing each cap's rise under load…";
+  try {
+    const [status, data] = await post("/predict", {spec});
+    if (mine === generation) {
+      $("status").textContent = "";
+      if (show(status, data) && window.matcad.riseShownMs === null) window.matcad.riseShownMs = performance.now();
+    }
+  } finally {
+    riseBusy = false;
+    askRise();
+  }
+}
+
+function show(status, data) {  // a /predict reply on the page; false for an error (told beside its field)
+  clearErrors();
   if (status !== 200) {
     showError(data.error);
     $("f0").textContent = "—";
     $("model").textContent = $("band").textContent = "";
     $("bandchart").replaceChildren();
     for (const id of ["warnings", "notes", "conflicts", "layout"]) list(id, []);
-    return;
+    return false;
   }
   lastPrediction = data;
   if (data.board) {
@@ -271,7 +296,7 @@ async function predict() {
   list("warnings", data.warnings);
   list("notes", data.notes);
   showDetails();
-  schedulePreview(spec);
+  return true;
 }
 
 function el(tag, attrs, text) {
@@ -287,9 +312,11 @@ function drawBands(data) {  // every taxel's unloaded band (blue) and loaded ris
   const span = hi - lo; lo -= 0.04 * span; hi += 0.04 * span;
   const W = 720, left = 120, right = 20, rowH = 26, top = 24, H = top + rowH * rows.length + 34;
   const x = (f) => left + (f - lo) / (hi - lo) * (W - left - right);
-  const svg = el("svg", {viewBox: `0 0 ${W} ${H}`, id: "bands-svg", role: "img"});
+  const svg = el("svg", {viewBox: `0 0 ${W} ${H}`, id: "bands-svg", role: "img",
+                         "data-rise": data.rise_pending ? "pending" : "done"});
   svg.appendChild(el("text", {x: left, y: 14, "font-size": 12, fill: data.conflicts.length ? "#b00020" : "#222"},
-    `${rows.length} taxel band(s), guard ${g.toFixed(0)} Hz, loaded to ${data.max_force_n} N: ` +
+    `${rows.length} taxel band(s), guard ${g.toFixed(0)} Hz, ` + (data.rise_pending
+      ? `unloaded (the rise to ${data.max_force_n} N follows): ` : `loaded to ${data.max_force_n} N: `) +
     (data.conflicts.length ? `${data.conflicts.length} conflict(s)` : "disjoint")));
   const step = [50, 100, 200, 250, 500, 1000, 2000, 5000].find((s) => (hi - lo) / s <= 9) || 10000;
   for (let f = Math.ceil(lo / step) * step; f <= hi; f += step) {
