@@ -237,6 +237,21 @@ def test_headline_and_verdict_line_name_each_taxel_whose_chosen_model_fails(lase
     assert "t2:" not in head and "t2:" not in verdict
 
 
+def test_a_boards_section_is_not_captioned_as_dimensioned(spec, tmp_path):
+    """write_section_svg labels a board's parts without dimensions: its caption says so and names the taxel whose
+    row it cuts (it said "dimensioned" as a single taxel's does)."""
+    from matcad.prediction import predict
+    from matcad.render.kit import render_figures
+    from matcad.spec import taxel_spec
+
+    (tmp_path / "section.svg").write_text("<svg/>")
+    first = taxels(spec)[0]
+    caption = render_figures(spec, predict(taxel_spec(spec, first)), tmp_path, {}, [])[0]["caption"]
+    assert "dimensioned" not in caption and f"through {first.name}'s row of necks" in caption
+    single = taxel_spec(spec, first)
+    assert "dimensioned" in render_figures(single, predict(single), tmp_path, {}, [])[0]["caption"]
+
+
 # --- 3-D parts read back from STL / STEP (CAD kernel) ----------------------------------------------------------
 
 @pytest.fixture(scope="module")
