@@ -1,7 +1,9 @@
 """The design page as a user meets it, timed in headless Chromium against a fresh in-process server.
 
   board      open ?template=mat-array-4 in a fresh server: ms from navigation to the four bands drawn (browser's
-             performance.now() when the chart is drawn), then again on a second page load (server warm)
+             performance.now() when the chart is drawn), and to their rise under load drawn (the cap mechanics,
+             FElupe per cap unless in the cache: MATCAD_CACHE_DIR=<empty folder> times a first visit), then again
+             on a second page load (server warm)
   section    mat-paper: the first section (the preview process loads the CAD kernel), then N edits of
              cavity.length, each timed from the edit's request to the section shown (ms, median and max)
   mesh       the 3-D view's meshes after the first section: the assembly, then with the mold (ms)
@@ -68,7 +70,9 @@ def main(argv: list[str]) -> None:
                 d.get(url + "/?template=mat-array-4")
                 ms = wait(d, "return document.querySelectorAll('#bandchart g.band').length === 4 "
                              "&& window.matcad.bandsShownMs")
-                print(f"board {visit}: page opened -> 4 bands shown {ms:8.0f} ms")
+                risen = wait(d, "return window.matcad.riseShownMs")
+                print(f"board {visit}: page opened -> 4 bands shown {ms:8.0f} ms, with their rise under load "
+                      f"{risen:8.0f} ms")
             first = wait(d, "return window.matcad.previewMs.length && window.matcad.previewMs[0]")
             mesh, mold = wait(d, "return window.matcad.meshMs"), wait(d, "return window.matcad.moldMs")
             print(f"board-section first {first:8.0f} ms   board mesh: assembly {mesh:8.0f} ms, with the mold "

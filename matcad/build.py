@@ -89,9 +89,9 @@ class BuildResult:
         lines += [f"{t['name']} at ({t['x_mm']:g}, {t['y_mm']:g}) mm: f0 = {t['f0_hz']:.0f} Hz ({t['model']}), band "
                   f"{t['unloaded_hz'][0]:.0f}-{t['unloaded_hz'][1]:.0f} Hz, loaded to {t['max_force_n']:g} N "
                   f"{t['loaded_hz'][0]:.0f}-{t['loaded_hz'][1]:.0f} Hz" for t in board or ()]
-        from matcad.render.plots import chosen_model_status
+        from matcad.render.plots import chosen_models_status
 
-        status = "" if board else chosen_model_status(self.report["prediction"])
+        status = chosen_models_status(self.report)
         lines.append((f"{len(board)} taxels" if board else f"f0 = {p.f0_hz:.0f} Hz ({p.model}), band "
                       f"{p.band_hz[0]:.0f}-{p.band_hz[1]:.0f} Hz") + f"; verdict {self.report['verdict']}"
                      + (f" (design rules); {status}" if status else ""))

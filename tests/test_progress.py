@@ -100,6 +100,23 @@ def test_analyze_draws_progress_in_seconds_of_recording(tmp_path):
     assert code == 0 and ERASE not in err and "of recording" not in err
 
 
+def test_design_taxels_draws_progress_in_taxels_placed(tmp_path):
+    """`design --taxels` (a FElupe run per new cap, 38 s for the paper's 3 taxels): the taxels placed on a
+    terminal; nothing in a pipe or under --json."""
+    from tests.test_design import ARRAY_BASE
+
+    spec = tmp_path / "arr.toml"
+    spec.write_text(ARRAY_BASE.format(force="5.0"), encoding="utf-8")
+    args = ("design", spec, "--taxels", "3", "--band", "3500", "6500")
+    code, out, tty = run_on_pty(*args, "--out", tmp_path / "a")
+    assert code == 0, tty
+    assert "matcad: design arr" in tty and "3/3 taxels (100 %)" in tty and "matcad: design" not in out
+    code, out, tty = run_on_pty(*args, "--out", tmp_path / "b", "--json")
+    assert code == 0 and ERASE not in tty and "taxels (" not in tty
+    code, out, err = piped(*args, "--out", tmp_path / "c")
+    assert code == 0 and ERASE not in err and "taxels (" not in err
+
+
 def test_line_is_quiet_off_a_terminal_and_under_json(monkeypatch):
     """The utility itself: nothing on a non-terminal stream or when quiet; on a terminal the count, the share and
     the erase."""

@@ -8,6 +8,7 @@ import math
 import re
 import xml.etree.ElementTree as ET
 from html.parser import HTMLParser
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -144,9 +145,8 @@ def test_section_is_labelled_and_dimensioned_to_scale(kit):
     assert max(ys) - min(ys) == pytest.approx(spec.neck.length, abs=1e-6)
 
 
-def test_printed_report_keeps_captions_with_their_pictures(kit, tmp_path):
-    """report.html printed to PDF by headless Chromium: every raster picture lands on the page of its caption
-    (no heading orphaned at a page's foot), and the pages stay few (mat-paper: 18 before the print stylesheet)."""
+def _printed(page, tmp_path) -> tuple[Path, list[str]]:
+    """``page`` (an HTML file) printed to PDF by headless Chromium on A4: (the PDF, each page's text)."""
     import shutil
     import subprocess
 
@@ -156,24 +156,50 @@ def test_printed_report_keeps_captions_with_their_pictures(kit, tmp_path):
         _missing("poppler-utils (pdfinfo, pdftotext, pdfimages) missing")
     if not shutil.which(CHROMIUM) and not (CHROMIUM and __import__("os").path.exists(CHROMIUM)):
         _missing("chromium missing")
-    _, out, report = kit
     pdf = tmp_path / "report.pdf"
     subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
-                    f"--user-data-dir={tmp_path / 'profile'}", f"--print-to-pdf={pdf}", (out / "report.html").as_uri()],
+                    f"--user-data-dir={tmp_path / 'profile'}", f"--print-to-pdf={pdf}", page.as_uri()],
                    capture_output=True, timeout=120, check=True)
     info = subprocess.run(["pdfinfo", str(pdf)], capture_output=True, text=True, check=True).stdout
     pages = int(re.search(r"^Pages:\s+(\d+)", info, flags=re.M).group(1))
-    assert pages <= 10, pages
+    return pdf, [subprocess.run(["pdftotext", "-f", str(k), "-l", str(k), "-layout", str(pdf), "-"],
+                                capture_output=True, text=True, check=True).stdout for k in range(1, pages + 1)]
+
+
+def test_printed_report_keeps_captions_with_their_pictures(kit, tmp_path):
+    """report.html printed to PDF by headless Chromium: every raster picture lands on the page of its caption
+    (no heading orphaned at a page's foot), and the pages stay few (mat-paper: 18 before the print stylesheet)."""
+    import subprocess
+
+    _, out, report = kit
+    pdf, texts = _printed(out / "report.html", tmp_path)
+    assert len(texts) <= 10, len(texts)
     listed = subprocess.run(["pdfimages", "-list", str(pdf)], capture_output=True, text=True, check=True).stdout
     image_pages = [int(line.split()[0]) for line in listed.splitlines()[2:]
                    if line.split() and line.split()[2] == "image"]
-    texts = [subprocess.run(["pdftotext", "-f", str(k), "-l", str(k), "-layout", str(pdf), "-"], capture_output=True,
-                            text=True, check=True).stdout for k in range(1, pages + 1)]
     raster = [f for f in report["figures"] if f["file"].endswith(".png")]
     assert len(image_pages) >= len(raster)
     for fig, page in zip(raster, image_pages):  # pictures are drawn in report order
         head = " ".join(fig["caption"].split()[:3])
         assert head in " ".join(texts[page - 1].split()), f"{fig['caption']!r} not on page {page} with its picture"
+
+
+def test_printed_lines_that_introduce_a_list_or_table_stay_with_it(tmp_path):
+    """A line ending in ':' before a list or a table ("Trim:", "Caliper these sheets ...:") never ends a printed
+    page away from what it introduces (the board kit's report printed "Trim:" alone at a page's foot). Steps of
+    growing length put such lines at many heights on the page."""
+    from matcad.report.page import render_html
+
+    md = []
+    for i in range(24):
+        md += [f"## Step {i}", ""] + [f"Filler line {j} of step {i}." + " word" * 8 + "\n" for j in range(i % 7)]
+        md += ["Do these:", ""] + [f"- item {k}: " + "text " * 30 for k in range(4)] + [""]
+        md += ["Measure these:", "", "| a | b |", "|---|---|"] + [f"| {k} | {2 * k} |" for k in range(6)] + [""]
+    page = tmp_path / "steps.html"
+    page.write_text(render_html("\n".join(md), "steps"), encoding="utf-8")
+    _, texts = _printed(page, tmp_path)
+    feet = [[line for line in text.splitlines() if line.strip()][-1].strip() for text in texts]
+    assert len(feet) > 5 and not [foot for foot in feet if foot.endswith(":")], feet
 
 
 def test_headline_and_band_chart_agree_on_an_invalid_chosen_model(kit, tmp_path):
@@ -212,6 +238,10 @@ def test_headline_and_band_chart_agree_on_an_invalid_chosen_model(kit, tmp_path)
     finally:
         canvas.Axes.frame = real_frame
     assert any(status in t for t in titles)
+    import matplotlib.image as mpimg
+
+    dark = (mpimg.imread(tmp_path / "band.png")[..., :3] < 0.85).any(axis=2)  # the longer title is not clipped
+    assert not (dark[0].any() or dark[-1].any() or dark[:, 0].any() or dark[:, -1].any())
 
 
 def test_no_picture_is_clipped_at_its_edge(kit):

@@ -46,11 +46,13 @@ def solve(spec, args):
         return dataclasses.replace(result, spec=dataclasses.replace(
             result.spec, name=args.name or f"{spec.name}-{args.target_hz:.0f}hz"))
     from matcad.design.allocate import allocate
+    from matcad.progress import line
 
     if not args.band:
         raise ValueError("--taxels needs --band LO HI (Hz)")
-    return allocate(spec, args.taxels, *args.band, parse_vary(spec, args.vary or ["neck.diameter"], CONTINUOUS),
-                    args.name)
+    vary = parse_vary(spec, args.vary or ["neck.diameter"], CONTINUOUS)
+    with line(f"design {spec.name}", "taxels", quiet=args.json) as progress:
+        return allocate(spec, args.taxels, *args.band, vary, args.name, progress)
 
 
 def _tube(spec, args):

@@ -135,9 +135,11 @@ def array_spec(base, points, solutions, name: str):
     return from_dict(data)
 
 
-def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = None) -> Allocation:
+def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = None,
+             progress=None) -> Allocation:
     """Allocate ``n`` disjoint bands in [``lo_hz``, ``hi_hz``] and solve one taxel for each (see the module
-    docstring); ``vary`` as for :func:`matcad.design.solve.solve`, continuous per-taxel fields only. Raises
+    docstring); ``vary`` as for :func:`matcad.design.solve.solve`, continuous per-taxel fields only;
+    ``progress(taxels placed, n)`` (:mod:`matcad.progress`) is told as each is placed. Raises
     :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
     from matcad.listening import guard_hz
     from matcad.prediction.bands import taxel_band
@@ -172,6 +174,8 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
             raise Unreachable(_fit_text(None, k, n, lo_hz, hi_hz, [*placed, band])[0])
         placed.append(band)
         solutions.append(solution)
+        if progress is not None:
+            progress(k, n)
         ratio = band.f0_hz / band.loaded_hz[0]
         start = band.loaded_hz[1] + guard
     out = array_spec(base, points, solutions, name or f"{spec.name}-{n}taxels")

@@ -46,10 +46,12 @@ class BoardPrediction:
 
 
 def predict_board(spec, forces_n=(), model: str | None = None, fem_level: int | None = None,
-                  progress=None) -> BoardPrediction:
+                  progress=None, mechanics: bool = True) -> BoardPrediction:
     """Every taxel of ``spec`` predicted (:func:`matcad.prediction.taxel.predict`, at ``forces_n`` N) with its band
     (:func:`matcad.prediction.bands.taxel_band`), and the board's summary; ``progress(taxels done, taxels)`` is told
-    as each taxel is done."""
+    as each taxel is done. ``mechanics=False`` leaves out the cap mechanics' rise under load (a FElupe run per
+    cap not yet in :mod:`matcad.mechanics.store`: seconds to minutes): each loaded band is then the unloaded one
+    unless a calibration gives the rise."""
     from matcad.prediction.bands import summary, taxel_band
     from matcad.prediction.taxel import predict
     from matcad.spec import taxel_spec, taxels
@@ -59,7 +61,7 @@ def predict_board(spec, forces_n=(), model: str | None = None, fem_level: int | 
     for t in board:
         one = taxel_spec(spec, t)
         p = predict(one, forces_n=forces_n, model=model, fem_level=fem_level)
-        bands.append(taxel_band(one, t.name, t.x, t.y, prediction=p))
+        bands.append(taxel_band(one, t.name, t.x, t.y, mechanics, prediction=p))
         predictions[t.name] = p
         if progress is not None:
             progress(len(predictions), len(board))

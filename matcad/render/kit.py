@@ -40,10 +40,12 @@ def render_figures(spec, prediction, folder: Path, meshes: dict, plans: list) ->
     from matcad.spec import taxel_spec, taxels
 
     figures = []
-    if (folder / "section.svg").is_file():
-        figures.append({"part": "assembly", "file": "section.svg",
-                        "caption": "section through the neck and needle axes, dimensioned (mm)"})
     board = taxels(spec)
+    if (folder / "section.svg").is_file():  # a board's section is labelled, not dimensioned (write_section_svg)
+        figures.append({"part": "assembly", "file": "section.svg", "caption": (
+            "section through the neck and needle axes, dimensioned (mm)" if len(board) == 1 else
+            f"section through {board[0].name}'s row of necks and the needle axes, parts labelled (mm; each "
+            "taxel's sizes: Taxels)")})
     first = taxel_spec(spec, board[0])  # ``prediction`` is the first taxel's; the band chart shows every taxel
     scope = f" (taxel {board[0].name} of {len(board)})" if len(board) > 1 else ""
     figure = band_plot(prediction.to_dict(), folder / BAND_PNG)

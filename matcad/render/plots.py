@@ -22,6 +22,16 @@ def chosen_model_status(p: dict) -> str:
     return f"chosen model {p['model']} invalid" + (f" ({failed})" if failed else "")
 
 
+def chosen_models_status(r: dict) -> str:
+    """:func:`chosen_model_status` of a report: a single taxel's; a board's names every taxel whose chosen model
+    fails ("t1: chosen model elastic_wall invalid (no_wall_mode_near_f); t3: ..."), '' when all hold. The report's
+    headline and the build's verdict line say this (a board's band chart is its first taxel's)."""
+    board = r.get("taxels")
+    if not board:
+        return chosen_model_status(r["prediction"])
+    return "; ".join(f"{t['name']}: {status}" for t in board if (status := chosen_model_status(t["prediction"])))
+
+
 def band_plot(p: dict, path: Path) -> dict:
     """Every model's f0 (dot; cross when invalid), the chosen band (orange) and each budget line's shift (Hz) as a
     bar from f0 (blue), f0 dotted; drawn with :mod:`matcad.canvas` (no matplotlib on the build's path)."""
@@ -36,9 +46,17 @@ def band_plot(p: dict, path: Path) -> dict:
     xs += [m["f0_hz"] for m in p["models"].values() if m["f0_hz"] is not None]
     span = max(xs) - min(xs) or 1.0
     xlim = (min(xs) - 0.06 * span, max(xs) + 0.06 * span)
-    canvas = Canvas(792, 90 + 26 * len(labels))
+    status = chosen_model_status(p)
+    title = f"f0 = {f0:.0f} Hz ({p['model']}), band {lo:.0f}–{hi:.0f} Hz" + (f"\n{status}" if status else "")
+    top = 34 + (18 if status else 0)  # the status on a line of its own, so a long list of checks stays in
+    height = top + 56 + 26 * len(labels)
+    canvas = Canvas(792, height)
     left = 24 + max(canvas.text_width(label, 10) for label in labels)
-    ax = canvas.axes((left, 34, 776, 40 + 26 * len(labels)), xlim, (-0.6, len(labels) - 0.4))
+    widest = max(canvas.text_width(line, 12) for line in title.splitlines())
+    if left + widest > 792:  # the title, centred over the axes, would run off the right edge: widen the picture
+        canvas = Canvas(round(left + widest), height)
+    width = canvas.image.width
+    ax = canvas.axes((left, top, width - 16, top + 6 + 26 * len(labels)), xlim, (-0.6, len(labels) - 0.4))
     y = 0
     for b in reversed(lines):
         ax.rect(f0 + b["low_hz"], y - 0.3, f0 + b["high_hz"], y + 0.3, fill="#8fb8e0")
@@ -50,10 +68,8 @@ def band_plot(p: dict, path: Path) -> dict:
             ax.marker(m["f0_hz"], y, "o" if m["valid"] else "x", "black")
         y += 1
     ax.line([f0, f0], list(ax.ylim), "#333333", 1, dash=3)
-    status = chosen_model_status(p)
     ax.frame(xlabel="frequency [Hz]", yticks=list(enumerate(labels)), grid="x", title_colour="#a03000" if status
-             else "black", title=f"f0 = {f0:.0f} Hz ({p['model']}), band {lo:.0f}–{hi:.0f} Hz"
-             + (f"; {status}" if status else ""))
+             else "black", title=title)
     canvas.save(path)
     return {"part": "prediction", "file": path.name, "caption": "models, band and uncertainty budget"}
 

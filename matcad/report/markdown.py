@@ -143,7 +143,7 @@ def sections(r: dict) -> str:
     """The report's known sections (:data:`matcad.report.page.KNOWN_KEYS`) as Markdown: title and verdict, as
     built, prediction, bands, design rules, BOM, fabrication, casting, taxels, files, mesh checks."""
     from matcad.render.bands import bands_markdown
-    from matcad.render.plots import chosen_model_status
+    from matcad.render.plots import chosen_models_status
 
     p, ab, bom = r["prediction"], r["as_built"], r["bom"]
     board = r.get("taxels")
@@ -155,10 +155,10 @@ def sections(r: dict) -> str:
     else:
         headline = f"f0 = {p['f0_hz']:.0f} Hz ({p['model']}), band {p['band_hz'][0]:.0f}–{p['band_hz'][1]:.0f} Hz"
         scope = ""
+    status = chosen_models_status(r)
     lines = [f"# {r['name']} — matcad {r['matcad_version']} build report", "",
              f"**Verdict: {r['verdict']}** (design rules) · {headline}"
-             + (f" · **{chosen_model_status(p)}**: the f0 comes from a model outside its validity" if
-                chosen_model_status(p) else ""), "",
+             + (f" · **{status}**: the f0 comes from a model outside its validity" if status else ""), "",
              f"## As built{scope}", "",
              f"- cavity: D {ab['cavity_diameter_mm']:g} × L {ab['cavity_length_mm']:g} mm, draft "
              f"{ab['draft_deg']:g}° (closed-end D {ab['cavity_tip_diameter_mm']:.3f} mm), volume "

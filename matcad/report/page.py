@@ -35,6 +35,7 @@ h2 { border-bottom: 1px solid #ddd; margin-top: 2rem; }
   h2 { font-size: 12.5pt; margin-top: 0.9rem; }
   h3 { font-size: 10.5pt; margin: 0.5rem 0 0.2rem; }
   h1, h2, h3 { break-after: avoid; page-break-after: avoid; break-inside: avoid; }
+  p:has(+ table, + ul, + ol) { break-after: avoid; page-break-after: avoid; }
   .picture, img, tr, pre { break-inside: avoid; page-break-inside: avoid; }
   .picture { display: inline-block; vertical-align: top; width: 49%; margin: 0 0 0.3rem; }
   .picture img, img { max-height: 88mm; max-width: 100%; width: auto; border: none; }
@@ -44,8 +45,8 @@ h2 { border-bottom: 1px solid #ddd; margin-top: 2rem; }
 }
 """
 """The page's look on screen and, under ``@media print``, on paper (A4): headings never end a page (they stay with
-the table or picture that follows: ``break-after: avoid``), a picture and its caption are never split
-(``break-inside: avoid``) and two pictures share a row."""
+the table or picture that follows: ``break-after: avoid``), nor does a line that introduces a table or a list
+("Trim:"), a picture and its caption are never split (``break-inside: avoid``) and two pictures share a row."""
 
 
 def _pictures(r: dict) -> list[str]:

@@ -59,11 +59,15 @@ class Builds:
 
     def progress(self, build_id: str) -> dict:
         """What the build ``build_id`` has written so far: its stage (index, key, text, of how many), the files
-        in its folder and the seconds since it started; Refused(404) for a build that is not running."""
+        in its folder and the seconds since it started; ``{"running": false}`` for a build that is not running
+        (not started yet: waiting for the build slot; or just finished: the page's last poll crosses the kit on
+        its way), Refused(422) for an id that cannot be a build's."""
+        if not BUILD_ID.fullmatch(build_id):
+            raise Refused(422, "build must be 8-64 letters, digits, '_' or '-'", "build")
         with self.lock:
             entry = self.running.get(build_id)
         if entry is None:
-            raise Refused(404, f"no build {build_id[:64]!r} is running", "build")
+            return {"running": False}
         kit, started = entry
         names: set[str] = set()
         for folder in (kit, *kit.parent.glob(f".{kit.name}.tmp-*")):  # matcad.output stages into a hidden sibling
@@ -73,7 +77,7 @@ class Builds:
                 pass
         i = stage_of(names, kit.is_dir())
         key, text, _ = STAGES[i]
-        return {"stage": key, "text": text, "index": i + 1, "of": len(STAGES), "files": len(names),
+        return {"running": True, "stage": key, "text": text, "index": i + 1, "of": len(STAGES), "files": len(names),
                 "elapsed_s": round(time.monotonic() - started, 1)}
 
     def folder(self) -> Path:
@@ -129,8 +133,10 @@ class Builds:
 
 
 def build_json(payload: dict, builds: Builds) -> tuple[int, dict]:
-    """Build the request's spec with `matcad build` in a temporary folder: the kit as a base64 zip and the previews
-    as data URIs; a design-rule failure as 422 with its findings."""
+    """Build the request's spec with `matcad build` in a temporary folder: the kit as a base64 zip, the previews
+    as data URIs, the verdict and, as the report's headline says it, each taxel whose chosen model fails its checks;
+    a design-rule failure as 422 with its findings."""
+    from matcad.render.plots import chosen_models_status
     from matcad.report import KIT_ARCHIVE
 
     spec = spec_of(payload)  # a bad spec is told at once, before a process starts
@@ -165,7 +171,8 @@ def build_json(payload: dict, builds: Builds) -> tuple[int, dict]:
                      "src": f"data:{MIME[Path(fig['file']).suffix]};base64,"
                             f"{base64.b64encode((kit / fig['file']).read_bytes()).decode()}"}
                     for fig in report.get("figures", ())]
-        return 200, {"name": spec.name, "verdict": report["verdict"], "files": result["written"],
+        return 200, {"name": spec.name, "verdict": report["verdict"], "model_status": chosen_models_status(report),
+                     "files": result["written"],
                      "zip": base64.b64encode(buf.getvalue()).decode(), "previews": previews,
                      "findings": [f for f in result["findings"] if f["level"] != "info"]}
     finally:

@@ -21,17 +21,28 @@ def predict_json(payload: dict) -> dict:
     """The prediction of the request's spec as plain data (Hz, mm). A board ([[taxel]] or [array]) is predicted as
     `matcad predict` predicts it (:func:`matcad.prediction.board.predict_board`: every taxel, its loaded band from
     the cap mechanics or its calibration, the conflicts); a single taxel by :func:`matcad.prediction.predict` with
-    its unloaded band (no FElupe on every keystroke). The first taxel's numbers are also at the top level."""
+    its unloaded band (no FElupe on every keystroke). ``"mechanics": false`` in the request predicts a board without
+    its caps' rise under load (``rise_pending``: the page shows these bands at once and asks again for the rises,
+    which take a FElupe run per cap not yet cached). The first taxel's numbers are also at the top level. A board's
+    layout findings (``layout``: caps off the plate, on a fastener or too close, jets, ligaments, the mold's slots,
+    crossing bores; :mod:`matcad.rules.board`, ~0.01 s) come with it, so that adding or moving a taxel is judged
+    as it is typed, not at the build."""
     from matcad.prediction import predict, taxel_band
     from matcad.prediction.bands import summary
     from matcad.spec import is_array, spec_notes
 
     spec = spec_of(payload)
+    mechanics = payload.get("mechanics", True)
+    if not isinstance(mechanics, bool):
+        raise Refused(422, f"mechanics {str(mechanics)[:40]!r} invalid, must be true or false", "mechanics")
     notes = spec_notes(spec, payload["spec"])
+    layout = []
     if is_array(spec):
         from matcad.prediction.board import predict_board
+        from matcad.rules import board as board_rules
 
-        board = predict_board(spec)
+        board = predict_board(spec, mechanics=mechanics)
+        layout = [f.to_dict() for rule in board_rules.RULES for f in rule(spec) if f.level != "info"]
         bands, predictions = board.bands, [board.predictions[b.name] for b in board.bands]
         data = board.summary
     else:
@@ -45,7 +56,8 @@ def predict_json(payload: dict) -> dict:
             "warnings": [w for row in rows for w in
                          ((f"{row['name']}: {w}" for w in row["warnings"]) if len(rows) > 1 else row["warnings"])],
             "notes": notes, "taxels": rows, "guard_hz": data["guard_hz"], "max_force_n": data["max_force_n"],
-            "harmonics": data["harmonics"], "conflicts": data["conflicts"]}
+            "harmonics": data["harmonics"], "conflicts": data["conflicts"], "layout": layout,
+            "rise_pending": is_array(spec) and not mechanics}
 
 
 def spec_toml(payload: dict) -> dict:

@@ -11,8 +11,8 @@ const inputs = {};
 let taxelRows = [];      // [{cells: {column: input}, extra: {...}}]: extra keeps what the table does not edit
 let preserved = {};      // other arrays of tables ([[measured]], ...) passed through unchanged
 let INITIAL = BOOT.initial;
-window.matcad = {stages: [], bandsShownMs: null, previewMs: [], editToSectionMs: [], meshMs: null, moldMs: null,
-                 editAt: null};
+window.matcad = {stages: [], bandsShownMs: null, riseShownMs: null, previewMs: [], editToSectionMs: [], meshMs: null,
+                 moldMs: null, editAt: null};
 
 function initialValue(key) {
   let node = INITIAL;
@@ -236,23 +236,48 @@ function list(id, items) {
 // ---- prediction ---------------------------------------------------------------------------------------------------
 
 let timer = null, generation = 0, lastPrediction = null;
+let riseBusy = false, riseWanted = null;
 function schedulePredict() { clearTimeout(timer); timer = setTimeout(predict, 200); }
 
-async function predict() {
+async function predict() {  // the bands at once (a board's without its caps' rise under load), then the rises
   const mine = ++generation;
   $("status").textContent = "predicting…";
   const spec = collect();
-  const [status, data] = await post("/predict", {spec});
+  const [status, data] = await post("/predict", {spec, mechanics: false});
   if (mine !== generation) return;  // a newer edit is on its way
-  clearErrors();
   $("status").textContent = "";
+  if (!show(status, data)) return;
+  schedulePreview(spec);
+  if (data.rise_pending) { riseWanted = {spec, mine}; askRise(); }
+}
+
+async function askRise() {  // one request at a time, for the newest edit: a new cap costs a FElupe run (seconds)
+  if (riseBusy || riseWanted === null) return;
+  const {spec, mine} = riseWanted;
+  riseWanted = null;
+  riseBusy = true;
+  $("status").textContent = "computing each cap's rise under load…";
+  try {
+    const [status, data] = await post("/predict", {spec});
+    if (mine === generation) {
+      $("status").textContent = "";
+      if (show(status, data) && window.matcad.riseShownMs === null) window.matcad.riseShownMs = performance.now();
+    }
+  } finally {
+    riseBusy = false;
+    askRise();
+  }
+}
+
+function show(status, data) {  // a /predict reply on the page; false for an error (told beside its field)
+  clearErrors();
   if (status !== 200) {
     showError(data.error);
     $("f0").textContent = "—";
     $("model").textContent = $("band").textContent = "";
     $("bandchart").replaceChildren();
-    for (const id of ["warnings", "notes", "conflicts"]) list(id, []);
-    return;
+    for (const id of ["warnings", "notes", "conflicts", "layout"]) list(id, []);
+    return false;
   }
   lastPrediction = data;
   if (data.board) {
@@ -261,16 +286,17 @@ async function predict() {
     $("band").textContent = `f0 ${data.taxels.map((t) => `${t.name} ${t.f0_hz.toFixed(0)}`).join(", ")} Hz`;
   } else {
     $("f0").textContent = `f0 = ${data.f0_hz.toFixed(0)} Hz`;
-    $("model").textContent = `(${data.model})`;
+    $("model").textContent = `(${data.model}${data.models[data.model]?.valid === false ? ", outside its checks" : ""})`;
     $("band").textContent = `band ${data.band_hz[0].toFixed(0)}–${data.band_hz[1].toFixed(0)} Hz`;
   }
   drawBands(data);
   if (window.matcad.bandsShownMs === null) window.matcad.bandsShownMs = performance.now();
   list("conflicts", data.conflicts.map((c) => "conflict: " + c.message));
+  list("layout", data.layout.map((f) => `${f.level} ${f.id}: ${f.message}`));  // a board's taxels on the plate
   list("warnings", data.warnings);
   list("notes", data.notes);
   showDetails();
-  schedulePreview(spec);
+  return true;
 }
 
 function el(tag, attrs, text) {
@@ -286,9 +312,11 @@ function drawBands(data) {  // every taxel's unloaded band (blue) and loaded ris
   const span = hi - lo; lo -= 0.04 * span; hi += 0.04 * span;
   const W = 720, left = 120, right = 20, rowH = 26, top = 24, H = top + rowH * rows.length + 34;
   const x = (f) => left + (f - lo) / (hi - lo) * (W - left - right);
-  const svg = el("svg", {viewBox: `0 0 ${W} ${H}`, id: "bands-svg", role: "img"});
+  const svg = el("svg", {viewBox: `0 0 ${W} ${H}`, id: "bands-svg", role: "img",
+                         "data-rise": data.rise_pending ? "pending" : "done"});
   svg.appendChild(el("text", {x: left, y: 14, "font-size": 12, fill: data.conflicts.length ? "#b00020" : "#222"},
-    `${rows.length} taxel band(s), guard ${g.toFixed(0)} Hz, loaded to ${data.max_force_n} N: ` +
+    `${rows.length} taxel band(s), guard ${g.toFixed(0)} Hz, ` + (data.rise_pending
+      ? `unloaded (the rise to ${data.max_force_n} N follows): ` : `loaded to ${data.max_force_n} N: `) +
     (data.conflicts.length ? `${data.conflicts.length} conflict(s)` : "disjoint")));
   const step = [50, 100, 200, 250, 500, 1000, 2000, 5000].find((s) => (hi - lo) / s <= 9) || 10000;
   for (let f = Math.ceil(lo / step) * step; f <= hi; f += step) {
@@ -489,6 +517,7 @@ async function buildKit() {
     const response = await fetch("/progress?build=" + id);
     if (response.status !== 200) return;
     const p = await response.json();
+    if (!p.running) return;  // not started yet (waiting for the build slot) or just finished
     $("build-bar").max = p.of;
     $("build-bar").value = p.index;
     $("build-stage").textContent = `${p.index}/${p.of} ${p.text} — ${p.files} files, ${p.elapsed_s.toFixed(0)} s`;
@@ -513,7 +542,8 @@ async function buildKit() {
   link.href = URL.createObjectURL(new Blob([bytes], {type: "application/zip"}));
   link.download = data.name + ".zip";
   link.hidden = false;
-  $("build-status").textContent = `${data.files.length} files, verdict ${data.verdict}`;
+  $("build-status").textContent = `${data.files.length} files, verdict ${data.verdict}` +
+    (data.model_status ? ` (design rules); ${data.model_status}` : "");
   list("findings", data.findings.map((f) => `${f.level} ${f.id}: ${f.message}`));
   $("previews").replaceChildren(...data.previews.map((p) => {
     const fig = document.createElement("figure");
