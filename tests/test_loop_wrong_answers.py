@@ -6,6 +6,8 @@ same over 10 seeds per case."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -120,6 +122,9 @@ def test_board_taxel_pressed_out_of_its_band(seed):
     a = tracks[1].analysis
     lo, hi = rec.bands_hz[1]
     assert any("left its band" in w and "t2" in w for w in a.warnings), a.warnings
+    # its tone in the guard is no other taxel's and no harmonic: t1 names it as a stronger tone outside every band
+    assert any(re.search(r"near 44[12]\d Hz outside the bands of every taxel", w)
+               for w in tracks[0].analysis.warnings), tracks[0].analysis.warnings
     df = a.plot_freqs_hz[1] - a.plot_freqs_hz[0]
     assert not [s for s in a.segments if not s.flag and hi - s.mean_hz < 3 * df]
     assert not np.any(a.voiced & (hi - a.track_hz < 3 * df))

@@ -41,6 +41,11 @@ covers >= 90 % up to τ = 1 N on the paper's range; three cycles are 1.3 times a
 0.7 N, and the prior dominates below that (2.2 times at 0.5 N, ~11 with no scatter at all)."""
 OUTLIER_LEVEL = 0.05
 """Family-wise level of the outlier test (Bonferroni over the points)."""
+ROUND_OFF = 64.0
+"""Float64 round-off through the fit, in units of eps·cond(X)·f̄ (Hz): the scatter that an exact, noise-free data
+set still leaves (measured ~1e-15·f̄ at cond ~10-100), with a safety factor; no real tone is read that finely."""
+FINEST_STEP_HZ = 1e-6
+"""The finest decimal step (Hz) at which :func:`_resolution_hz` looks for the digits the frequencies were written to."""
 
 
 @dataclass(frozen=True)
@@ -112,7 +117,8 @@ class LeastSquares:
     """What :func:`weighted_least_squares` found, in the scaled parameters (V0, b·s, a·s²) of its design matrix:
     the estimate and its covariance, the within-cycle variance σ² (``dof_within`` degrees of freedom), the
     between-cycle variance τ² used and its degrees of freedom (inf: given, not estimated), the cycles' own estimate
-    of τ² (None with one cycle), and each point's externally studentized within-cycle residual."""
+    of τ² (None with one cycle), and each point's externally studentized within-cycle residual (judged against
+    no less than the noise floor it was given)."""
 
     coef: np.ndarray
     cov: np.ndarray
@@ -133,14 +139,16 @@ def _per_cycle(index, k: int, values) -> np.ndarray:
 
 
 def weighted_least_squares(force, y, w, scale, index, k: int, tau2_prior: float = 0.0,
-                           prior_dof: float = PRIOR_CYCLES) -> LeastSquares:
+                           prior_dof: float = PRIOR_CYCLES, noise_floor: float = 0.0) -> LeastSquares:
     """Eq. 5 in (V0, b, a) by weighted least squares with a random offset per load cycle (a random intercept):
     y_ij = x_ijᵀθ + u_i + e_ij, u_i ~ N(0, τ²), e_ij ~ N(0, σ²/w_ij²); ``index`` gives each point's cycle
     (0 … ``k`` − 1). O(n) time and memory: no n × n matrix is ever formed.
 
     - σ² and the outlier test come from the within-cycle (fixed-effects) fit, each cycle its own intercept
       (n − 2 − k degrees of freedom); its externally studentized residuals use the exact leave-one-out variance
-      ((n−p)s² − e_i²/(1−h_i))/(n−p−1), which cannot go negative.
+      ((n−p)s² − e_i²/(1−h_i))/(n−p−1), which cannot go negative, and never below ``noise_floor``² (the
+      scatter the data cannot resolve, in the units of y·w): a perfect fit leaves only round-off, and round-off
+      judged by round-off would name a point of it an outlier.
     - τ²: with k >= 2 cycles, the spread of the cycles' weighted mean residuals beyond what σ² explains (method of
       moments, k − 1 degrees of freedom), pooled with the prior ``tau2_prior`` worth ``prior_dof`` degrees of
       freedom (:data:`PRIOR_CYCLES`; ``prior_dof`` inf: τ² taken as known). One cycle: the prior alone.
@@ -169,7 +177,7 @@ def weighted_least_squares(force, y, w, scale, index, k: int, tau2_prior: float 
     room = np.clip(1.0 - hat, 0.0, None)
     with np.errstate(divide="ignore", invalid="ignore"):
         deleted = np.where(room > 1e-12, e * e / room, 0.0)
-        s2_others = np.maximum(rss - deleted, 0.0) / max(dof_w - 1, 1)  # exact leave-one-out: never < 0
+        s2_others = np.maximum(np.maximum(rss - deleted, 0.0) / max(dof_w - 1, 1), noise_floor ** 2)
         student = np.where((room > 1e-12) & (s2_others > 0), e / np.sqrt(s2_others * room), 0.0)
     tau2_data = None
     if k >= 2:
@@ -264,6 +272,19 @@ class _Turns(Exception):
         self.at = at
 
 
+def _resolution_hz(frequencies_hz) -> float:
+    """The step (Hz) the frequencies were written to: the coarsest of 1, 0.1, … :data:`FINEST_STEP_HZ` Hz that each
+    is a whole multiple of (4500.25 Hz: 0.01 Hz), 0 when none is (full-precision numbers)."""
+    freq = np.asarray(frequencies_hz, dtype=float)
+    step = 1.0
+    while step >= FINEST_STEP_HZ * 0.5:
+        q = freq / step
+        if np.all(np.abs(q - np.round(q)) <= 1e-6 + 8 * np.finfo(float).eps * np.abs(q)):
+            return step
+        step /= 10.0
+    return 0.0
+
+
 def _check_points(force):
     n = len(force)
     if n < MIN_POINTS:
@@ -279,11 +300,16 @@ def _fit_once(force, freq, k_mm3_hz2, v0_fixed_mm3, cycles, cycle_std_n) -> Eq5F
     n = len(force)
     scale = max(float(np.max(np.abs(force))), 1e-12)
     x_scaled = np.column_stack([np.ones(n), -force / scale, -(force / scale) ** 2])
-    if np.linalg.cond(x_scaled) > MAX_CONDITION:
+    condition = float(np.linalg.cond(x_scaled))
+    if condition > MAX_CONDITION:
         raise LoopError("degenerate data: the forces cannot separate V0, b and a")
     y = k_mm3_hz2 / freq ** 2 if v0_fixed_mm3 is None else 1.0 / freq ** 2
     # the measurement noise is in f, so y = K/f² scatters as f⁻³: weight by (f/f̄)⁶ (σ then refers to f̄)
     w = np.sqrt((freq / freq.mean()) ** 6)
+    # the outlier test credits no scatter finer than the data resolve: their written step (a uniform rounding,
+    # sd step/√12) or round-off; a change δf moves y·w by 2(y f²)δf/f̄³ at every f (that is why w = (f/f̄)³)
+    floor_hz = max(_resolution_hz(freq) / math.sqrt(12.0), ROUND_OFF * np.finfo(float).eps * condition * freq.mean())
+    noise_floor = 2.0 * float(y[0] * freq[0] ** 2) * floor_hz / freq.mean() ** 3
     labels, index = np.unique(cycles, return_inverse=True)
     k_cycles = len(labels)
     unscale = np.diag([1.0, 1.0 / scale, 1.0 / scale ** 2])
@@ -296,7 +322,7 @@ def _fit_once(force, freq, k_mm3_hz2, v0_fixed_mm3, cycles, cycle_std_n) -> Eq5F
     tau_prior_n = cycle_std_n if given else PAPER_CYCLE_SHARE * max(abs(lo), abs(hi))
     # one cycle: the prior is all there is, taken as known (a stated assumption); several: pooled with theirs
     ls = weighted_least_squares(force, y, w, scale, index, k_cycles, (tau_prior_n * dy_df) ** 2,
-                                math.inf if k_cycles == 1 else PRIOR_CYCLES)
+                                math.inf if k_cycles == 1 else PRIOR_CYCLES, noise_floor)
     theta, cov, sigma2, tau2 = unscale @ ls.coef, unscale @ ls.cov @ unscale, ls.sigma2, ls.tau2
     # Welch–Satterthwaite: a new reading's scatter in y is σ² (dof within) plus τ²(1 + 1/k) — its own cycle's
     # offset and the calibration cycles' mean offset that sits in V0 — with the degrees of freedom of τ²

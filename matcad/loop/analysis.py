@@ -17,7 +17,7 @@ from matcad.listening import EDGE_BINS, WINDOW_S, window_samples
 from matcad.errors import LoopError
 from matcad.loop import crossing
 from matcad.loop.segments import Segment
-from matcad.loop.spectrum import BandBins
+from matcad.loop.spectrum import BandBins, levels
 from matcad.loop.voicing import (MIN_RUN, MIN_RUN_HARMONIC, STABLE_BINS, STRONG_DB, STRONG_RUN, WEAK_DB,
                                  longest_run)
 
@@ -253,14 +253,22 @@ def second_sources(other_bin, other_excess, other_level, band_freqs) -> list[Sou
     return [Source(float(band_freqs[int(round(centre))]), rel, float(np.sum(close) / len(other_bin)))]
 
 
-def strongest_outside(f, mean_spectrum, bands, in_band_peak) -> str:
+def strongest_outside(f, mean_spectrum, bands, in_band_peak, on_harmonic=None) -> str:
     """'a stronger tone near … Hz outside the band (… dB above …)' if one exists above 20 Hz outside every band of
     ``bands`` (Hz; the first is this taxel's, the others its neighbours'), else ''. ``f``: the spectrum's bins (Hz);
-    ``mean_spectrum``: its mean power; ``in_band_peak``: the band's highest mean power."""
+    ``mean_spectrum``: its mean power; ``in_band_peak``: the band's highest mean power. A tone is a line of the mean
+    spectrum (:func:`matcad.loop.spectrum.levels`: a local maximum >= LINE_DB over the running-median floor): the
+    skirt of a tone inside a band, sloping out past the band's edge, is none (it named a silent board taxel's
+    neighbour, 25 Hz inside its own band, as a stronger tone 10-35 Hz outside it). Nor is a bin whose mean power
+    was at least half heard on a taxel's predicted harmonic (``on_harmonic``: each bin's share,
+    :mod:`matcad.loop.overtones`; it named a singing taxel's 2f in every silent neighbour's reason: 46/46)."""
     df = f[1] - f[0]
     outside = f > 20.0  # below 20 Hz: drift, not a tone
     for lo, hi in bands:
         outside &= (f < lo - 2 * df) | (f > hi + 2 * df)
+    outside &= np.isfinite(levels(mean_spectrum[None, :])[2][0])
+    if on_harmonic is not None:
+        outside &= on_harmonic < 0.5
     if not np.any(outside):
         return ""
     i = int(np.argmax(np.where(outside, mean_spectrum, 0.0)))

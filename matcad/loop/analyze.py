@@ -34,17 +34,20 @@ from matcad.loop.spectrum import Framer
 from matcad.loop.tracker import BandTracker
 
 
-def run_trackers(blocks, fs: float, bands, on_frame=None) -> tuple[list[BandTracker], float, np.ndarray]:
+def run_trackers(blocks, fs: float, bands,
+                 on_frame=None) -> tuple[list[BandTracker], float, np.ndarray, np.ndarray]:
     """Feed an iterable of sample blocks at ``fs`` (Hz) to one :class:`BandTracker` per band (Hz), in one pass:
-    (trackers, duration s, mean power spectrum). With several bands, each frame's bins on a band's predicted
-    harmonics (:mod:`matcad.loop.overtones`) are discounted in the others. ``on_frame`` is called as (band index, time s, frequency Hz or
-    NaN, excess dB) as frames become final."""
+    (trackers, duration s, mean power spectrum, each bin's share of that power heard on a predicted harmonic).
+    With several bands, each frame's bins on a band's predicted harmonics (:mod:`matcad.loop.overtones`) are
+    discounted in the others. ``on_frame`` is called as (band index, time s, frequency Hz or NaN, excess dB) as
+    frames become final."""
     framer = Framer(fs)
     trackers = [BandTracker(framer.freqs, fs, band,
                             None if on_frame is None else (lambda *a, k=k: on_frame(k, *a)))
                 for k, band in enumerate(bands)]
     overtones = Overtones(framer.freqs, bands) if len(bands) > 1 else None
     total = np.zeros(len(framer.freqs))
+    on_harmonic = np.zeros(len(framer.freqs))
     samples = 0
     for block in blocks:
         samples += len(block)
@@ -52,17 +55,20 @@ def run_trackers(blocks, fs: float, bands, on_frame=None) -> tuple[list[BandTrac
         if len(times):
             total += power.sum(axis=0)
             discount = overtones.mask(power) if overtones is not None else None
+            if discount is not None:
+                on_harmonic += np.where(discount, power, 0.0).sum(axis=0)
             for tr in trackers:
                 tr.push(times, power, discount)
-    return trackers, samples / fs, total / max(1, framer.frames)
+    tiny = np.finfo(float).tiny
+    return trackers, samples / fs, total / max(1, framer.frames), on_harmonic / np.maximum(total, tiny)
 
 
 def analyze_stream(blocks, fs: float, bands, on_frame=None) -> list[Analysis]:
     """One :class:`matcad.loop.analysis.Analysis` per band (Hz) from an iterable of sample blocks at ``fs`` (Hz),
     in one pass (:func:`run_trackers`); raises LoopError when any band has no tone. A board of taxels whose silent
     members must not stop the others is :func:`matcad.loop.board.analyze_board`."""
-    trackers, duration, mean_power = run_trackers(blocks, fs, bands, on_frame)
-    return [tr.finish(duration, mean_power, [b for j, b in enumerate(bands) if j != k])
+    trackers, duration, mean_power, on_harmonic = run_trackers(blocks, fs, bands, on_frame)
+    return [tr.finish(duration, mean_power, [b for j, b in enumerate(bands) if j != k], on_harmonic)
             for k, tr in enumerate(trackers)]
 
 

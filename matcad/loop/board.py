@@ -12,9 +12,9 @@ tone and discounted in the other bands before their ridges see them (:mod:`matca
 :func:`discount_harmonics` checks the tracks afterwards. Frames that hold the room's tail of the old pitch just
 before a fast step are left out (:func:`room_tails`). A louder
 neighbour's tone lies in the neighbour's band: it is that taxel's tone, not a distractor of this one (the
-"stronger tone outside the band" report skips the other taxels' bands); a stronger tone outside every band is
-still reported, and a second line inside a taxel's own band is reported as before. A silent taxel does not stop
-the others: its track carries the reason; "no tone" (exit 1) only when no taxel has one.
+"stronger tone outside the band" report skips the other taxels' bands, and their predicted harmonics); a stronger
+tone outside every band is still reported, and a second line inside a taxel's own band is reported as before. A
+silent taxel does not stop the others: its track carries the reason; "no tone" (exit 1) only when no taxel has one.
 
 Calibrations: each taxel has its own Eq. 5 calibration (``matcad calibrate --taxel NAME`` per taxel), carried in
 the spec as that [[taxel]] entry's [taxel.calibration] table or given to ``sense`` as ``--calibration NAME=FILE``
@@ -98,12 +98,12 @@ def analyze_board(blocks, fs: float, named_bands, on_frame=None) -> list[TaxelTr
     named_bands = [(name, trackable(tuple(band), fs)) for name, band in named_bands]
     bands = [band for _, band in named_bands]
     hold = None if on_frame is None else TailHold(len(bands), on_frame)
-    trackers, duration, mean_power = run_trackers(blocks, fs, bands, hold)
+    trackers, duration, mean_power, on_harmonic = run_trackers(blocks, fs, bands, hold)
     tracks = []
     for k, ((name, band), tracker) in enumerate(zip(named_bands, trackers)):
         others = [b for j, b in enumerate(bands) if j != k]
         try:
-            heard = tracker.finish(duration, mean_power, others)
+            heard = tracker.finish(duration, mean_power, others, on_harmonic)
             analysis = room_tails(off_edge(name, heard))
             tracks.append(TaxelTrack(name, band, replace(analysis, warnings=(*analysis.warnings,
                                                                              *dropouts(name, heard)))))

@@ -144,10 +144,12 @@ class BandTracker:
                 self.on_frame(self.times[j], self.track[j] if state[j] else float("nan"), self.excess[j])
         self._emitted = max(self._emitted, stop)
 
-    def finish(self, duration_s: float, full_mean_power: np.ndarray | None = None, others=()) -> Analysis:
+    def finish(self, duration_s: float, full_mean_power: np.ndarray | None = None, others=(),
+               on_harmonic: np.ndarray | None = None) -> Analysis:
         """The :class:`matcad.loop.analysis.Analysis` of everything pushed. ``full_mean_power`` (the whole
         spectrum's mean) lets a stronger tone outside the band be reported; one inside another taxel's band
-        (``others``, Hz) is that taxel's, not reported here."""
+        (``others``, Hz) or whose power is mostly heard on a taxel's predicted harmonic (``on_harmonic``: each
+        bin's share) is that taxel's, not reported here."""
         states = self._ridge.finish()
         if len(states):
             self._decide(states)
@@ -156,7 +158,7 @@ class BandTracker:
         loudest = ""
         if full_mean_power is not None and len(self.times):
             loudest = strongest_outside(self.bins.freqs, full_mean_power, [self.bins.band_hz, *others],
-                                        float(self.band_peak_power.max() / len(self.times)))
+                                        float(self.band_peak_power.max() / len(self.times)), on_harmonic)
         frames = Frames(np.array(self.times), np.array(self.track), np.array(self.excess),
                         np.array(self._voicing.state, dtype=int), np.array(self.other_bin),
                         np.array(self.other_excess), np.array(self.other_level),
