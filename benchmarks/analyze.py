@@ -178,7 +178,7 @@ def false_alarm_table(minutes):
     from scipy.stats import beta
 
     from matcad.loop.analyze import analyze_stream
-    from matcad.loop.spectrum import FLOOR_BINS, Framer, running_median_rows
+    from matcad.loop.spectrum import Framer, levels
     from matcad.loop.tracker import BandTracker
     from matcad.loop.voicing import STRONG_DB
 
@@ -209,9 +209,8 @@ def false_alarm_table(minutes):
             framer = Framer(FS)
             power = framer.feed(x)[1]
             tracker = BandTracker(framer.freqs, FS, BAND)
-            slab = power[:, tracker.slab]
-            excess = (10 * np.log10(slab / running_median_rows(slab, FLOOR_BINS)))[:, tracker.offset:
-                                                                                    tracker.offset + len(tracker.in_band)]
+            excess = levels(power[:, tracker.slab], power.max(axis=1))[1][:, tracker.offset:
+                                                                          tracker.offset + len(tracker.in_band)]
             over += [np.sum(excess > 12.0), np.sum(excess > 15.0)]
             bins += excess.size
         bound = float(beta.ppf(0.95, voiced + 1, frames - voiced))

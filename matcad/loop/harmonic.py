@@ -5,10 +5,10 @@ over hundreds of Hz in a 93 ms frame and cannot be recognised as a comb there; t
 response peaks they leave short, steady-looking lines that pass a tone detector (benchmarks/analyze.py, speech
 and reverberant-noise rows). Its low harmonics (150 Hz–2.5 kHz) stay resolved: the excess spectrum there is
 periodic in frequency with the pitch as period. This module measures that periodicity per frame — the largest
-normalised autocorrelation of the excess spectrum (dB over the running-median floor, clipped to 0–30 dB) at
-frequency lags of 80–400 Hz, the cepstral idea of Noll (1967) in its autocorrelation form — and calls the frame
-harmonic when it reaches :data:`THRESHOLD`. Measured per frame (the synth cases of benchmarks/analyze.py, 10 s,
-3 seeds, 642 frames each): a taxel alone, with presses, taps, gaps or a neighbouring taxel, white, brown and
+normalised autocorrelation of the excess spectrum (dB over :func:`matcad.loop.spectrum.noise_floor`, clipped to
+0–30 dB) at frequency lags of 80–400 Hz, the cepstral idea of Noll (1967) in its autocorrelation form — and calls
+the frame harmonic when it reaches :data:`THRESHOLD`. Measured per frame (the synth cases of benchmarks/analyze.py,
+10 s, 3 seeds, 642 frames each): a taxel alone, with presses, taps, gaps or a neighbouring taxel, white, brown and
 reverberant room noise: median 0.15, 99th percentile 0.27–0.28, largest 0.34; synthetic speech median 0.47, 0.79 at
 90 %, 64 % of frames ≥ 0.35 (the rest are its syllable gaps); 60 Hz buzz median 0.70, every frame.
 
@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from matcad.loop.spectrum import running_median_rows
+from matcad.loop.spectrum import noise_floor
 
 LOW_HZ = 150.0
 HIGH_HZ = 2500.0
@@ -33,7 +33,6 @@ SPACING_HZ = (80.0, 400.0)
 MIN_SPAN_PERIODS = 3
 """The detector's band must span this many of the longest spacing, else it is off."""
 THRESHOLD = 0.35
-FLOOR_BINS = 63
 CLIP_DB = 30.0
 
 
@@ -51,7 +50,7 @@ def periodicity(power: np.ndarray, freqs: np.ndarray, band_hz: tuple[float, floa
     sel = np.flatnonzero((freqs >= band_hz[0]) & (freqs <= band_hz[1]))
     tiny = np.finfo(float).tiny
     level = 10 * np.log10(power[:, sel] + tiny)
-    excess = np.clip(level - 10 * np.log10(running_median_rows(power[:, sel], FLOOR_BINS) + tiny), 0.0, CLIP_DB)
+    excess = np.clip(level - 10 * np.log10(noise_floor(power[:, sel], power.max(axis=1)) + tiny), 0.0, CLIP_DB)
     excess -= excess.mean(axis=1, keepdims=True)
     n = excess.shape[1]
     spectrum = np.fft.rfft(excess, n=2 * n, axis=1)

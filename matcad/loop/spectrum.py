@@ -7,7 +7,11 @@ follows coloured noise (pink, brown, a speech or fan hump) where a band-wide mea
 coloured noise a bin's power is exponential; with a *known* median the tail would be exp(−ln 2 · 10^(x/10)) per
 bin, but the floor is itself estimated from ~30 independent bins, so the measured tail is far heavier: 1.2e-4 over
 12 dB (law 2e-5), ~8e-7 over 15 dB (law 3e-10) per bin (benchmarks/analyze.py; the order-statistic law for a median
-of 31–41 bins brackets it within ×2). Frequencies Hz, times s, levels dB.
+of 31–41 bins brackets it within ×2). A noise-free recording has no floor: a tone an exact number of cycles
+per window leaves every other bin of the zero-padded spectrum at round-off (−300 dB), and the median of such bins
+made a Hann sidelobe 86 dB under the tone 200 dB "over the floor" (a clean 1500 Hz tone at 48 kHz read 1283 Hz);
+so the floor never lies more than :data:`DYNAMIC_RANGE_DB` under the frame's strongest bin. Frequencies Hz, times
+s, levels dB.
 """
 
 from __future__ import annotations
@@ -20,6 +24,15 @@ from matcad.listening import BAND_BINS, ZERO_PAD, window_samples
 
 FLOOR_BINS = 63
 """Width of the running median that sets the local noise floor (≈ 340 Hz at 44.1 kHz)."""
+DYNAMIC_RANGE_DB = 140.0
+"""The floor lies at most this far under the frame's strongest bin (dB, per bin of the :class:`Framer`'s PSD).
+Per bin a recording's range is its broadband range plus the Hann window's processing gain, 10·log10(n/(2·1.5)) =
+31–34 dB (n 4096–8192 samples): a full-scale tone stands 128–131 dB over 16-bit PCM's own floor (98 dB broadband;
+measured at 44.1 and 96 kHz), so nothing a 16-bit file holds is touched; the MEMS and electret microphones a taxel
+is heard with (60–75 dB SNR on their data sheets) stay far inside it. Only a measurement chain at full scale
+(~120 dB broadband) could pass it, and a line over a floor deeper than 140 dB under the frame's strongest bin would
+lose as much excess as the floor lies beyond. Further down is numerical nothing (round-off; a synthesis without
+noise), never evidence: an exact-bin tone's sidelobes now stand ≤ 56 dB over the floor, its own line ~80 dB."""
 LINE_DB = 6.0
 """A local maximum this far over the floor counts as a line in the comb and second-source tests."""
 
@@ -89,12 +102,19 @@ def running_max(x: np.ndarray, size: int, mode: str = "reflect") -> np.ndarray:
     return out
 
 
-def levels(power: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per frame and bin of ``power`` (frames × bins, PSD): (level dB, excess over the running-median floor of
-    FLOOR_BINS dB, lines: the excess where a bin is a local maximum ≥ LINE_DB over the floor, else −inf)."""
+def noise_floor(power: np.ndarray, peak: np.ndarray) -> np.ndarray:
+    """Per frame and bin of ``power`` (frames × bins, PSD): the running median over FLOOR_BINS bins, never under
+    the frame's strongest bin ``peak`` (one per frame, PSD: the whole spectrum's, of which ``power`` may be a slab)
+    DYNAMIC_RANGE_DB down."""
+    return np.maximum(running_median_rows(power, FLOOR_BINS), (peak * 10 ** (-DYNAMIC_RANGE_DB / 10))[:, None])
+
+
+def levels(power: np.ndarray, peak: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per frame and bin of ``power`` (frames × bins, PSD): (level dB, excess over the :func:`noise_floor` dB,
+    lines: the excess where a bin is a local maximum ≥ LINE_DB over the floor, else −inf). ``peak``: each frame's
+    strongest bin over the whole spectrum (PSD)."""
     tiny = np.finfo(float).tiny
-    floor = running_median_rows(power, FLOOR_BINS)
-    excess = 10 * np.log10((power + tiny) / (floor + tiny))
+    excess = 10 * np.log10((power + tiny) / (noise_floor(power, peak) + tiny))
     level = 10 * np.log10(power + tiny)
     is_max = (excess >= running_max(excess, 3)) & (excess >= LINE_DB)
     return level, excess, np.where(is_max, excess, -np.inf)

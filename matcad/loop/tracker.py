@@ -80,7 +80,7 @@ class BandTracker:
             return
         b = self.bins
         slab = power[:, self.slab]
-        level, excess, lines = levels(slab)
+        level, excess, lines = levels(slab, power.max(axis=1))
         band = slice(self.offset, self.offset + len(self.in_band))
         zone = mains_zone(lines, b.freqs[self.slab], b.df)
         if discount is not None:
