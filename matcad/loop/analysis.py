@@ -266,7 +266,7 @@ def strongest_outside(f, mean_spectrum, bands, in_band_peak, on_harmonic=None) -
     outside = f > 20.0  # below 20 Hz: drift, not a tone
     for lo, hi in bands:
         outside &= (f < lo - 2 * df) | (f > hi + 2 * df)
-    outside &= np.isfinite(levels(mean_spectrum[None, :])[2][0])
+    outside &= np.isfinite(levels(mean_spectrum[None, :], mean_spectrum.max(keepdims=True))[2][0])
     if on_harmonic is not None:
         outside &= on_harmonic < 0.5
     if not np.any(outside):
