@@ -11,9 +11,16 @@
              section's plane), each timed from the edit's request to the section shown and to the meshes shown (the
              preview process keeps built parts: an edit rebuilds the edited taxel's cap and the mold only)
 
-With --shots DIR it saves a screenshot of the board page and of the single-taxel page there (PNG).
+  mold-edit  no browser, in this process: the preview's own work for N edits of t1's cavity_length on the board
+             with its cache warm, CPU s (process_time, every thread) and wall s per edit: the mold's meshes (mesh
+             booleans of the kept tool meshes, matcad.serve.tessellate) and the assembly's; against the B-rep route
+             the preview took before (the build's mold solids, booleans in the kernel, build123d's
+             tessellate at the preview's tolerance) and the ratio
 
-Run: PYTHONPATH=. .venv/bin/python benchmarks/page.py [N] [--shots DIR]   (default N 5)
+With --shots DIR it saves a screenshot of the board page and of the single-taxel page there (PNG). --cpu runs the
+mold-edit rows only.
+
+Run: PYTHONPATH=. .venv/bin/python benchmarks/page.py [N] [--shots DIR] [--cpu]   (default N 5)
 """
 
 from __future__ import annotations
@@ -24,7 +31,8 @@ import threading
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 
 from matcad.serve import make_server  # noqa: E402
 from tests.browser import chromium  # noqa: E402
@@ -57,9 +65,50 @@ def edits_timed(driver, field: str, values: list[float]) -> tuple[list[float], l
     return sections, meshes, molds
 
 
+def timed(work) -> tuple[float, float]:
+    """(CPU s, wall s) of ``work()``."""
+    cpu, wall = time.process_time(), time.perf_counter()
+    work()
+    return time.process_time() - cpu, time.perf_counter() - wall
+
+
+def mold_edits_cpu(n: int) -> None:
+    """The mold-edit rows (module docstring): median (max) CPU and wall s per edit."""
+    import copy
+    import tomllib
+
+    from matcad.parts.registry import part
+    from matcad.serve import preview
+    from matcad.spec import from_dict
+
+    data = tomllib.loads((ROOT / "templates" / "mat-array-4.toml").read_text(encoding="utf-8"))
+    cache = preview.PartCache()
+    first = timed(lambda: preview.meshes(from_dict(data), cache))
+    print(f"mold-edit  board, first meshes (every part built): {first[0]:6.2f} s CPU, {first[1]:6.2f} s wall")
+    rows = {"molds": [], "assembly": [], "B-rep molds": []}
+    for i in range(n):
+        edited = copy.deepcopy(data)
+        edited["taxel"][0]["cavity_length"] = 4.5 + 0.05 * i
+        spec = from_dict(edited)
+        rows["molds"].append(timed(lambda: preview.meshes(spec, cache, groups=("molds",))))
+        rows["assembly"].append(timed(lambda: preview.meshes(spec, cache, groups=("assembly",))))
+        rows["B-rep molds"].append(timed(lambda: [part(name).make(spec).tessellate(preview.MESH_TOLERANCE_MM,
+                                                                                   preview.ANGULAR_TOLERANCE_RAD)
+                                                  for name in preview.MOLD_PARTS]))
+    for name, times in rows.items():
+        cpu, wall = [statistics.median(t[k] for t in times) for k in (0, 1)]
+        print(f"mold-edit  board, t1 cavity_length x {n}, {name:12s}: median {cpu:6.3f} s CPU "
+              f"(max {max(t[0] for t in times):.3f}), {wall:6.3f} s wall")
+    ratio = statistics.median(t[0] for t in rows["B-rep molds"]) / statistics.median(t[0] for t in rows["molds"])
+    print(f"mold-edit  B-rep route / mesh booleans, CPU: {ratio:5.1f}x")
+
+
 def main(argv: list[str]) -> None:
     n = int(argv[0]) if argv and argv[0].isdigit() else 5
     shots = Path(argv[argv.index("--shots") + 1]) if "--shots" in argv else None
+    mold_edits_cpu(n)
+    if "--cpu" in argv:
+        return
     server = make_server(0)
     threading.Thread(target=server.serve_forever, daemon=True).start()
     url = f"http://127.0.0.1:{server.server_address[1]}"

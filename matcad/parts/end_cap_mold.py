@@ -24,6 +24,7 @@ import math
 from matcad.parts.end_cap import cap_envelope, core_pin, end_cap
 from matcad.parts.features import bolt_clearance_mm
 from matcad.parts.mold_layout import MoldLayout, layout  # noqa: F401  (the layout is part of this part's API)
+from matcad.parts.recipe import Recipe, Tool
 from matcad.parts.registry import Kind, Part, PrintPose
 
 KEY_TOP_RATIO = 0.6
@@ -35,25 +36,26 @@ RIB_ANGLES_DEG = (90.0, 210.0, 330.0)
 """Three ribs 120° apart: each lateral direction pushes the key into at least one of them."""
 
 
-def _key(spec, grow: float, x: float, y: float):
+def _key(diameter: float, height: float, grow: float, x: float, y: float):
+    """A registration key ``diameter`` wide at its base and ``height`` tall at (x, y) on the parting plane,
+    grown by ``grow`` all round (mm)."""
     from matcad.parts.solid import frustum_up
 
-    m = spec.mold
-    r = m.key_diameter / 2
-    return frustum_up(r + grow, r * KEY_TOP_RATIO + grow, m.key_height + grow, x, y, 0.0)
+    r = diameter / 2
+    return frustum_up(r + grow, r * KEY_TOP_RATIO + grow, height + grow, x, y, 0.0)
 
 
-def _ribbed_socket(spec, x: float, y: float):
-    """The lid's socket over the key at (x, y): the key grown by ``machine.key_clearance``, less three crush
-    ribs that fill the clearance line-to-line with the key in :data:`RIB_WIDTH_MM`-wide sectors (mm)."""
+def _ribbed_socket(diameter: float, height: float, clearance: float, printer: str, x: float, y: float):
+    """The lid's socket over the key (``diameter``, ``height``) at (x, y): the key grown by ``clearance``
+    (``machine.key_clearance``), less three crush ribs that fill the clearance line-to-line with the key in
+    :data:`RIB_WIDTH_MM`-wide sectors for ``printer`` (mm)."""
     from build123d import Box, Pos, Rot
 
-    grown = _key(spec, spec.machine.key_clearance, x, y)
-    gap = grown - _key(spec, 0.0, x, y)
-    reach = spec.mold.key_diameter / 2 + spec.machine.key_clearance + 1.0
-    width = RIB_WIDTH_MM[spec.machine.printer]
-    sectors = [Pos(x, y, 0) * Rot(0, 0, a) * Pos(reach / 2, 0, 0)
-               * Box(reach, width, 2 * (spec.mold.key_height + spec.machine.key_clearance))
+    grown = _key(diameter, height, clearance, x, y)
+    gap = grown - _key(diameter, height, 0.0, x, y)
+    reach = diameter / 2 + clearance + 1.0
+    width = RIB_WIDTH_MM[printer]
+    sectors = [Pos(x, y, 0) * Rot(0, 0, a) * Pos(reach / 2, 0, 0) * Box(reach, width, 2 * (height + clearance))
                for a in RIB_ANGLES_DEG]
     return grown - gap.intersect(sectors[0].fuse(*sectors[1:]))
 
@@ -102,22 +104,23 @@ def _hexagon(x: float, y: float, z: float, circumradius: float):
                                y + circumradius * math.sin(math.radians(60 * k)), z) for k in range(6)], close=True)
 
 
-def _nut_pocket(spec, lay: MoldLayout, x: float, y: float):
-    """A clamp nut's hex pocket in the base (closed below on FDM, a trap open to the base's underside on SLA),
-    its funnel roof (:func:`matcad.parts.mold_layout.nut_funnel_mm`) and the bolt's clearance hole from it up to
-    the parting plane (mm)."""
+def _nut_pocket(bolt: str, printer: str, clamp, base_height: float, x: float, y: float) -> list:
+    """A clamp nut's hex pocket in the base (``clamp``: :class:`matcad.parts.mold_layout.ClampNut`; closed below
+    on FDM, a trap open to the underside of a base ``base_height`` deep on SLA), its funnel roof
+    (:func:`matcad.parts.mold_layout.nut_funnel_mm`) and the bolt's clearance hole from it up to the parting
+    plane (mm)."""
     from build123d import Face, Solid, Vector
 
     from matcad.parts.mold_layout import nut_funnel_mm
     from matcad.parts.solid import cylinder_up
 
-    c = lay.clamp
+    c = clamp
     r = c.across_flats_mm / 2 / math.cos(math.pi / 6)
-    hole = bolt_clearance_mm(spec.mold.bolt, "normal") / 2
-    z0 = -lay.base_height if c.open_below else c.pocket_bottom_z
+    hole = bolt_clearance_mm(bolt, "normal") / 2
+    z0 = -base_height if c.open_below else c.pocket_bottom_z
     pocket = Solid.extrude(Face(_hexagon(x, y, z0, r)), Vector(0, 0, c.pocket_top_z - z0))
     funnel = Solid.make_loft([_hexagon(x, y, c.pocket_top_z, r),
-                              _hexagon(x, y, c.pocket_top_z + nut_funnel_mm(c.bolt, spec.machine.printer), hole)])
+                              _hexagon(x, y, c.pocket_top_z + nut_funnel_mm(c.bolt, printer), hole)])
     return [pocket, funnel, cylinder_up(hole, -c.pocket_top_z, x, y, c.pocket_top_z)]
 
 
@@ -134,39 +137,69 @@ def _upside_down(shape, x: float):
     return Pos(x, 0, 0) * Rot(180, 0, 0) * shape
 
 
-def mold_base(spec):
+def _cap_negative(cap_spec, x: float):
+    """The outer shape of the cap ``cap_spec`` casts, upside down at x: the base's pocket for it (mm)."""
+    return _upside_down(cap_envelope(cap_spec), x)
+
+
+def _core_pin_at(cap_spec, x: float):
+    """The core pin of the cap ``cap_spec`` casts, hanging from the lid at x (mm)."""
+    return _upside_down(core_pin(cap_spec), x)
+
+
+def _slab(width: float, depth: float, height: float, below: bool):
+    """A block ``width`` × ``depth`` centred on the axis, from z = -``height`` to 0 if ``below``, else from 0 up
+    (mm)."""
+    from build123d import Box
+
+    from matcad.parts.solid import BOTTOM, TOP
+
+    return Box(width, depth, height, align=TOP if below else BOTTOM)
+
+
+def base_recipe(spec) -> Recipe:
     """Base block: top face at z = 0, cap negatives upside down, keys on top, captive clamp nuts under bolt holes,
     a board's taxel names beside the pockets (mm)."""
-    from build123d import Box
-
     from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
-    from matcad.parts.solid import TOP, engraved
-
-    lay = layout(spec)
-    block = Box(lay.block_x, lay.block_y, lay.base_height, align=TOP)
-    block = block.fuse(*(_key(spec, 0.0, x, y) for x, y in lay.keys))
-    return block.cut(*[_upside_down(cap_envelope(s), x) for x, s in _slot_specs(spec, lay)],
-                     *[f for x, y in lay.bolts for f in _nut_pocket(spec, lay, x, y)],
-                     *engraved(base_labels(spec), 0.0, PRINTED_LABEL_DEPTH_MM))
-
-
-def mold_lid(spec):
-    """Lid: bottom face at z = 0, solid core pins hanging into the caps, ribbed key sockets, fill ports, vents,
-    bolt holes, a board's taxel names beside the fill ports on its top face (mm)."""
-    from build123d import Box
-
-    from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
-    from matcad.parts.solid import BOTTOM, cylinder_up, engraved
+    from matcad.parts.solid import engraved
 
     lay = layout(spec)
     m = spec.mold
-    lid = Box(lay.block_x, lay.block_y, m.lid_thickness, align=BOTTOM)
-    lid = lid.fuse(*(_upside_down(core_pin(s), x) for x, s in _slot_specs(spec, lay)))
+    return Recipe(Tool(_slab, (lay.block_x, lay.block_y, lay.base_height, True)),
+                  add=tuple(Tool(_key, (m.key_diameter, m.key_height, 0.0, x, y)) for x, y in lay.keys),
+                  cut=(*(Tool(_cap_negative, (s, x)) for x, s in _slot_specs(spec, lay)),
+                       *(Tool(_nut_pocket, (m.bolt, spec.machine.printer, lay.clamp, lay.base_height, x, y))
+                         for x, y in lay.bolts),
+                       Tool(engraved, (base_labels(spec), 0.0, PRINTED_LABEL_DEPTH_MM))))
+
+
+def lid_recipe(spec) -> Recipe:
+    """Lid: bottom face at z = 0, solid core pins hanging into the caps, ribbed key sockets, fill ports, vents,
+    bolt holes, a board's taxel names beside the fill ports on its top face (mm)."""
+    from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
+    from matcad.parts.solid import cylinder_up, engraved
+
+    lay = layout(spec)
+    m = spec.mold
     bolt = bolt_clearance_mm(m.bolt, "normal") / 2
-    return lid.cut(*[_ribbed_socket(spec, x, y) for x, y in lay.keys],
-                   *[cylinder_up(o.diameter / 2, o.z_top - o.z_bottom, o.x, o.y, o.z_bottom) for o in lay.openings],
-                   *[cylinder_up(bolt, m.lid_thickness, x, y, 0.0) for x, y in lay.bolts],
-                   *engraved(lid_labels(spec), m.lid_thickness, PRINTED_LABEL_DEPTH_MM))
+    socket = (m.key_diameter, m.key_height, spec.machine.key_clearance, spec.machine.printer)
+    return Recipe(Tool(_slab, (lay.block_x, lay.block_y, m.lid_thickness, False)),
+                  add=tuple(Tool(_core_pin_at, (s, x)) for x, s in _slot_specs(spec, lay)),
+                  cut=(*(Tool(_ribbed_socket, (*socket, x, y)) for x, y in lay.keys),
+                       *(Tool(cylinder_up, (o.diameter / 2, o.z_top - o.z_bottom, o.x, o.y, o.z_bottom))
+                         for o in lay.openings),
+                       *(Tool(cylinder_up, (bolt, m.lid_thickness, x, y, 0.0)) for x, y in lay.bolts),
+                       Tool(engraved, (lid_labels(spec), m.lid_thickness, PRINTED_LABEL_DEPTH_MM))))
+
+
+def mold_base(spec):
+    """The base (:func:`base_recipe`) as a solid (mm)."""
+    return base_recipe(spec).solid()
+
+
+def mold_lid(spec):
+    """The lid (:func:`lid_recipe`) as a solid (mm)."""
+    return lid_recipe(spec).solid()
 
 
 def cast_caps(spec):
@@ -174,9 +207,11 @@ def cast_caps(spec):
     return [_upside_down(end_cap(s), x) for x, s in _slot_specs(spec, layout(spec))]
 
 
-PARTS = (Part("end_cap_mold_base", Kind.PRINTED, flag="end_cap_mold", make=mold_base, order=60, colour="#e0c090",
+PARTS = (Part("end_cap_mold_base", Kind.PRINTED, flag="end_cap_mold", make=mold_base, recipe=base_recipe,
+              order=60, colour="#e0c090",
               pose=PrintPose(0.0, "flat underside; cap cavities and keys face up"),
               view=("from above: cap pockets, keys, nut pockets", 90.0, -90.0)),
-         Part("end_cap_mold_lid", Kind.PRINTED, flag="end_cap_mold", make=mold_lid, order=70, colour="#e0c090",
+         Part("end_cap_mold_lid", Kind.PRINTED, flag="end_cap_mold", make=mold_lid, recipe=lid_recipe,
+              order=70, colour="#e0c090",
               pose=PrintPose(180.0, "outer (top) face; core pins point up, the parting face prints last"),
               view=("from above (as printed, pins up): core pins, vents, ribbed key sockets", 90.0, -90.0)))

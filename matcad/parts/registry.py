@@ -75,7 +75,9 @@ class Part:
     :data:`DEFAULT_VIEW` when None). Laser parts name their ``sheet`` (a key of
     :data:`matcad.parts.features.SHEETS`). ``label`` names the part on the section (default: its name spelt
     out). ``section`` draws the preview's second view as a cut instead: 'axis' (through y = 0, every cap's axis)
-    or 'bore' (through an inclined bore's plane), so what lies inside shows."""
+    or 'bore' (through an inclined bore's plane), so what lies inside shows. ``recipe(spec)`` gives a 3-D part
+    made by booleans of simple tools as those tools (:class:`matcad.parts.recipe.Recipe`; ``make`` returns its
+    ``solid()``): the design page's preview meshes it from the tools' kept meshes."""
 
     name: str
     kind: Kind
@@ -89,6 +91,7 @@ class Part:
     when: Callable[[Spec], bool] | None = None
     label: str = ""
     section: str = ""
+    recipe: Callable[[Spec], Any] | None = None
 
     def __post_init__(self):
         from matcad.spec import Outputs

@@ -26,7 +26,8 @@ from pathlib import Path
 PREVIEW_TIMEOUT_S = 120.0
 """The first preview imports the CAD kernel (5-15 s on a loaded 2-core machine); a board's parts take seconds."""
 MESH_TOLERANCE_MM = 0.08
-"""Chordal deviation of the preview mesh: coarse enough for a few thousand triangles a part."""
+"""Deflection of the preview mesh, relative as build123d's ``tessellate`` passes it (0.08 x each edge's size;
+on the parts' small circles the angular tolerance governs): a few thousand triangles a part."""
 ANGULAR_TOLERANCE_RAD = 0.35
 MOLD_PARTS = ("end_cap_mold_base", "end_cap_mold_lid")
 """Printed parts drawn beside the assembly (they are not in it)."""
@@ -114,23 +115,31 @@ def _read_line(pipe, deadline: float) -> bytes:
 
 # ---- the child's side -----------------------------------------------------------------------------------------
 
+def _lists(name: str, colour: str, vertices, triangles) -> dict:
+    """A mesh as the page's viewer draws it: flat vertex list (x, y, z mm, 3 decimals) and triangle indices."""
+    import numpy as np
+
+    return {"name": name, "colour": colour, "vertices": (np.round(vertices, 3) + 0.0).ravel().tolist(),
+            "triangles": np.asarray(triangles, dtype=np.int64).ravel().tolist()}
+
+
 def _mesh(name: str, solid, colour: str) -> dict:
-    """One solid as the page's viewer draws it: flat vertex list (x, y, z mm, 3 decimals) and triangle indices."""
-    vertices, triangles = solid.tessellate(MESH_TOLERANCE_MM, ANGULAR_TOLERANCE_RAD)
-    return {"name": name, "colour": colour,
-            "vertices": [round(c, 3) for v in vertices for c in (v.X, v.Y, v.Z)],
-            "triangles": [i for t in triangles for i in t]}
+    """One solid as the page's viewer draws it (:func:`_lists`), triangulated at the preview's tolerance."""
+    from matcad.serve.tessellate import triangulate
+
+    return _lists(name, colour, *triangulate(solid, MESH_TOLERANCE_MM, ANGULAR_TOLERANCE_RAD))
 
 
 ACOUSTIC_TABLES = ("air", "wall", "microphone", "silicone", "calibration", "mechanics", "reference", "measured")
 """Spec tables no solid reads (the physics' inputs): an edit there rebuilds no part."""
 CAP_ONLY = ("cavity_diameter", "cavity_length", "cap_top_thickness", "calibration")
 """[[taxel]] keys only that taxel's cap reads: an edit there rebuilds that cap alone."""
-MOLD_IGNORES = ("x", "y")
-"""[[taxel]] keys the cap mold does not read (it casts the caps side by side, wherever they sit on the plate)."""
 CACHE_SIZE = 128
 """Solids kept, and meshes kept, least recently used dropped first: a board's 18 parts for several edits (a mesh
-is up to ~1 MB of lists, a mold solid a few MB)."""
+is up to ~1 MB of lists)."""
+TOOL_CACHE_SIZE = 1024
+"""Meshes of the molds' tools kept (:class:`matcad.parts.recipe.Tool`; a board's mold has ~80, mostly vent
+cylinders of a few kB)."""
 
 
 def _projection(spec, drop: tuple[str, ...] = ()) -> str:
@@ -148,24 +157,26 @@ def _projection(spec, drop: tuple[str, ...] = ()) -> str:
 class PartCache:
     """The child's solids and meshes kept between requests, keyed by what they are built from: a board part by the
     spec without the physics' tables and the caps' own fields; a cap by its single-taxel spec (position dropped);
-    the mold by the spec without the physics' tables and the positions. An edit to one taxel's cavity rebuilds its
-    cap and the mold only; a move rebuilds the board's flat parts, mount and needles but no cap and no mold. ``built``
-    counts the parts built (name → times), for the tests."""
+    each tool of the mold (:class:`matcad.parts.recipe.Tool`) by its call, a cap's spec in it without the physics'
+    tables (:func:`_tool_key`), and the mold by its tools. An edit to one taxel's cavity rebuilds its cap and
+    meshes its mold tools only; a move rebuilds the board's flat parts, mount and needles but no cap and no mold
+    tool. ``built`` counts the parts built and the mold tools meshed (name → times), for the tests."""
 
     def __init__(self):
         from collections import Counter, OrderedDict
 
         self.solids: OrderedDict = OrderedDict()
         self.meshes: OrderedDict = OrderedDict()
+        self.tools: OrderedDict = OrderedDict()
         self.built: Counter = Counter()
 
     @staticmethod
-    def _get(store, key, make):
+    def _get(store, key, make, size: int = CACHE_SIZE):
         if key in store:
             store.move_to_end(key)
             return store[key]
         value = store[key] = make()
-        if len(store) > CACHE_SIZE:
+        if len(store) > size:
             store.popitem(last=False)
         return value
 
@@ -188,18 +199,54 @@ class PartCache:
         self.built[name] += 1
         return build()
 
-    def mold(self, spec, name: str):
-        """The printed mold part ``name`` of ``spec`` (design frame) and its key."""
-        from matcad.parts.registry import part
+    def mold(self, recipe) -> tuple:
+        """The printed mold part ``recipe`` makes (design frame) as a manifold3d mesh, made from its tools' meshes
+        (:func:`matcad.serve.tessellate.recipe_mesh`), and its key. Each tool is meshed once and kept (``built``
+        counts the tools meshed by their function's name)."""
+        from matcad.serve.tessellate import manifold, recipe_mesh
 
-        key = (name, _projection(spec, MOLD_IGNORES))
-        return self._get(self.solids, key, lambda: self._count(name, lambda: part(name).make(spec))), key
+        keys = {tool: _tool_key(tool) for tool in (recipe.stock, *recipe.add, *recipe.cut)}
+
+        def tool_meshes(tool):
+            return self._get(self.tools, keys[tool], lambda: self._count(
+                tool.make.__name__, lambda: [manifold(s, MESH_TOLERANCE_MM, ANGULAR_TOLERANCE_RAD)
+                                             for s in tool.solids()]), TOOL_CACHE_SIZE)
+
+        key = ("mold", *keys.values())
+        return self._get(self.solids, key, lambda: recipe_mesh(recipe, tool_meshes)), key
+
+    def mold_mesh(self, name: str, recipe, x: float, colour: str) -> tuple[dict, float]:
+        """The page's mesh of the mold part ``name`` (:meth:`mold`) set with its lowest x at ``x``, centred on
+        y = 0, its underside on z = 0, kept; and its length along x (mm)."""
+        mold, key = self.mold(recipe)
+        (x0, y0, z0), (x1, y1, _) = _corners(mold)
+        move = (x - x0, -(y0 + y1) / 2, -z0)
+
+        def draw():
+            mesh = mold.translate(move).to_mesh()
+            return _lists(name, colour, mesh.vert_properties[:, :3], mesh.tri_verts)
+
+        return self._get(self.meshes, (key, move, colour), draw) | {"name": name}, x1 - x0
 
     def mesh(self, key, name: str, solid, colour: str) -> dict:
         """:func:`_mesh` of ``solid`` (made from ``key``; its bounding box tells where it was placed), kept."""
         box = solid.bounding_box()
         where = tuple(round(c, 6) for c in (box.min.X, box.min.Y, box.min.Z, box.max.X, box.max.Y, box.max.Z))
         return self._get(self.meshes, (key, where, colour), lambda: _mesh(name, solid, colour)) | {"name": name}
+
+
+def _tool_key(tool) -> tuple:
+    """The key a mold tool's mesh is kept by: its function and arguments, a spec among them without the tables no
+    solid reads (:func:`_projection`)."""
+    from matcad.spec import Spec
+
+    return tool.make, tuple(_projection(a) if isinstance(a, Spec) else a for a in tool.args)
+
+
+def _corners(mesh) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """The lowest and highest corner of a manifold3d mesh's bounding box (mm)."""
+    x0, y0, z0, x1, y1, z1 = mesh.bounding_box()
+    return (x0, y0, z0), (x1, y1, z1)
 
 
 CACHE = PartCache()
@@ -221,15 +268,14 @@ def section(spec, cache: PartCache | None = None) -> dict:
 
 
 MESHES = {"mesh": ("assembly", "molds"), "assembly": ("assembly",), "molds": ("molds",)}
-"""A mesh request's ``what`` → the groups it draws: the page asks for the assembly, then the molds (slow on a
-board: the mold is rebuilt on any cap edit), so an edit made meanwhile waits for the assembly only."""
+"""A mesh request's ``what`` → the groups it draws: the page asks for the assembly, then the molds (the slower on
+a board: any cap edit meshes that cap's mold tools and redoes the mold's mesh booleans), so an edit made meanwhile
+waits for the assembly only."""
 
 
 def meshes(spec, cache: PartCache | None = None, groups=("assembly", "molds")) -> dict:
     """The meshes of the assembled parts (group "assembly") and of the cap mold's parts when the spec asks for the
     mold (group "molds"), the molds set beside the plate (+x), and the time it took (ms)."""
-    from build123d import Pos
-
     from matcad.parts.registry import part
     from matcad.render.section import layer_of, section_colours
 
@@ -242,13 +288,11 @@ def meshes(spec, cache: PartCache | None = None, groups=("assembly", "molds")) -
                else _mesh(name, solid, colours.get(layer_of(name), "#999999")) for name, solid in parts.items()]
     x = spec.plate.width / 2 + 6.0
     for name in MOLD_PARTS:
-        if "molds" not in groups or not part(name).wanted(spec):
-            continue
-        solid, key = cache.mold(spec, name)
-        box = solid.bounding_box()
-        placed = Pos(x - box.min.X, -(box.min.Y + box.max.Y) / 2, -box.min.Z) * solid
-        x += box.max.X - box.min.X + 4.0
-        out.append(cache.mesh(key, name, placed, "#b0b8c8" if name.endswith("lid") else "#8890a8"))
+        if "molds" in groups and part(name).wanted(spec):
+            mesh, length = cache.mold_mesh(name, part(name).recipe(spec), x,
+                                           "#b0b8c8" if name.endswith("lid") else "#8890a8")
+            out.append(mesh)
+            x += length + 4.0
     return {"parts": out, "ms": round(1e3 * (time.perf_counter() - t0))}
 
 
