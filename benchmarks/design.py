@@ -5,8 +5,9 @@ Capacity (``--capacity-only``): `design --taxels N` on a rigid-wall taxel whose 
 (calipered sheet, max force F, neck diameter, cavity diameter and length free per taxel; the neck length is the
 plate's sheet, one stock thickness per board), at 44.1 and 96 kHz: the most taxels that fit, whether `check`
 passes, and each taxel tracked on a synthetic board recording (matcad.loop.synth_board: every taxel singing in its
-listening band with 2f/3f at -20/-30 dB, presses to F on every third, a room; 5 seeds) — the per-taxel |mean error|
-and track RMS (Hz) over voiced frames, and per seed how many taxels are within 1 Hz and the worst one.
+listening band with 2f/3f at -20/-30 dB, presses to F on every third, a room heard from ``--mic-distance-m``,
+default the paper's 0.10 m; 5 seeds) — the per-taxel |mean error| and track RMS (Hz) over voiced frames, and per
+seed how many taxels are within 1 Hz and the worst one.
 
 Capacity figure (``--figure docs/capacity.png``): the most taxels that fit below 0.45 fs against the max force per
 taxel, at 44.1 and 96 kHz, for two routes with buildable caps (no tracking), and every design's loaded bands.
@@ -125,15 +126,19 @@ def _most_that_fit(s, n, band, vary):
     return None, why
 
 
-def capacity(forces=(5.0,), seeds=5):
+def capacity(forces=(5.0,), seeds=5, mic_distance_m=None):
     import tomllib
 
-    from matcad.loop import synth_board
+    from matcad.loop import synth, synth_board
     from matcad.loop.board import analyze_board
     from matcad.prediction.bands import listening_bands, taxel_bands
     from matcad.rules import check, errors
 
-    print("\ncapacity: taxels per microphone (rigid walls, Eq. 5 rise, calipered sheet; guard from the tracker)")
+    mic_distance_m = synth_board.MIC_DISTANCE_M if mic_distance_m is None else mic_distance_m
+    wet = synth.reverb_share(mic_distance_m, synth_board.BOARD_RT60_S)
+    print("\ncapacity: taxels per microphone (rigid walls, Eq. 5 rise, calipered sheet; guard from the tracker); "
+          f"board recordings heard from {mic_distance_m:.3f} m in the {synth.LAB_VOLUME_M3:g} m³ lab at RT60 "
+          f"{synth_board.BOARD_RT60_S:g} s (direct {-20 * np.log10(wet):+.1f} dB over the reverberant field)")
     print("| rate [kHz] | max force [N] | sheet [mm] | vary | asked | fit | reach [Hz] | check errors | design [s] | "
           "board: worst per-taxel |mean error| [Hz] | worst track RMS [Hz] | taxels with a tone | "
           "largest neck boundary-layer drop [%] |")
@@ -155,7 +160,7 @@ def capacity(forces=(5.0,), seeds=5):
             heard, per_seed = [], []
             for seed in range(seeds):
                 rec = synth_board.board_recording(listen, [b.rise for b in bands], force, seconds=6.0, seed=seed,
-                                                  fs=rate)
+                                                  fs=rate, mic_distance_m=mic_distance_m)
                 tracks = analyze_board([rec.x], rec.fs, listen)
                 count, errors_hz = 0, []
                 for k, t in enumerate(tracks):
@@ -270,6 +275,9 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser()
     parser.add_argument("--capacity-only", action="store_true")
     parser.add_argument("--seeds", type=int, default=5, help="synthetic board recordings per design")
+    parser.add_argument("--mic-distance-m", type=float, help="microphone distance of the board recordings (m; "
+                        "default the paper's 0.10; 0.31863968679372007, half the critical distance, is the +6 dB room "
+                        "the board recordings had before)")
     parser.add_argument("--figure", metavar="PNG", help="only the capacity sweep (--forces) and its figure "
                                                         "(docs/capacity.png)")
     parser.add_argument("--forces", type=float, nargs="+", default=[5.0, 2.0, 20.0],
@@ -281,4 +289,4 @@ if __name__ == "__main__":
         if not args.capacity_only:
             inverse_design()
             allocation()
-        capacity(seeds=args.seeds)
+        capacity(seeds=args.seeds, mic_distance_m=args.mic_distance_m)
