@@ -5,14 +5,18 @@ Capacity (``--capacity-only``): `design --taxels N` on a rigid-wall taxel whose 
 (calipered sheet, max force F, neck diameter, cavity diameter and length free per taxel; the neck length is the
 plate's sheet, one stock thickness per board), at 44.1 and 96 kHz: the most taxels that fit, whether `check`
 passes, and each taxel tracked on a synthetic board recording (matcad.loop.synth_board: every taxel singing in its
-listening band with 2f/3f at -20/-30 dB, presses to F on every third, a room; 5 seeds) — the per-taxel |mean error|
-and track RMS (Hz) over voiced frames, and per seed how many taxels are within 1 Hz and the worst one.
+listening band with 2f/3f at -20/-30 dB, presses to F on every third, a room heard from ``--mic-distance-m``,
+default the paper's 0.10 m; 5 seeds) — the per-taxel |mean error| and track RMS (Hz) over voiced frames, and per
+seed how many taxels are within 1 Hz and the worst one.
+
+Room shift (``--room-shift``): how far the board recordings' room alone moves a steady line's heard pitch, per
+microphone distance (:func:`room_shift`).
 
 Capacity figure (``--figure docs/capacity.png``): the most taxels that fit below 0.45 fs against the max force per
 taxel, at 44.1 and 96 kHz, for two routes with buildable caps (no tracking), and every design's loaded bands.
 
-Prints numbers, asserts nothing. Run: OMP_NUM_THREADS=1 .venv/bin/python benchmarks/design.py [--capacity-only |
---figure PNG]
+Prints numbers, asserts nothing. Run: OMP_NUM_THREADS=1 .venv/bin/python benchmarks/design.py [--capacity-only
+[--mic-distance-m M] | --room-shift | --figure PNG]
 """
 
 import dataclasses
@@ -125,15 +129,19 @@ def _most_that_fit(s, n, band, vary):
     return None, why
 
 
-def capacity(forces=(5.0,), seeds=5):
+def capacity(forces=(5.0,), seeds=5, mic_distance_m=None):
     import tomllib
 
-    from matcad.loop import synth_board
+    from matcad.loop import synth, synth_board
     from matcad.loop.board import analyze_board
     from matcad.prediction.bands import listening_bands, taxel_bands
     from matcad.rules import check, errors
 
-    print("\ncapacity: taxels per microphone (rigid walls, Eq. 5 rise, calipered sheet; guard from the tracker)")
+    mic_distance_m = synth_board.MIC_DISTANCE_M if mic_distance_m is None else mic_distance_m
+    wet = synth.reverb_share(mic_distance_m, synth_board.BOARD_RT60_S)
+    print("\ncapacity: taxels per microphone (rigid walls, Eq. 5 rise, calipered sheet; guard from the tracker); "
+          f"board recordings heard from {mic_distance_m:.3f} m in the {synth.LAB_VOLUME_M3:g} m³ lab at RT60 "
+          f"{synth_board.BOARD_RT60_S:g} s (direct {-20 * np.log10(wet):+.1f} dB over the reverberant field)")
     print("| rate [kHz] | max force [N] | sheet [mm] | vary | asked | fit | reach [Hz] | check errors | design [s] | "
           "board: worst per-taxel |mean error| [Hz] | worst track RMS [Hz] | taxels with a tone | "
           "largest neck boundary-layer drop [%] |")
@@ -155,7 +163,7 @@ def capacity(forces=(5.0,), seeds=5):
             heard, per_seed = [], []
             for seed in range(seeds):
                 rec = synth_board.board_recording(listen, [b.rise for b in bands], force, seconds=6.0, seed=seed,
-                                                  fs=rate)
+                                                  fs=rate, mic_distance_m=mic_distance_m)
                 tracks = analyze_board([rec.x], rec.fs, listen)
                 count, errors_hz = 0, []
                 for k, t in enumerate(tracks):
@@ -184,6 +192,51 @@ def capacity(forces=(5.0,), seeds=5):
             print("\n".join(f"    {line}" for line in per_seed))
             if len(bands) < n:
                 print(f"    ({n} asked: {why[:260]})")
+
+
+def room_shift(seeds=5, step_hz=0.1):
+    """How far the board recordings' room alone moves a steady line's heard pitch, per microphone distance: the
+    paper's 0.10 m, 0.20 m, half the critical distance (the +6 dB room the board recordings had before) and the
+    critical distance. The heard pitch is the peak of the expected frame spectrum — the taxel's Lorentzian line
+    times the room's |H(f)|² (synth.reverb's impulse response, the rooms of board_recording's seeds
+    0..``seeds``-1), smoothed by the tracker's Hann window's |W|² — against the line's centre, for tones every 7.3 Hz
+    over 2-12 kHz: the share of 1 Hz-wide lines (synth.taxel's) shifted by >= 0.5 and >= 1 Hz, the largest shift
+    (Hz), and the largest for a 0.05 Hz-wide line."""
+    from matcad.listening import window_samples
+    from matcad.loop import synth, synth_board
+
+    rt60 = synth_board.BOARD_RT60_S
+    rc = synth.critical_distance_m(synth.LAB_VOLUME_M3, rt60)
+    tones = np.arange(2000.0, 12000.0, 7.3)
+    offsets = np.arange(-40.0, 40.0 + step_hz / 2, step_hz)
+    core = offsets[np.abs(offsets) < 15.0]
+    lines = [1 / (1 + (2 * offsets / width) ** 2) for width in (1.0, 0.05)]
+    print(f"\nroom shift of a steady line (room alone: {synth.LAB_VOLUME_M3:g} m³ lab, RT60 {rt60:g} s, critical "
+          f"distance {rc:.2f} m; {len(tones) * seeds} tones 2-12 kHz)")
+    print("| rate [kHz] | distance [m] | direct over reverberant [dB] | 1 Hz line shifted >= 0.5 Hz | >= 1 Hz | "
+          "largest [Hz] | 0.05 Hz line: largest [Hz] |")
+    print("|---:|---:|---:|---:|---:|---:|---:|")
+    for fs in (44100.0, 96000.0):
+        n = window_samples(fs)
+        window = np.hanning(n + 1)[:-1]
+        lags = np.arange(-80.0, 80.0 + step_hz / 2, step_hz)
+        w2 = np.abs(np.exp(-2j * np.pi * np.outer(lags, np.arange(n)) / fs) @ window) ** 2
+        smooth = w2[np.round((core[:, None] - offsets[None, :]) / step_hz).astype(int) + len(lags) // 2]
+        impulse = np.zeros(int(rt60 * fs) + 1)
+        impulse[0] = 1.0
+        for r in (0.10, 0.20, rc / 2, rc):
+            wet = synth.reverb_share(r, rt60)
+            shifts = []
+            for seed in range(seeds):
+                h = synth.reverb(impulse, fs, rt60, seed + 1, wet)
+                h2 = np.abs(np.fft.rfft(h, int(round(fs / step_hz)))) ** 2
+                for f in tones:
+                    i = int(round(f / step_hz)) - len(offsets) // 2
+                    room = h2[i: i + len(offsets)]
+                    shifts.append([core[np.argmax(smooth @ (line * room))] for line in lines])
+            wide, narrow = np.abs(np.array(shifts)).T
+            print(f"| {fs / 1e3:g} | {r:.2f} | {-20 * np.log10(wet) + 0.0:+.1f} | {100 * np.mean(wide >= 0.5):.1f} % | "
+                  f"{100 * np.mean(wide >= 1.0):.1f} % | {wide.max():.1f} | {narrow.max():.1f} |", flush=True)
 
 
 SWEEP = ((44100.0, (1700.0, 19800.0), 1.5875, 40), (96000.0, (1700.0, 43000.0), 0.8, 48))
@@ -270,6 +323,11 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser()
     parser.add_argument("--capacity-only", action="store_true")
     parser.add_argument("--seeds", type=int, default=5, help="synthetic board recordings per design")
+    parser.add_argument("--room-shift", action="store_true", help="only the room's shift of a steady line per "
+                        "microphone distance (no design)")
+    parser.add_argument("--mic-distance-m", type=float, help="microphone distance of the board recordings (m; "
+                        "default the paper's 0.10; 0.31863968679372007, half the critical distance, is the +6 dB room "
+                        "the board recordings had before)")
     parser.add_argument("--figure", metavar="PNG", help="only the capacity sweep (--forces) and its figure "
                                                         "(docs/capacity.png)")
     parser.add_argument("--forces", type=float, nargs="+", default=[5.0, 2.0, 20.0],
@@ -277,8 +335,10 @@ if __name__ == "__main__":
     args = parser.parse_args()
     if args.figure:
         capacity_sweep(args.forces, args.figure)
+    elif args.room_shift:
+        room_shift()
     else:
         if not args.capacity_only:
             inverse_design()
             allocation()
-        capacity(seeds=args.seeds)
+        capacity(seeds=args.seeds, mic_distance_m=args.mic_distance_m)

@@ -185,6 +185,58 @@ def test_taxels_bands_are_disjoint_inside_the_band_and_check_accepts(tmp_path, w
     assert [t["name"] for t in json.loads(stdout)["taxels"]] == ["t1", "t2", "t3"]
 
 
+@pytest.mark.parametrize("vary, widest", [({"neck.diameter": None}, 3.18), ({"neck.diameter": (0.5, 7.0)}, 7.0)],
+                         ids=["default", "to-7mm"])
+def test_taxel_layout_is_jet_free_by_construction(vary, widest):
+    """Issue 24: the old square grid put a row's necks in the upstream needles' jets (18 board.jet findings on the
+    12-taxel board). The stagger board_base lays out for 2-24 taxels of templates/mat-array-4.toml's needle and
+    neck, every neck the widest the --vary range allows (the worst case; the cavity as wide where it must be), gets
+    no board.jet finding and no error from the board rules themselves; its pitch is the least that does: half a
+    row flatter by one step, a neck is in a jet (when the jet, not the flange spacing, sets the pitch)."""
+    from types import SimpleNamespace
+
+    from matcad.design.allocate import (LAYOUT_STEPS_PER_MM, array_spec, board_base, stagger, stagger_pitch,
+                                        widest_neck_mm)
+    from matcad.rules import board
+
+    template = spec_mod.load(ROOT / "templates" / "mat-array-4.toml")
+    base = spec_mod.taxel_spec(template, spec_mod.taxels(template)[0])
+    assert widest_neck_mm(base, vary) == widest
+    solved = SimpleNamespace(fields={"neck.diameter": (base.neck.diameter, widest),
+                                     "cavity.diameter": (base.cavity.diameter, max(widest, base.cavity.diameter))})
+    for n in range(2, 25):
+        plate, points = board_base(base, n, vary)
+        spec = array_spec(plate, points, [solved] * n, f"s{n}")
+        found = [f for rule in (board.plate_fit, board.spacing, board.jet_interference, board.plate_ligaments,
+                                board.bore_crossings) for f in rule(spec) if f.id == "board.jet" or f.level == "error"]
+        assert found == [], (n, [f.message for f in found])
+        assert len({x for x, _ in points}) == 2 and len({y for _, y in points}) == n
+    pitch_x, half_row = stagger_pitch(base, widest)
+    pitch = spec_mod.cap_flange_diameter_mm(base) + base.machine.laser_min_feature
+    flatter = half_row - 1 / LAYOUT_STEPS_PER_MM
+    if flatter >= pitch / 2:
+        assert board.jet_interference(array_spec(plate, stagger(3, pitch_x, flatter), [solved] * 3, "flatter"))
+    else:  # the flange spacing sets the pitch: a hexagonal packing, every neighbour a pitch apart
+        assert vary["neck.diameter"] is None and (pitch_x, half_row) == (11.3, pitch / 2)
+
+
+def test_designed_board_has_no_jet_finding(tmp_path, write_spec):
+    """`design --taxels 4` writes two staggered columns that `check` passes with no board.jet finding (the old 2 x 2
+    grid put t2's neck in t1's jet and t4's in t3's)."""
+    out = tmp_path / "arr"
+    code, stdout, err = run_cli("design", _array_base(write_spec), "--taxels", "4", "--band", "3500", "7000",
+                                "--out", out, "--json")
+    assert code == 0, err
+    path = out / f"{json.loads(stdout)['name']}.toml"
+    board = spec_mod.taxels(spec_mod.load(path))
+    assert [t.x < 0 for t in board] == [True, False, True, False]
+    assert [a.y > b.y for a, b in zip(board, board[1:])] == [True] * 3
+    code, stdout, err = run_cli("check", path, "--json")
+    assert code == 0, stdout + err
+    ids = [f["id"] for f in json.loads(stdout)["findings"]]
+    assert "bands.allocation" in ids and "board.jet" not in ids
+
+
 def test_taxels_that_do_not_fit_exit_2(tmp_path, write_spec):
     code, _, err = run_cli("design", _array_base(write_spec, "20.0"), "--taxels", "4", "--band", "4000", "5000",
                            "--out", tmp_path / "d")

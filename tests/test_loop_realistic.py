@@ -224,3 +224,30 @@ def test_temperature_compensation(tmp_path):
     assert raw[0] - 10.0 > 0.5 and fixed[0] == pytest.approx(10.0, abs=1e-6)
     with pytest.raises(ValueError, match="temperature"):
         cal.force_with_interval([heard], temperature_c=500.0)
+
+
+def test_room_reverberant_share_follows_the_microphone_distance():
+    """The synthetic room (synth.reverb) at a microphone distance: the critical distance r_c ≈ 0.057·sqrt(V/T60)
+    against Sabine's absorption area from first principles (A = 24·ln10·V/(c·T60), c = 343 m/s; r_c = sqrt(A/16π))
+    within 1 %; the impulse response's direct-to-reverberant energy ratio (r_c/r)² within 1 %; and what it does to a
+    steady 1 Hz-wide line at 4805 Hz, 96 kHz, in seed 1's room (the 16-taxel board's t7, issue 24): mean over
+    4 line realisations 2.1 Hz high at r_c/2 (the +6 dB room the board recordings had), within 0.5 Hz at the
+    paper's 10 cm (+16 dB)."""
+    volume, rt60, fs = synth.LAB_VOLUME_M3, 0.4, 96000.0
+    rc = synth.critical_distance_m(volume, rt60)
+    assert rc == pytest.approx(np.sqrt(24 * np.log(10) * volume / (343.0 * rt60) / (16 * np.pi)), rel=0.01)
+    impulse = np.zeros(int(0.5 * fs))
+    impulse[0] = 1.0
+    for r in (0.10, rc / 2):
+        h = synth.reverb(impulse, fs, rt60, 3, wet=synth.reverb_share(r, rt60))
+        assert 1.0 / np.sum(h[1:] ** 2) == pytest.approx((rc / r) ** 2, rel=0.01)
+    f, n = 4805.33, int(6.0 * fs)
+    shift = {}
+    for r in (0.10, rc / 2):
+        errors = []
+        for seed in range(4):
+            x = synth.taxel(np.full(n, f), fs, seed, harmonics_db=synth.HARMONICS_DB)
+            a = analyze(synth.room(x, fs, 1, rt60=rt60, wet=synth.reverb_share(r, rt60)), fs, (4700.0, 5200.0))
+            errors.append(np.mean(a.track_hz[a.voiced]) - f)
+        shift[r] = np.mean(errors)
+    assert abs(shift[0.10]) < 0.5 and shift[rc / 2] > 1.0, shift

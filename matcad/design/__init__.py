@@ -3,7 +3,7 @@
 - :mod:`matcad.design.solve` — one taxel's f0 onto a target by varying chosen fields (stock sheet thickness
   first, then the continuous fields by root finding), within the design rules;
 - :mod:`matcad.design.allocate` — N disjoint bands (guard and harmonic rule) in [LO, HI], one taxel solved for
-  each, placed on a grid as an array spec;
+  each, in two staggered columns clear of every needle's jet, as an array spec;
 - :mod:`matcad.design.spec_toml` — a validated spec written back as TOML that `matcad check` reads.
 
 Frequencies Hz, lengths mm. Errors: :class:`Unreachable` (a ValueError: the CLI's exit 2, bad input, naming the

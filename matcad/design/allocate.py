@@ -1,4 +1,4 @@
-"""N taxels sharing one microphone: N disjoint bands in [LO, HI], one taxel solved for each, on a grid.
+"""N taxels sharing one microphone: N disjoint bands in [LO, HI], one taxel solved for each, jet-free on the plate.
 
 Bands are placed upward from LO. For taxel k the allocation starts at ``start`` (LO, or the previous loaded band's
 top plus the guard, :func:`matcad.prediction.bands.guard_hz`); its f0 is the lowest target whose solved geometry
@@ -7,9 +7,11 @@ rise to ``mechanics.max_force_n``) starting at or above ``start``, found by bise
 by side, the guard apart, whether or not another taxel's 2f or 3f lands in them: the board tracker discounts a
 predicted harmonic (:func:`matcad.loop.board.discount_harmonics`; issue 24 — the band used to be moved above the
 harmonic, which sent the 4th band of 2.5-12 kHz to 11.7 kHz). Every band must end at or below HI; otherwise the
-message says how far the N bands reach. The taxels go on a grid (columns = ceil(√N)) of [[taxel]] entries with the
-pitch of the largest cap flange plus the laser's smallest web, on a plate grown by the grid's extent. Frequencies
-Hz, lengths mm.
+message says how far the N bands reach. The taxels go in two staggered columns of [[taxel]] entries
+(:func:`stagger`: every neck downstream of a needle sits between two of its rows) with the pitches that keep the
+cap flanges the laser's smallest web apart and every neck out of every jet (:func:`stagger_pitch`, the
+``board.jet`` rule's geometry), on a plate grown by the layout's extent; the written array must pass every rule
+with no ``board.jet`` finding. Frequencies Hz, lengths mm.
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ TARGET_MARGIN = 1e-3
 """Relative precision of each taxel's f0 target (the bisection stops there: 5 Hz at 5 kHz)."""
 STEP_UP = 0.03
 """Relative step up of the target while looking for a first band that clears its start."""
+LAYOUT_STEPS_PER_MM = 10
+"""The layout's pitches are whole tenths of a millimetre: necks at multiples of 0.05 mm, readable in the spec."""
 PER_TAXEL = {"neck.diameter": "neck_diameter", "cavity.diameter": "cavity_diameter",
              "cavity.length": "cavity_length"}
 """Fields a [[taxel]] entry may set for itself (the neck length is the plate's sheet, shared)."""
@@ -99,25 +103,60 @@ def _one(base, name: str, start: float, stop: float, vary, ratio: float):
     return solution, taxel_band(solution.spec, name)
 
 
-def grid(n: int, pitch: float) -> list[tuple[float, float]]:
-    """Neck positions (mm) of n taxels on a grid of ceil(√n) columns centred on the plate, row by row from the top."""
-    columns = math.ceil(math.sqrt(n))
-    rows = math.ceil(n / columns)
-    return [((c - (columns - 1) / 2) * pitch, ((rows - 1) / 2 - r) * pitch)
-            for r in range(rows) for c in range(columns)][:n]
+def stagger(n: int, pitch_x: float, half_row: float) -> list[tuple[float, float]]:
+    """Neck positions (mm) of n taxels in two columns ``pitch_x`` apart, centred on the plate, from the top: taxel
+    i (0-based) in the left column when i is even, at y = ((n − 1)/2 − i) · ``half_row`` — the right column sits
+    half a row lower, so every neck downstream (+x) of a needle lies between two of its rows, as in
+    templates/mat-array-4.toml."""
+    return [((i % 2 - 0.5) * pitch_x, ((n - 1) / 2 - i) * half_row) for i in range(n)]
 
 
-def board_base(base, n: int):
-    """(the single-taxel spec every taxel is solved on, the n grid positions): the pitch is the cap flange plus
-    the laser's smallest web (the varied fields leave the cap's footprint alone: its outside is resolved), and the
-    plate grows by the grid's extent — before solving, because the mount mouth's end correction depends on the
-    plate (mm)."""
-    from matcad.spec import cap_flange_diameter_mm
+def widest_neck_mm(base, vary) -> float:
+    """The widest neck the solver may give a taxel (mm): the top of its ``--vary neck.diameter`` range (the route
+    stays inside it), else the base's neck; never past the cap's outside (the neck fits in the cavity, the cavity
+    in the cap: :func:`matcad.spec.checks.geometry_invalid`)."""
+    from matcad.design.solve import default_range
 
-    points = grid(n, cap_flange_diameter_mm(base) + base.machine.laser_min_feature)
+    top = (vary["neck.diameter"] or default_range(base, "neck.diameter"))[1] if "neck.diameter" in vary \
+        else base.neck.diameter
+    return min(top, base.end_cap.outer_diameter)
+
+
+def stagger_pitch(base, neck_mm: float) -> tuple[float, float]:
+    """(pitch_x, half_row) in mm of the flattest :func:`stagger` that keeps every cap flange the laser's smallest web
+    from its neighbours and every neck out of every needle's jet (``board.jet``: the rule's own
+    :func:`matcad.rules.board.jet_clearance_mm` >= 0), for ``base``'s taxel with a ``neck_mm`` neck (the widest it
+    may get: a wider neck moves its needle upstream and opens a wider mouth, so it clears less). ``half_row``
+    rises from half the pitch (a hexagonal packing: every neighbour at the pitch) in steps of
+    1/:data:`LAYOUT_STEPS_PER_MM`, ``pitch_x`` the least such multiple that keeps the two columns' neighbours a
+    pitch apart (0 from ``half_row`` = pitch on: one column, where the clearance grows with ``half_row``, so the
+    search ends); three taxels hold every relative position to test — pairs further apart in y clear by more."""
+    from matcad.rules.board import jet_clearance_mm
+    from matcad.spec import cap_flange_diameter_mm, taxels
+
+    pitch = cap_flange_diameter_mm(base) + base.machine.laser_min_feature
+    one = taxels(base)[0]
+    one = dataclasses.replace(one, neck=dataclasses.replace(one.neck, diameter=neck_mm))
+    steps = math.ceil(pitch / 2 * LAYOUT_STEPS_PER_MM)
+    while True:
+        half_row = steps / LAYOUT_STEPS_PER_MM
+        pitch_x = math.ceil(math.sqrt(max(pitch ** 2 - half_row ** 2, 0.0)) * LAYOUT_STEPS_PER_MM)
+        pitch_x /= LAYOUT_STEPS_PER_MM
+        probe = [dataclasses.replace(one, x=x, y=y) for x, y in stagger(3, pitch_x, half_row)]
+        if all(min(jet_clearance_mm(a, b)) >= 0 for a in probe for b in probe if a is not b):
+            return pitch_x, half_row
+        steps += 1
+
+
+def board_base(base, n: int, vary):
+    """(the single-taxel spec every taxel is solved on, the n :func:`stagger` positions, jet-free for the widest
+    neck ``vary`` allows, :func:`stagger_pitch`): the varied fields leave the cap's footprint alone (its outside is
+    resolved), and the plate grows by the layout's extent — before solving, because the mount mouth's end
+    correction depends on the plate (mm)."""
+    points = stagger(n, *stagger_pitch(base, widest_neck_mm(base, vary)))
     xs, ys = [p[0] for p in points], [p[1] for p in points]
-    plate = dataclasses.replace(base.plate, width=base.plate.width + max(xs) - min(xs),
-                                depth=base.plate.depth + max(ys) - min(ys))
+    plate = dataclasses.replace(base.plate, width=round(base.plate.width + max(xs) - min(xs), 6),
+                                depth=round(base.plate.depth + max(ys) - min(ys), 6))
     return dataclasses.replace(base, plate=plate), points
 
 
@@ -143,7 +182,7 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
     from matcad.listening import guard_hz
     from matcad.prediction.bands import taxel_band
-    from matcad.rules import check, errors
+    from matcad.rules import check
     from matcad.spec import MAX_TAXELS, taxel_spec, taxels
 
     start_time = time.perf_counter()
@@ -155,7 +194,7 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     if bad:
         raise ValueError(f"--vary {bad[0]}: with --taxels only per-taxel fields vary: {', '.join(CONTINUOUS)} "
                          "(the neck length is the plate's sheet, shared by every taxel)")
-    base, points = board_base(taxel_spec(spec, taxels(spec)[0]), n)
+    base, points = board_base(taxel_spec(spec, taxels(spec)[0]), n, vary)
     guard = guard_hz(spec.microphone.sample_rate_hz)
     shape = taxel_band(base)
     ratio = shape.f0_hz / shape.loaded_hz[0]
@@ -180,8 +219,9 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
         start = band.loaded_hz[1] + guard
     out = array_spec(base, points, solutions, name or f"{spec.name}-{n}taxels")
     findings = check(out)
-    if errors(findings):
-        bad = "; ".join(f"{f.id}: {f.message}" for f in errors(findings))
+    broken = [f for f in findings if f.level == "error" or f.id == "board.jet"]
+    if broken:  # board.jet cannot fire on the stagger (stagger_pitch): checked on the solved necks all the same
+        bad = "; ".join(f"{f.id}: {f.message}" for f in broken)
         raise RulesFailed(f"the {n}-taxel array breaks a design rule: {bad}", findings)
     placed = [dataclasses.replace(b, x_mm=t.x, y_mm=t.y) for b, t in zip(placed, taxels(out))]
     return Allocation(out, tuple(placed), tuple(solutions), guard, (lo_hz, hi_hz), time.perf_counter() - start_time)

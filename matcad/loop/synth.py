@@ -157,8 +157,32 @@ def speech_like(n: int, fs: float, seed: int, rms: float = 0.02) -> np.ndarray:
     return rms * x / max(np.std(x), 1e-12)
 
 
+LAB_VOLUME_M3 = 50.0
+"""Volume of the lab room of the synthetic board recordings (m³): a small lab, 4 x 5 x 2.5 m."""
+
+
+def critical_distance_m(volume_m3: float, rt60_s: float) -> float:
+    """Critical (reverberation) distance (m) of an omnidirectional source in a diffuse room of ``volume_m3`` (m³)
+    with reverberation time ``rt60_s`` (s): where the direct sound's energy density equals the reverberant field's,
+    r_c = sqrt(A/16π) with Sabine's absorption area A = 0.163·V/T60 (m²), r_c ≈ 0.057·sqrt(V/T60) (Kuttruff, Room
+    Acoustics, ch. 5, the reverberation distance). At a distance r the direct-to-reverberant energy ratio is
+    (r_c/r)²: 50 m³ at RT60 0.4 s gives r_c = 0.64 m."""
+    return 0.057 * float(np.sqrt(volume_m3 / rt60_s))
+
+
+def reverb_share(distance_m: float, rt60_s: float, volume_m3: float = LAB_VOLUME_M3) -> float:
+    """The ``wet`` of :func:`reverb` for a microphone ``distance_m`` (m) from the source in a diffuse room
+    (m³, s): r/r_c, the reverberant field's RMS over the direct sound's, so that the direct-to-reverberant
+    energy ratio is (r_c/r)² (:func:`critical_distance_m`)."""
+    return distance_m / critical_distance_m(volume_m3, rt60_s)
+
+
 def reverb(x: np.ndarray, fs: float, rt60_s: float, seed: int, wet: float = 0.5) -> np.ndarray:
-    """Room: ``x`` convolved with an exponentially decaying noise impulse response (−60 dB after ``rt60_s``)."""
+    """Room: ``x`` convolved with an impulse response of the direct sound (a unit impulse) plus an exponentially
+    decaying noise tail (−60 dB after ``rt60_s``, s) of total energy ``wet``²: a steady tone's reverberant field
+    has ``wet`` times the direct sound's RMS, a direct-to-reverberant ratio of −20·log10(``wet``) dB (0.5: +6 dB,
+    a microphone at half the critical distance, :func:`reverb_share`). The tail's spectrum is a random one: at
+    any frequency the room's response differs from the direct sound's by a draw whose spread grows with ``wet``."""
     from scipy.signal import oaconvolve
 
     rng = np.random.default_rng(seed)
@@ -199,9 +223,10 @@ def _base(seconds, fs, seed, force, gate=None, amplitude=0.1, freq=None):
     return x, truth
 
 
-def room(x, fs, seed, rt60=0.5, pink_rms=0.01):
-    """``x`` heard in a room: reverb of RT60 ``rt60`` (s), pink noise of RMS ``pink_rms``, the tablet microphone."""
-    return microphone(reverb(x, fs, rt60, seed + 1) + coloured_noise(len(x), fs, seed + 2, 1.0, pink_rms), fs)
+def room(x, fs, seed, rt60=0.5, pink_rms=0.01, wet=0.5):
+    """``x`` heard in a room: reverb of RT60 ``rt60`` (s) and reverberant share ``wet`` (:func:`reverb`), pink
+    noise of RMS ``pink_rms``, the tablet microphone."""
+    return microphone(reverb(x, fs, rt60, seed + 1, wet) + coloured_noise(len(x), fs, seed + 2, 1.0, pink_rms), fs)
 
 
 def scenario(name: str, seconds: float = 10.0, seed: int = 0, fs: float = FS) -> Recording:
@@ -319,7 +344,9 @@ def board_scenario(seconds: float = 10.0, seed: int = 0, fs: float = FS, f0_hz=B
                    pressed=(1, 3), amplitudes=(0.1, 0.3, 0.1, 0.15)) -> BoardRecording:
     """Four taxels singing at once in a room (pink noise, reverb RT60 0.4 s, tablet microphone): the ``pressed``
     ones (0-based) pressed 2 → 12 N for 0.8 s every 2 s (0.15 s ramps, the two out of phase), the others held at
-    4 N; amplitudes differ (taxel 2 is 10 dB louder than taxel 1, its lower neighbour)."""
+    4 N; amplitudes differ (taxel 2 is 10 dB louder than taxel 1, its lower neighbour). The room's reverberant
+    share is :func:`room`'s 0.5 (direct sound +6 dB: a microphone at half the critical distance, 0.32 m in the
+    50 m³ lab, :func:`reverb_share`), farther than :mod:`matcad.loop.synth_board`'s paper-like 0.10 m."""
     n = int(seconds * fs)
     forces, freqs = [], []
     for k, f0 in enumerate(f0_hz):

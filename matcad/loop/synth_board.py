@@ -43,14 +43,27 @@ def press_forces(seconds: float, fs: float, max_force_n: float, phase: float, pe
                                base_n=rest_share * max_force_n)
 
 
+MIC_DISTANCE_M = 0.10
+"""Microphone distance of the board recordings (m): the paper recorded "from approximately 10 cm in front of the
+testing configuration"."""
+BOARD_RT60_S = 0.4
+"""Reverberation time of the board recordings' lab (s)."""
+
+
 def board_recording(bands, rises, max_force_n: float, seconds: float = 8.0, seed: int = 0, fs: float = synth.FS,
                     pressed=None, harmonics_db=synth.HARMONICS_DB, level_spread_db: float = 6.0,
-                    rt60_s: float = 0.4, silent=()) -> synth.BoardRecording:
+                    rt60_s: float = BOARD_RT60_S, silent=(),
+                    mic_distance_m: float = MIC_DISTANCE_M) -> synth.BoardRecording:
     """Every taxel of a board singing at once in a room (pink noise, reverb, tablet microphone): ``bands`` (name,
     (low, high) Hz) are the listening bands, ``rises`` each taxel's f(max)/f(0); the ``pressed`` ones (indices;
     default every third from the second) pressed to ``max_force_n`` (N) at staggered times, the others held at 20
     %; levels spread uniformly over ±``level_spread_db``/2 dB; harmonics at ``harmonics_db``; the ``silent`` ones
-    (indices) do not sing (truth NaN)."""
+    (indices) do not sing (truth NaN).
+
+    The room is the lab of :data:`synth.LAB_VOLUME_M3` with reverberation time ``rt60_s`` (s), heard
+    ``mic_distance_m`` (m) from the board: its reverberant share follows from the critical distance
+    (:func:`synth.reverb_share`; 0.10 m at RT60 0.4 s: r_c = 0.64 m, direct sound +16 dB over the reverberant
+    field). The taxels' levels are the direct sound's at the microphone."""
     rng = np.random.default_rng(seed)
     n = int(seconds * fs)
     pressed = range(1, len(bands), 3) if pressed is None else pressed
@@ -66,7 +79,7 @@ def board_recording(bands, rises, max_force_n: float, seconds: float = 8.0, seed
     x = sum(synth.taxel(f, fs, seed + 11 * k, amplitude=a, harmonics_db=harmonics_db)
             for k, (f, a) in enumerate(zip(freqs, amps)) if k not in silent)
     freqs = [np.full(n, np.nan) if k in silent else f for k, f in enumerate(freqs)]
-    x = synth.room(x, fs, seed, rt60=rt60_s)
+    x = synth.room(x, fs, seed, rt60=rt60_s, wet=synth.reverb_share(mic_distance_m, rt60_s))
     return synth.BoardRecording(x, fs, tuple(names), np.array(freqs), np.array(forces),
                                 tuple(tuple(b) for _, b in bands))
 
