@@ -9,7 +9,9 @@ makes every top node a unilateral frictionless contact (``MultiPointContact``, a
 outside of the body may roll onto the plate without friction. F is the plate's reaction (N, the whole ring).
 
 Load steps are equal plate increments to ``displacement_mm``; a step whose Newton iterations (at most
-``MAX_NEWTON``) do not converge, or that inverts a cell, is cut in half, at most ``MAX_CUTS`` times, and a whole
+``MAX_NEWTON``) do not converge, that inverts a cell, or that ends in a state the model cannot hold (a cell's
+volume ratio off 1 by more than ``J_TOLERANCE``, or a cavity larger than at the step before: the cavity surface
+folded through itself, whose self-contact is not modelled), is cut in half, at most ``MAX_CUTS`` times, and a whole
 curve spends at most ``NEWTON_BUDGET_PER_STEP`` × max(steps, ``BUDGET_MIN_STEPS``) iterations; past either bound
 the curve stops at the last converged step and :attr:`CapCurve.message` says where and why. A failed step restores
 the last converged state of every item that keeps one (FElupe's ``checkpoint``/``restore``): the displacements and
@@ -39,6 +41,11 @@ BUDGET_MIN_STEPS = 10
 BUDGET_MIN_STEPS): a bound on the run time. A curve asked in fewer steps than the default 10 gets the default's
 budget, since its step cuts make the steps it did not ask for (1 step ran out after its first cut before)."""
 NEWTON_TOL = 1e-8
+J_TOLERANCE = 0.01
+"""A converged step whose cells' volume ratio J leaves 1 ± this is not a state of the silicone: K/G = 1000 keeps J
+within 1e-3 of 1 at the cap's stresses (:data:`matcad.mechanics.material.BULK_PER_SHEAR`), so ten times that is a
+hydrostatic stress of ~10 G, met only where the cavity's creased surface passes through itself (Ogden thin top and
+thick cap at 40 % travel: J 0.974 and 0.981, the cavity volume jumping from 5.9 to 24.0 mm³)."""
 PENALTY_PER_G_MM = 1e5
 """Contact penalty = this × G × outer radius (N/mm): a plate penetration below 1e-4 mm at the cap's forces."""
 
@@ -153,6 +160,24 @@ def cap_curve(case, progress=None) -> CapCurve:
     return curve
 
 
+class UnphysicalStep(ArithmeticError):
+    """A step converged to a state the model cannot hold (:func:`unphysical`): cut like one that did not converge."""
+
+
+def unphysical(j_range: tuple[float, float], volume_mm3: float, previous_mm3: float) -> str:
+    """Why a converged step is not a state of the pressed silicone cap ('' when it is): its cells' volume ratio
+    range ``j_range`` leaves 1 ± :data:`J_TOLERANCE`, or its cavity (``volume_mm3``, mm³) is not smaller than at the
+    step before (``previous_mm3``; a body without a cavity, 0, is not checked): a press only shrinks the cavity; it
+    grows when the creased surface has folded through itself, whose self-contact is not modelled."""
+    if max(1 - j_range[0], j_range[1] - 1) > J_TOLERANCE:
+        return (f"a cell's volume ratio J = {j_range[0]:.4f}-{j_range[1]:.4f} left 1 ± {J_TOLERANCE:g} (nearly "
+                "incompressible silicone)")
+    if previous_mm3 > 0 and not volume_mm3 < previous_mm3:
+        return (f"the cavity grew from {previous_mm3:.4g} to {volume_mm3:.4g} mm³ under the press (its surface "
+                "folded through itself)")
+    return ""
+
+
 def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking", displacement_mm: float = 2.0,
              steps: int = 10, element_size_mm: float | None = None, mesh: CapMesh | None = None,
              linear: bool = False, progress=None) -> CapCurve:
@@ -209,6 +234,7 @@ def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking",
     v0 = cavity_volume_mm3(outline0)
     volumes0 = _cell_volumes_mm3(cm.points, cm.cells)
     centres, hot = cm.points[cm.cells].mean(axis=1), np.zeros(2)
+    converged = [v0]  # the cavity volume (mm³) of the last converged step, sub-steps included
 
     def solve_at(x):
         plate.value = -x
@@ -227,7 +253,11 @@ def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking",
         j_range = (float(ratio.min()), float(ratio.max()))
         force = float(-res.fun.reshape(-1, 2)[ref, 0])
         outline = deformed[cm.cavity]
-        return res.iterations, CapStep(x, force, cavity_volume_mm3(outline), outline, strain, j_range)
+        volume = cavity_volume_mm3(outline)
+        problem = unphysical(j_range, volume, converged[-1])
+        if problem:
+            raise UnphysicalStep(problem)
+        return res.iterations, CapStep(x, force, volume, outline, strain, j_range)
 
     results: list[CapStep] = []
     step = displacement_mm / steps
@@ -252,13 +282,15 @@ def compress(sec: CapSection, material: Hyperelastic, contact: str = "sticking",
                     reason = str(exc).strip().splitlines()[0]
                     crease = _singular_corner(cm, sec, hot)
                     message = (f"stopped at x = {x_done:.4g} mm (last converged step) of {displacement_mm:g} mm: "
-                               f"no convergence at x = {x_done + dx:.4g} mm after {MAX_CUTS} step cuts ({reason}); "
+                               f"{'no physical state' if isinstance(exc, UnphysicalStep) else 'no convergence'} "
+                               f"at x = {x_done + dx:.4g} mm after {MAX_CUTS} step cuts ({reason}); "
                                f"G = {material.shear_modulus_mpa:g} MPa, top {sec.top_thickness:g} mm; peak strain "
                                f"{results[-1].peak_strain if results else 0:.2f} in the cell at r = {hot[0]:.2f}, "
                                f"z = {hot[1]:.2f} mm{crease}")
                     break
                 continue
             iterations += its
+            converged.append(state.cavity_volume_mm3)
             x_done = x_done + dx
             inc = min(step, 2 * dx)
         if message:
