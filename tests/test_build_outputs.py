@@ -345,7 +345,7 @@ def test_print_job_3mf_read_back(built):
     say how the mold base's captive nuts go in on either printer (at the pause, or pressed in after printing)."""
     import zipfile
 
-    from matcad.export.threemf import BED_MM
+    from matcad.export.threemf import bed_mm
     from matcad.parts.print_profile import profile
 
     spec, out, _ = built
@@ -371,7 +371,7 @@ def test_print_job_3mf_read_back(built):
             assert mesh.volume == pytest.approx(trimesh.load_mesh(out / f"{name}.stl").volume, rel=1e-6)
             lo, hi = mesh.bounds
             assert lo[2] == pytest.approx(0.0, abs=1e-6)
-            assert lo[0] >= 0 and lo[1] >= 0 and hi[0] <= BED_MM[printer][0] and hi[1] <= BED_MM[printer][1]
+            assert lo[0] >= 0 and lo[1] >= 0 and hi[0] <= bed_mm(spec)[0] and hi[1] <= bed_mm(spec)[1]
             boxes.append((lo[0], lo[1], hi[0], hi[1]))
         for i, a in enumerate(boxes):
             for b in boxes[i + 1:]:
