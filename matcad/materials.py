@@ -99,3 +99,8 @@ def grade(key: str) -> SiliconeGrade:
         return GRADES[key]
     except KeyError:
         raise ValueError(f"{key!r} invalid, must be one of {', '.join(GRADES)}") from None
+
+
+ACRYLIC_MODULUS_MPA = 3300.0
+"""Young's modulus of cast acrylic (PMMA) sheet, the neck plate's: 3300 MPa, Röhm PLEXIGLAS GS product information
+(tensile modulus, ISO 527-2/1B/1, 23 °C). Extruded sheet is within ~5 % of it."""
