@@ -631,3 +631,22 @@ def test_previews_show_bores_cavities_and_pockets(built):
             inner = edge[rows[0] + 4:rows[-1] - 4, cols[0] + 4:cols[-1] - 4]
             _, n = ndimage.label(inner, structure=np.ones((3, 3)))
             assert n >= len(end_cap_mold_layout(spec).cap_x) + 2, (name, n)
+
+
+def test_bed_rules_extents_are_the_files(built):
+    """What print.bed and laser.bed hold to the beds is what the build wrote: each printed STL's bounds (as
+    exported, in its print pose) equal its registry extent, and each nested sheet's DXF (outlines and reference
+    square) spans the extents the rule reads."""
+    from matcad.export.sheets import kit_sheets
+    from matcad.parts.registry import Kind, wanted
+
+    spec, out, _ = built
+    for part in wanted(spec, Kind.PRINTED):
+        lo, hi = trimesh.load_mesh(out / f"{part.name}.stl").bounds
+        assert tuple(hi - lo) == pytest.approx(part.extent(spec), abs=1e-3), part.name
+    for plan in kit_sheets(spec).values():
+        msp = ezdxf.readfile(out / f"{plan.flat.name}.dxf").modelspace()
+        pts = np.array([p[:2] for e in msp.query("LWPOLYLINE[layer=='CUT_OUTER' | layer=='REFERENCE']")
+                        for p in e.get_points("xy")])
+        x0, y0, x1, y1 = plan.extents
+        assert (*pts.min(axis=0), *pts.max(axis=0)) == pytest.approx((x0, y0, x1, y1), abs=1e-6), plan.flat.name

@@ -75,6 +75,7 @@ def nest(plans: list[CutPlan], sheet: str, reference_square: bool, row_width_mm:
     if reference_square:
         square = (max(xs) + PART_GAP_MM, max(ys) - REFERENCE_SQUARE_MM, REFERENCE_SQUARE_MM)
         xs.append(square[0] + REFERENCE_SQUARE_MM)
+        ys.append(square[1])  # below parts shorter than the square (the spacers)
     extents = (min(xs), min(ys), max(xs), max(ys))
     flat = Flat(name=SHEET_FILE.format(sheet=sheet), thickness=first.thickness,
                 thickness_measured=first.thickness_measured, thickness_example=first.thickness_example,
