@@ -1,6 +1,7 @@
 """Cast silicones matcad knows: one sourced record per grade, used by the wall model, the cap mechanics and the
 casting guide. Values are the manufacturers' technical data sheets unless a line says otherwise; see
-``docs/materials.md`` for the sources and the derivations.
+``docs/materials.md`` for the sources and the derivations. The neck plate's acrylic modulus
+(:data:`ACRYLIC_MODULUS_MPA`) is here too.
 
 Units: density kg/m³, moduli MPa, times minutes or hours as named, temperatures °C.
 """

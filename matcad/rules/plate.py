@@ -34,33 +34,61 @@ class Bending:
     shift_hz: float | None
 
 
+def deflections(spec):
+    """The board (:func:`matcad.spec.taxels`) and the plate's deflection under each taxel when each is pressed with
+    mechanics.max_force_n: w[pressed, heard] (mm; :func:`matcad.parts.stack.plate_deflection_mm`)."""
+    from matcad.spec import taxels
+
+    board = taxels(spec)
+    force = spec.mechanics.max_force_n
+    return board, np.array([plate_deflection_mm(spec, force, t, board) for t in board])
+
+
 def bendings(spec) -> list[Bending]:
-    """For every taxel pressed with mechanics.max_force_n, every taxel's deflection under it
-    (:func:`matcad.parts.stack.plate_deflection_mm`) and its pitch change: its f0 by the model `predict` chooses
-    for the wall (:data:`matcad.acoustics.registry.CHOSEN`) at the mount gap less that deflection, minus the same at
-    the gap as built. The gap is taken as uniform at its value under the taxel (the 'mount' mouth's model,
+    """For every taxel pressed with mechanics.max_force_n, every taxel's deflection under it (:func:`deflections`)
+    and its pitch change: its f0 by the model `predict` chooses for the wall
+    (:data:`matcad.acoustics.registry.CHOSEN`) at the mount gap less that deflection, minus the same at the gap as
+    built. The gap is taken as uniform at its value under the taxel (the 'mount' mouth's model,
     :func:`matcad.acoustics.models.mount_end_correction_mm`): the real gap opens again toward the supports, so the
     change is an upper bound there. A mouth other than 'mount' sees no gap: its pitch does not move."""
     from matcad.acoustics import registry
     from matcad.acoustics.design import design
     from matcad.acoustics.resonator import resonator
-    from matcad.spec import taxels
 
-    board = taxels(spec)
-    force, gap = spec.mechanics.max_force_n, spec.spacer.height
-    w = np.array([plate_deflection_mm(spec, force, t, board) for t in board])  # w[pressed, heard]
+    board, w = deflections(spec)
+    gap = spec.spacer.height
     model = registry.model(registry.CHOSEN[spec.wall.model])
     out = []
     for j, heard in enumerate(board):
         d = design(spec, heard)
         open_ = w[:, j] < gap
-        gaps = np.where(open_, gap - w[:, j], gap)
-        variants = np.append(gaps, gap)  # every pressed taxel's gap, then the gap as built
+        variants = np.append(np.where(open_, gap - w[:, j], gap), gap)  # every pressed taxel's gap, then as built
         many = d.replace(gap_mm=variants, cavity_diameter=np.full(len(variants), d.cavity_diameter))
         f = np.broadcast_to(np.asarray(model.f0_hz(resonator(many), d.wall), dtype=float), variants.shape)
-        out += [Bending(t.name, heard.name, force, float(w[i, j]), gap,
+        out += [Bending(t.name, heard.name, spec.mechanics.max_force_n, float(w[i, j]), gap,
                         float(f[i] - f[-1]) if open_[i] else None) for i, t in enumerate(board)]
     return out
+
+
+def shift_bound_hz(spec, board, w) -> float:
+    """An upper bound of every taxel's pitch change (Hz) that reads neither the cavity nor a model, so a sweep's
+    rule memo (:mod:`matcad.sweep.memo`) need not run the model for every cavity: the outer end correction δ is a
+    mass at the neck's mouth moving with the neck's air (:func:`matcad.acoustics.models.mouth_end_correction_mm`),
+    so by Rayleigh's principle raising it by Δδ lowers ω² by at most the share of the kinetic energy it holds,
+    ≤ δ / (l + δ), times Δδ / δ: |Δf| / f ≤ Δδ / (2 (l + δ)). Taken twice over (a neck whose air does not move as
+    one), at f = the sample rate (the microphone hears nothing above half of it)."""
+    from matcad.acoustics.design import gap_radius_mm
+    from matcad.acoustics.models import mouth_end_correction_mm
+
+    gap = spec.spacer.height
+    radius = float(gap_radius_mm(spec.plate.width, spec.plate.depth))
+    worst = 0.0
+    for j, heard in enumerate(board):
+        a = heard.neck.diameter / 2
+        built = float(mouth_end_correction_mm(spec.neck.mouth, a, gap, radius))
+        bent = float(mouth_end_correction_mm(spec.neck.mouth, a, gap - w[:, j].max(), radius))
+        worst = max(worst, spec.microphone.sample_rate_hz * (bent - built) / (spec.neck.length + built))
+    return worst
 
 
 def plate_bending(spec) -> list[Finding]:
@@ -70,10 +98,13 @@ def plate_bending(spec) -> list[Finding]:
     force on it. The worst pair is named, with the deflection and the gap."""
     if spec.mechanics.max_force_n <= 0:
         return []
-    rows = bendings(spec)
-    worst = max(rows, key=lambda b: (b.shift_hz is None, abs(b.shift_hz or 0.0), b.deflection_mm))
     guard = guard_hz(spec.microphone.sample_rate_hz)
     limit = BENDING_GUARD_SHARE * guard
+    board, w = deflections(spec)
+    if w.max() < spec.spacer.height and shift_bound_hz(spec, board, w) <= limit:
+        return []
+    rows = bendings(spec)
+    worst = max(rows, key=lambda b: (b.shift_hz is None, abs(b.shift_hz or 0.0), b.deflection_mm))
     if worst.shift_hz is not None and abs(worst.shift_hz) <= limit:
         return []
     axis, span, width = plate_beam(spec)
