@@ -151,10 +151,10 @@ def write_sheets(plans, spec, folder: Path) -> list[dict]:
     """One nested DXF + SVG per acrylic sheet (:mod:`matcad.export.sheets`) and the 1:1 PDF of them all; returns
     each sheet's file, parts, kerf, size (mm) and its PDF page."""
     from matcad.export.pdf import write_scale_pdf
-    from matcad.export.sheets import sheet_plans
+    from matcad.export.sheets import kit_sheets
     from matcad.report.fabrication import SCALE_FILE
 
-    sheets = sheet_plans(plans, spec.outputs.reference_square)
+    sheets = kit_sheets(spec, plans)
     for plan in sheets.values():
         write_dxf(plan, folder / f"{plan.flat.name}.dxf")
         write_svg(plan, folder / f"{plan.flat.name}.svg")
@@ -171,7 +171,7 @@ def write_print_job(spec, folder: Path, meshes: dict) -> dict | None:
     press them in after printing; one file per bed load. Returns the printer and each file's objects, pauses and
     after-print notes; None without printed parts."""
     from matcad.export.mesh import load_stl
-    from matcad.export.threemf import PrintPart, plates, write_3mf
+    from matcad.export.threemf import PrintPart, bed_mm, plates, write_3mf
     from matcad.parts.print_profile import profile
     from matcad.report.fabrication import PRINT_FILE
 
@@ -194,10 +194,12 @@ def write_print_job(spec, folder: Path, meshes: dict) -> dict | None:
         parts.append(PrintPart(name, mesh.vertices, mesh.faces, profile(printer, name), pause, after))
     if not parts:
         return None
-    loads = plates(parts, printer)
+    bed = bed_mm(spec)
+    loads = plates(parts, bed)
     stems = ([PRINT_FILE.format(printer=printer)] if len(loads) == 1 else
              [PRINT_FILE.format(printer=f"{printer}_{k}") for k in range(1, len(loads) + 1)])
-    return {"printer": printer, "files": [write_3mf(load, printer, folder / stem) for load, stem in zip(loads, stems)]}
+    return {"printer": printer,
+            "files": [write_3mf(load, printer, bed, folder / stem) for load, stem in zip(loads, stems)]}
 
 
 def _write_solids(spec, folder: Path) -> dict[str, dict]:

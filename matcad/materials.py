@@ -1,6 +1,7 @@
 """Cast silicones matcad knows: one sourced record per grade, used by the wall model, the cap mechanics and the
 casting guide. Values are the manufacturers' technical data sheets unless a line says otherwise; see
-``docs/materials.md`` for the sources and the derivations.
+``docs/materials.md`` for the sources and the derivations. The neck plate's acrylic modulus
+(:data:`ACRYLIC_MODULUS_MPA`) is here too.
 
 Units: density kg/m³, moduli MPa, times minutes or hours as named, temperatures °C.
 """
@@ -99,3 +100,8 @@ def grade(key: str) -> SiliconeGrade:
         return GRADES[key]
     except KeyError:
         raise ValueError(f"{key!r} invalid, must be one of {', '.join(GRADES)}") from None
+
+
+ACRYLIC_MODULUS_MPA = 3300.0
+"""Young's modulus of cast acrylic (PMMA) sheet, the neck plate's: 3300 MPa, Röhm PLEXIGLAS GS product information
+(tensile modulus, ISO 527-2/1B/1, 23 °C). Extruded sheet is within ~5 % of it."""

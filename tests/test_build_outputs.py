@@ -345,7 +345,7 @@ def test_print_job_3mf_read_back(built):
     say how the mold base's captive nuts go in on either printer (at the pause, or pressed in after printing)."""
     import zipfile
 
-    from matcad.export.threemf import BED_MM
+    from matcad.export.threemf import bed_mm
     from matcad.parts.print_profile import profile
 
     spec, out, _ = built
@@ -371,7 +371,7 @@ def test_print_job_3mf_read_back(built):
             assert mesh.volume == pytest.approx(trimesh.load_mesh(out / f"{name}.stl").volume, rel=1e-6)
             lo, hi = mesh.bounds
             assert lo[2] == pytest.approx(0.0, abs=1e-6)
-            assert lo[0] >= 0 and lo[1] >= 0 and hi[0] <= BED_MM[printer][0] and hi[1] <= BED_MM[printer][1]
+            assert lo[0] >= 0 and lo[1] >= 0 and hi[0] <= bed_mm(spec)[0] and hi[1] <= bed_mm(spec)[1]
             boxes.append((lo[0], lo[1], hi[0], hi[1]))
         for i, a in enumerate(boxes):
             for b in boxes[i + 1:]:
@@ -631,3 +631,22 @@ def test_previews_show_bores_cavities_and_pockets(built):
             inner = edge[rows[0] + 4:rows[-1] - 4, cols[0] + 4:cols[-1] - 4]
             _, n = ndimage.label(inner, structure=np.ones((3, 3)))
             assert n >= len(end_cap_mold_layout(spec).cap_x) + 2, (name, n)
+
+
+def test_bed_rules_extents_are_the_files(built):
+    """What print.bed and laser.bed hold to the beds is what the build wrote: each printed STL's bounds (as
+    exported, in its print pose) equal its registry extent, and each nested sheet's DXF (outlines and reference
+    square) spans the extents the rule reads."""
+    from matcad.export.sheets import kit_sheets
+    from matcad.parts.registry import Kind, wanted
+
+    spec, out, _ = built
+    for part in wanted(spec, Kind.PRINTED):
+        lo, hi = trimesh.load_mesh(out / f"{part.name}.stl").bounds
+        assert tuple(hi - lo) == pytest.approx(part.extent(spec), abs=1e-3), part.name
+    for plan in kit_sheets(spec).values():
+        msp = ezdxf.readfile(out / f"{plan.flat.name}.dxf").modelspace()
+        pts = np.array([p[:2] for e in msp.query("LWPOLYLINE[layer=='CUT_OUTER' | layer=='REFERENCE']")
+                        for p in e.get_points("xy")])
+        x0, y0, x1, y1 = plan.extents
+        assert (*pts.min(axis=0), *pts.max(axis=0)) == pytest.approx((x0, y0, x1, y1), abs=1e-6), plan.flat.name

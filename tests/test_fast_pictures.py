@@ -136,7 +136,7 @@ def test_dxf_writer_writes_ezdxfs_bytes(template, tmp_path):
     from pathlib import Path
 
     from matcad.export.dxf_svg import TEMPLATE, dxf_template, write_dxf, write_dxf_ezdxf
-    from matcad.export.sheets import sheet_plans
+    from matcad.export.sheets import kit_sheets
     from matcad.parts.catalogue import laser_parts
     from matcad.parts.flat import cut_plan
     from matcad.spec import load
@@ -144,7 +144,7 @@ def test_dxf_writer_writes_ezdxfs_bytes(template, tmp_path):
     root = Path(__file__).resolve().parents[1] / "templates"
     spec = load(root / template)
     plans = [cut_plan(f, spec.outputs.reference_square) for f in laser_parts(spec)]
-    plans += list(sheet_plans(plans, spec.outputs.reference_square).values())
+    plans += list(kit_sheets(spec, plans).values())
     assert plans
     for plan in plans:
         write_dxf(plan, tmp_path / "fast.dxf")

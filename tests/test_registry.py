@@ -49,7 +49,7 @@ def block(spec):
 
 
 PARTS = (Part("test_block", Kind.PRINTED, flag="guides", make=block, order=90, colour="#654321",
-              pose=PrintPose(0.0, "flat underside")),)
+              pose=PrintPose(0.0, "flat underside"), extent=lambda spec: (10.0, 6.0, 4.0)),)
 '''
 
 
@@ -98,7 +98,9 @@ def test_a_bad_entry_is_refused_at_registration():
     with pytest.raises(ValueError, match="flag 'stickers' invalid"):
         Part("x", Kind.LASER, flag="stickers", make=print, order=1, colour="#000000", sheet="guide")
     with pytest.raises(ValueError, match="pose must be given"):
-        Part("x", Kind.PRINTED, flag="guides", make=print, order=1, colour="#000000")
+        Part("x", Kind.PRINTED, flag="guides", make=print, order=1, colour="#000000", extent=print)
+    with pytest.raises(ValueError, match="extent must be given"):
+        Part("x", Kind.PRINTED, flag="guides", make=print, order=1, colour="#000000", pose=PrintPose(0.0, "flat"))
 
 
 def test_registering_imports_no_cad_kernel():

@@ -19,9 +19,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
-BED_MM = {"fdm": (250.0, 210.0), "sla": (120.0, 68.0)}
-"""Bed the parts are laid out on (a Prusa MK3-class FDM bed, an SL1-class SLA display, mm): the slicer re-arranges
-them on other beds."""
 GAP_MM = 8.0
 """Between parts on the bed."""
 CONTENT_TYPES = ('<?xml version="1.0" encoding="UTF-8"?>\n'
@@ -74,10 +71,16 @@ def _rows(sizes: list[tuple[float, float]], bed_w: float) -> list[list[int]]:
     return rows + [row]
 
 
-def plates(parts: list[PrintPart], printer: str) -> list[list[PrintPart]]:
-    """The parts split into bed loads of :data:`BED_MM`: rows of parts :data:`GAP_MM` apart, a new plate when the
-    next row would not fit (an SLA display holds the mold halves, not the mount beside them)."""
-    bed_w, bed_h = BED_MM[printer]
+def bed_mm(spec) -> tuple[float, float]:
+    """The bed the parts are laid out on: the printer's build volume in x and y (``machine.print_volume_x``,
+    ``print_volume_y``; mm)."""
+    return spec.machine.print_volume_x, spec.machine.print_volume_y
+
+
+def plates(parts: list[PrintPart], bed: tuple[float, float]) -> list[list[PrintPart]]:
+    """The parts split into loads of the ``bed`` (x, y mm; :func:`bed_mm`): rows of parts :data:`GAP_MM` apart, a
+    new plate when the next row would not fit (an SLA display holds the mold halves, not the mount beside them)."""
+    bed_w, bed_h = bed
     sizes = [_footprint(p) for p in parts]
     out, plate, depth = [], [], 0.0
     for row in _rows(sizes, bed_w):
@@ -90,10 +93,10 @@ def plates(parts: list[PrintPart], printer: str) -> list[list[PrintPart]]:
     return out + [plate]
 
 
-def layout_mm(parts: list[PrintPart], printer: str) -> list[tuple[float, float]]:
-    """Where each part's footprint centre goes on the bed: rows left to right, :data:`GAP_MM` apart, the whole
-    block centred on :data:`BED_MM` (mm)."""
-    bed_w, bed_h = BED_MM[printer]
+def layout_mm(parts: list[PrintPart], bed: tuple[float, float]) -> list[tuple[float, float]]:
+    """Where each part's footprint centre goes on the ``bed`` (x, y mm): rows left to right, :data:`GAP_MM` apart,
+    the whole block centred on the bed (mm)."""
+    bed_w, bed_h = bed
     sizes = [_footprint(p) for p in parts]
     rows = _rows(sizes, bed_w)
     heights = [max(sizes[i][1] for i in r) for r in rows]
@@ -186,10 +189,10 @@ def notes(parts: list[PrintPart], printer: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_3mf(parts: list[PrintPart], printer: str, path: Path) -> dict:
-    """Write the print job; returns what it holds: each object's name, bed position and settings, and the pauses
-    (mm)."""
-    places = layout_mm(parts, printer)
+def write_3mf(parts: list[PrintPart], printer: str, bed: tuple[float, float], path: Path) -> dict:
+    """Write the print job for ``printer`` laid out on ``bed`` (x, y mm); returns what it holds: each object's name,
+    bed position and settings, and the pauses (mm)."""
+    places = layout_mm(parts, bed)
     objects = "\n".join(_object_xml(i, part) for i, part in enumerate(parts, 1))
     items = "\n".join(f'  <item objectid="{i}" transform="1 0 0 0 1 0 0 0 1 {x:.4f} {y:.4f} 0" printable="1"/>'
                       for i, (x, y) in enumerate(places, 1))

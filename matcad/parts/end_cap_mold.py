@@ -157,6 +157,20 @@ def _slab(width: float, depth: float, height: float, below: bool):
     return Box(width, depth, height, align=TOP if below else BOTTOM)
 
 
+def base_extent_mm(spec) -> tuple[float, float, float]:
+    """The base's bounding box in its print pose (x, y, z mm): the block (:func:`layout`'s block_x x block_y x
+    base_height) and the keys standing mold.key_height on it."""
+    lay = layout(spec)
+    return lay.block_x, lay.block_y, lay.base_height + spec.mold.key_height
+
+
+def lid_extent_mm(spec) -> tuple[float, float, float]:
+    """The lid's bounding box in its print pose (x, y, z mm; turned over, the same box): the plate (block_x x
+    block_y x mold.lid_thickness) and the longest core pin hanging from it (its cavity length L)."""
+    lay = layout(spec)
+    return lay.block_x, lay.block_y, spec.mold.lid_thickness + max(t.cavity.length for t in lay.slots)
+
+
 def base_recipe(spec) -> Recipe:
     """Base block: top face at z = 0, cap negatives upside down, keys on top, captive clamp nuts under bolt holes,
     a board's taxel names beside the pockets (mm)."""
@@ -209,9 +223,10 @@ def cast_caps(spec):
 
 PARTS = (Part("end_cap_mold_base", Kind.PRINTED, flag="end_cap_mold", make=mold_base, recipe=base_recipe,
               order=60, colour="#e0c090",
-              pose=PrintPose(0.0, "flat underside; cap cavities and keys face up"),
+              pose=PrintPose(0.0, "flat underside; cap cavities and keys face up"), extent=base_extent_mm,
               view=("from above: cap pockets, keys, nut pockets", 90.0, -90.0)),
          Part("end_cap_mold_lid", Kind.PRINTED, flag="end_cap_mold", make=mold_lid, recipe=lid_recipe,
               order=70, colour="#e0c090",
               pose=PrintPose(180.0, "outer (top) face; core pins point up, the parting face prints last"),
+              extent=lid_extent_mm,
               view=("from above (as printed, pins up): core pins, vents, ribbed key sockets", 90.0, -90.0)))

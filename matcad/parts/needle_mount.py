@@ -42,6 +42,14 @@ def needle_bore(taxel, bore_diameter: float, reach: float):
     return _on_needle_axis(taxel, mouth_point, bore_diameter / 2, reach)
 
 
+def mount_extent_mm(spec) -> tuple[float, float, float]:
+    """The mount's bounding box in its print pose (x, y, z mm): the block plate.width wide, its ears
+    :data:`~matcad.parts.features.EAR_WIDTH_MM` beyond the plate's depth on ±y, ``mount.thickness`` tall plus the
+    standoffs (spacer.height) when they are printed on it."""
+    standoffs = spec.spacer.height if spec.spacer.style == "standoff" else 0.0
+    return spec.plate.width, spec.plate.depth + 2 * EAR_WIDTH_MM, spec.mount.thickness + standoffs
+
+
 def needle_mount(spec):
     """The mount solid in the assembly frame (mm): block, fixing ears, standoffs (if printed), bolt pilots,
     dowel holes, one needle bore per taxel (at its θ and y, aimed at its own neck), and on a board each bore's taxel
@@ -54,9 +62,9 @@ def needle_mount(spec):
 
     gap, thick = spec.spacer.height, spec.mount.thickness
     top = -gap
-    body = Pos(0, 0, top) * Box(spec.plate.width, spec.plate.depth, thick, align=TOP)
-    ears = Pos(0, 0, top - thick) * Box(spec.plate.width, spec.plate.depth + 2 * EAR_WIDTH_MM, EAR_THICKNESS_MM,
-                                        align=BOTTOM)
+    width, span, _ = mount_extent_mm(spec)
+    body = Pos(0, 0, top) * Box(width, spec.plate.depth, thick, align=TOP)
+    ears = Pos(0, 0, top - thick) * Box(width, span, EAR_THICKNESS_MM, align=BOTTOM)
     body = body + ears
     if spec.spacer.style == "standoff":
         for x, y in plate_bolt_positions_mm(spec):
@@ -108,4 +116,4 @@ def mount_labels(spec) -> tuple:
 PARTS = (Part("needle_mount", Kind.PRINTED, flag="needle_mount", make=needle_mount, order=80, colour="#b4b4b4",
               pose=PrintPose(0.0, "flat underside; standoffs and the needle bore's mouth face up"),
               view=("section through a needle's plane: its bore at θ", 0.0, -90.0), label="needle mount (printed)",
-              section="bore"),)
+              section="bore", extent=mount_extent_mm),)

@@ -77,7 +77,10 @@ class Part:
     out). ``section`` draws the preview's second view as a cut instead: 'axis' (through y = 0, every cap's axis)
     or 'bore' (through an inclined bore's plane), so what lies inside shows. ``recipe(spec)`` gives a 3-D part
     made by booleans of simple tools as those tools (:class:`matcad.parts.recipe.Recipe`; ``make`` returns its
-    ``solid()``): the design page's preview meshes it from the tools' kept meshes."""
+    ``solid()``): the design page's preview meshes it from the tools' kept meshes. ``extent(spec)`` is a printed
+    part's bounding box in its print pose (x, y, z mm), from the arithmetic its solid is made of (required for
+    one, and only for one): the design rule ``print.bed`` holds it to the printer's build volume, without building
+    the solid."""
 
     name: str
     kind: Kind
@@ -92,6 +95,7 @@ class Part:
     label: str = ""
     section: str = ""
     recipe: Callable[[Spec], Any] | None = None
+    extent: Callable[[Spec], tuple[float, float, float]] | None = None
 
     def __post_init__(self):
         from matcad.spec import Outputs
@@ -110,6 +114,8 @@ class Part:
             problems.append("pose must be given for a printed or cast part and only for one")
         if (self.kind is Kind.LASER) != (self.sheet is not None):
             problems.append("sheet must be given for a laser part and only for one")
+        if (self.kind is Kind.PRINTED) != (self.extent is not None):
+            problems.append("extent must be given for a printed part and only for one")
         if self.section not in SECTIONS:
             problems.append(f"section {self.section!r} invalid, must be one of {SECTIONS}")
         if problems:

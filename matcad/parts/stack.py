@@ -1,4 +1,5 @@
-"""Heights in the assembled stack, and the flange squeeze the clamp can produce: arithmetic of the spec (mm).
+"""Heights in the assembled stack, the flange squeeze the clamp can produce, and how far a pressed taxel bends the
+neck plate toward the mount: arithmetic of the spec (mm).
 
 Assembly frame: plate underside z = 0, neck axis = z. Bottom to top: the needle mount (its top face at
 z = −spacer.height, ``mount.thickness`` thick), the spacers, the neck plate (0 … l), the locator guide around the
@@ -10,6 +11,9 @@ of materials and the fabrication plan all read these heights from here.
 from __future__ import annotations
 
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
+from matcad.materials import ACRYLIC_MODULUS_MPA
+from matcad.mechanics.plate import deflection_mm
+from matcad.parts.features import plate_bolt_positions_mm
 from matcad.spec import cap_flange_thickness_mm
 
 
@@ -39,3 +43,28 @@ def squeeze_range_mm(spec, nominal: bool = False) -> tuple[float, float, float]:
     tol = sheet_tolerance_mm(spec.guide.thickness, spec.guide.thickness_measured and not nominal)
     s = spec.end_cap.flange_squeeze
     return s - tol, s + tol, tol
+
+
+def plate_beam(spec) -> tuple[str, float, float]:
+    """The neck plate as the beam :mod:`matcad.mechanics.plate` bends: the axis along its longer side ('x' or 'y';
+    'y' for a square plate), the span between the bolt rows across that axis, and the plate's width across it
+    (mm). The bolts (:func:`matcad.parts.features.plate_bolt_positions_mm`) at the four corners, over the spacers,
+    are its only supports."""
+    xs, ys = zip(*plate_bolt_positions_mm(spec))
+    if spec.plate.depth >= spec.plate.width:
+        return "y", max(ys) - min(ys), spec.plate.width
+    return "x", max(xs) - min(xs), spec.plate.depth
+
+
+def plate_deflection_mm(spec, force_n: float, pressed, taxels):
+    """How far the neck plate (cast acrylic, :data:`matcad.materials.ACRYLIC_MODULUS_MPA`, neck.length thick) bends
+    down toward the mount under each of ``taxels`` when ``force_n`` presses on the taxel ``pressed`` (a
+    :class:`matcad.spec.Taxel`, or anything with x and y): :func:`matcad.mechanics.plate.deflection_mm` on
+    :func:`plate_beam` (mm, an array in the order of ``taxels``)."""
+    axis, span, width = plate_beam(spec)
+
+    def along(t) -> float:
+        return getattr(t, axis) + span / 2
+
+    return deflection_mm(force_n, along(pressed), [along(t) for t in taxels], span, width, spec.neck.length,
+                         ACRYLIC_MODULUS_MPA)

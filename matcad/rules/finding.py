@@ -27,6 +27,13 @@ class Finding:
         return asdict(self)
 
 
+def fits_bed(size, bed) -> bool:
+    """Whether a box ``size`` (x, y[, z] mm) fits inside ``bed`` (the same axes, mm), turned either way round in
+    the bed's plane (a slicer or the laser's software may rotate it by 90°; a diagonal placement is not tried)."""
+    (x, y, *z), (bx, by, *bz) = size, bed
+    return all(a <= b for a, b in zip(z, bz)) and ((x <= bx and y <= by) or (y <= bx and x <= by))
+
+
 def findings_text(findings) -> str:
     """The findings as `matcad check` prints them: one line each (level, rule, message) and its fix below unless
     it is only information."""

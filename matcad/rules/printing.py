@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 from matcad.parts.casting import MIN_BATCH_G, MOLD_MATERIALS, casting_guide
 from matcad.parts.coupon import FDM_THETA_MIN_DEG
 from matcad.parts.mold_layout import NUT_ROOF_MM, appendages, layout, plan_vents
-from matcad.rules.finding import Finding
+from matcad.parts.registry import Kind, wanted
+from matcad.rules.finding import Finding, fits_bed
 
 MIN_WALL_SLA_MM = 0.8
 KEY_CLEARANCE_MIN_MM = {"fdm": 0.15, "sla": 0.05}
@@ -174,8 +177,46 @@ def sla_inhibition(spec) -> list[Finding]:
                     "cast a test drop")]
 
 
+def _volume_mm(spec) -> tuple[float, float, float]:
+    m = spec.machine
+    return m.print_volume_x, m.print_volume_y, m.print_volume_z
+
+
+def _oversize(spec) -> list:
+    """The printed parts ``spec`` asks for that do not fit the build volume: (part, its extent in mm)."""
+    volume = _volume_mm(spec)
+    return [(p, p.extent(spec)) for p in wanted(spec, Kind.PRINTED) if not fits_bed(p.extent(spec), volume)]
+
+
+def _caps_that_fit(spec) -> int:
+    """The most caps per mold (mold.count, at most the spec's) whose mold base and lid fit the build volume; 0 when
+    not even one does."""
+    for count in range(spec.mold.count - 1, 0, -1):
+        fewer = dataclasses.replace(spec, mold=dataclasses.replace(spec.mold, count=count))
+        if not any(p.flag == "end_cap_mold" for p, _ in _oversize(fewer)):
+            return count
+    return 0
+
+
+def print_bed(spec) -> list[Finding]:
+    """Every printed part, as its print pose's bounding box (:attr:`matcad.parts.registry.Part.extent`, the
+    arithmetic its solid is made of), must fit the printer's build volume (``machine.print_volume_x/y/z``), turned
+    either way round on the bed: a part that does not fit cannot be printed."""
+    volume = _volume_mm(spec)
+    out = []
+    for part, (x, y, z) in _oversize(spec):
+        fit = _caps_that_fit(spec) if part.flag == "end_cap_mold" else 0
+        fix = (f"set mold.count = {fit} (the most caps per mold that fit; pour it more often), or " if fit else "")
+        out.append(Finding("print.bed", "error", [round(x, 3), round(y, 3), round(z, 3)], list(volume),
+                           f"{part.name}: {x:.1f} x {y:.1f} x {z:.1f} mm in its print pose does not fit the "
+                           f"printer's build volume machine.print_volume_x/y/z = {volume[0]:g} x {volume[1]:g} x "
+                           f"{volume[2]:g} mm (either way round on the bed)",
+                           fix + "enter a printer with a larger build volume (machine.print_volume_x/y/z)"))
+    return out
+
+
 RULES = (printable_walls, key_clearance, fill_and_vents, cap_wall, silicone_batch, sla_inhibition, bore_overhang,
-         cavity_appendages, clamp_nut)
+         cavity_appendages, clamp_nut, print_bed)
 TAXEL_RULES = (fill_and_vents, cap_wall, bore_overhang)
 INFO_RULES = (silicone_batch,)
 """Rules that only inform (level ``info``, never error or warning): a sweep, which counts errors and warnings, does

@@ -8,9 +8,9 @@ here (docs/extending.md). A module of :data:`SPEC_MODULES` may also name, in ``T
 
 from __future__ import annotations
 
-from matcad.rules import acoustic, bands, board, laser, printing, stack, tube
+from matcad.rules import acoustic, bands, board, laser, plate, printing, stack, tube
 
-SPEC_MODULES = (laser, printing, stack, bands, board)
+SPEC_MODULES = (laser, printing, stack, bands, board, plate)
 """Modules whose ``RULES`` are functions of the spec: ``rule(spec) -> list[Finding]``."""
 PREDICTION_MODULES = (acoustic,)
 """Modules whose ``RULES`` judge one taxel's predicted sound: ``rule(taxel_spec, prediction) -> list[Finding]``,

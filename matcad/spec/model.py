@@ -146,11 +146,14 @@ PROPORTIONAL_DEFAULTS = {"end_cap.outer_diameter": CAP_OUTER_PER_D, "end_cap.top
 """The fields whose default follows cavity.diameter (this factor times it) when the spec leaves them out."""
 KEY_CLEARANCE_MM = {"fdm": 0.2, "sla": 0.1}
 """Registration-key clearance per side by printer process (docs/physics.md, shop practice)."""
+PRINT_VOLUME_MM = {"fdm": (250.0, 210.0, 220.0), "sla": (120.0, 68.0, 150.0)}
+"""Default build volume (x, y, z mm) by printer process: a Prusa MK4 (FDM) and a Prusa SL1 (SLA display), from
+Prusa Research's specifications (``machine.print_volume_*`` override it)."""
 
 
 def _resolve_defaults(spec: Spec) -> Spec:
-    """Fill defaults that depend on other fields (cap body proportional to the cavity; key clearance; silicone
-    values from its grade)."""
+    """Fill defaults that depend on other fields (cap body proportional to the cavity; key clearance and build
+    volume by printer; silicone values from its grade)."""
     cap = spec.end_cap
     entries = tuple(dataclasses.replace(
         e, cap_outer_diameter=_proportional(e.cap_outer_diameter, cap.outer_diameter, CAP_OUTER_PER_D,
@@ -164,6 +167,10 @@ def _resolve_defaults(spec: Spec) -> Spec:
     machine = spec.machine
     if machine.key_clearance is None:
         machine = dataclasses.replace(machine, key_clearance=KEY_CLEARANCE_MM[machine.printer])
+    if None in (machine.print_volume_x, machine.print_volume_y, machine.print_volume_z):
+        given = (machine.print_volume_x, machine.print_volume_y, machine.print_volume_z)
+        x, y, z = (v if v is not None else d for v, d in zip(given, PRINT_VOLUME_MM[machine.printer]))
+        machine = dataclasses.replace(machine, print_volume_x=x, print_volume_y=y, print_volume_z=z)
     grade = GRADES[spec.silicone.grade]
     silicone = spec.silicone
     if silicone.density_g_cm3 is None:

@@ -188,6 +188,16 @@ class Machine(Section):
     nozzle: float = length_mm("FDM nozzle diameter (walls >= 2 nozzles)", 0.4)
     key_clearance: float | None = param("registration-key clearance per side; default by printer "
                                         "(fdm 0.2, sla 0.1)", "mm", None, lo=0.0, hi=5.0)
+    print_volume_x: float | None = length_mm(
+        "printer's build volume along x (the bed's width); default by printer: fdm 250 (a Prusa MK4, 250 x 210 x "
+        "220 mm, Prusa Research's specifications), sla 120 (a Prusa SL1, 120 x 68 x 150 mm, the same source)", None)
+    print_volume_y: float | None = length_mm("printer's build volume along y (the bed's depth); default by printer: "
+                                             "fdm 210 (Prusa MK4), sla 68 (Prusa SL1)", None)
+    print_volume_z: float | None = length_mm("printer's build height; default by printer: fdm 220 (Prusa MK4), sla "
+                                             "150 (Prusa SL1)", None)
+    laser_bed_x: float = length_mm("laser cutter's work area along x; default a K40-class CO2 laser's 300 x 200 mm "
+                                   "bed, the common hobby laser (a 10 mm margin is kept at every edge)", 300.0)
+    laser_bed_y: float = length_mm("laser cutter's work area along y; default the K40-class 200 mm", 200.0)
     stl_tolerance: float = param("STL chordal deviation; floored at 1e-4 x each part's size (the report "
                                  "gives the one used)", "mm", 0.01, lo=1e-5, hi=10.0)
     stl_angular_tolerance: float = param("STL angular deviation (0.1 rad keeps STL volume within 0.05 % "
