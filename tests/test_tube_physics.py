@@ -141,7 +141,7 @@ def _wall_interpolation(wall_per_a):
 
 @pytest.mark.slow
 def test_exterior_fem_unflanged_converges_rises_with_the_wall_and_ignores_the_exterior_radius(td, monkeypatch):
-    """The unflanged rung's verification (~15 s): with a thin wall (0.02 a, ka = 0.048) δ rises under refinement at
+    """The unflanged rung's verification (~10 s): with a thin wall (0.02 a, ka = 0.048) δ rises under refinement at
     a steady log-log rate (order 1.0-1.2: the wall's edge is a knife edge at these cells), its Aitken limit
     0.015 a above Levine & Schwinger's zero-thickness 0.6133 a, the wall's own share by the thick-flange
     interpolation being 0.009 a; the wall's thickness raises δ monotonically from there towards the flanged
