@@ -2,7 +2,9 @@
 
 Prints: the 1-D FEM's error against the transmission line's root (P1, P2) with its run time and observed order; the
 closed form's error; the axisymmetric exterior FEM of the template made flanged against the quarter wave with
-Norris & Sheng's frequency-dependent correction (error, the correction it implies, CPU time); the column length that sings at 3 and 5.5 kHz (the AcousTac range the MAT paper cites) and what
+Norris & Sheng's frequency-dependent correction (error, the correction it implies, CPU time); the exterior FEM of a
+thin-walled unflanged tube against Levine & Schwinger's 0.6133 a (the correction it implies per level, CPU time); the
+column length that sings at 3 and 5.5 kHz (the AcousTac range the MAT paper cites) and what
 a 100 mm column sings at. Run: .venv/bin/python benchmarks/tube.py
 """
 
@@ -46,6 +48,27 @@ def exterior_fem(td):
               f"{T.phase_correction_mm(flanged, run.f0_hz) / a:9.5f} {cpu:8.2f}")
 
 
+def unflanged_exterior_fem(td, wall_per_a=0.02, levels=(2, 4, 8, 16)):
+    """A thin-walled unflanged tube (wall 0.02 a, 60 mm bore: ka = 0.048), rigid cap: the correction the exterior
+    FEM's f1 implies per level against Levine & Schwinger's zero-thickness 0.6133 a and against the Aitken limit of
+    the last three levels (the wall's own share), with CPU time (the machine is shared)."""
+    a = td.bore_diameter / 2
+    thin = dataclasses.replace(td, mouth="unflanged", length=60.0, tube_wall=wall_per_a * a)
+    rows = []
+    for level in levels:
+        t0 = time.process_time()
+        run = T.exterior_fem(thin, level)
+        rows.append((level, run.dofs, T.phase_correction_mm(thin, run.f0_hz) / a, time.process_time() - t0))
+    d = [row[2] for row in rows[-3:]]
+    limit = d[2] + (d[2] - d[1]) ** 2 / ((d[1] - d[0]) - (d[2] - d[1]))
+    print(f"unflanged, wall {wall_per_a:g} a, rigid cap, ka = {2 * math.pi * run.f0_hz / (T.speed_of_sound(td.air) * 1e3) * a:.3f}: "
+          f"Aitken limit {limit:.4f} a (Levine & Schwinger, zero wall: {T.UNFLANGED} a)")
+    print("exterior FEM level   dofs  delta/a   - 0.6133   - limit   CPU (s)")
+    for level, dofs, delta, cpu in rows:
+        print(f"             {level:5d} {dofs:6d} {delta:8.5f} {delta - T.UNFLANGED:+9.5f} {delta - limit:+9.5f} "
+              f"{cpu:8.2f}")
+
+
 def main():
     td = T.tube_design(load(TEMPLATE))
     kappa = T.with_wall_hz(td, td.wall.dynamic_moduli_pa()[1])[1]
@@ -63,6 +86,7 @@ def main():
             print(f"    P{order}  {n:6d}  {f:12.6f}  {err:12.3e}  {rate:>5}  {t * 1e3:8.1f}")
             prev = err
     exterior_fem(td)
+    unflanged_exterior_fem(td)
     for target in (3000.0, 5500.0):  # the column (mouth to cap wall) for a pitch, by bisection on the line
         lo, hi = 1.0, 500.0
         for _ in range(60):

@@ -84,9 +84,27 @@ def test_predict_model_fem_in_json():
     assert rigid.models["fem"].checks["mode_in_cavity"]
 
 
-def test_unflanged_mouth_is_a_clear_error():
-    with pytest.raises(ValueError, match="mouth"):
+def test_unflanged_mouth_needs_the_tube_wall_and_meshes_the_free_space_around_it():
+    """A MAT design's unflanged neck has no wall thickness in the spec: a clear error naming the field; with a wall
+    the exterior is the free space around the tube's end, its radiation boundary the arc alone (not the outer
+    wall r = a + w that meets it), its triangles unfolded."""
+    with pytest.raises(ValueError, match=r"FemGeometry.wall = 0 mm invalid for mouth 'unflanged': must be > 0"):
         fem.mesh(_geom(mouth="unflanged"))
+    with pytest.raises(ValueError, match="mouth 'sideways' invalid for the FEM, must be one of"):
+        fem.mesh(_geom(mouth="sideways"))
+    g = _geom(mouth="unflanged", wall=0.05)
+    m = fem.mesh(g, 2)
+    big_r, b = fem.EXTERIOR_RADIUS_PER_A * 1.05, 1.05 + 0.05
+    facets, _ = fem._boundary_facets(m, g)
+    ends = m.p[:, m.facets[:, facets]]
+    assert np.allclose(np.hypot(*ends), big_r, rtol=1e-9)
+    arc_length = np.sum(np.hypot(*(ends[:, 1] - ends[:, 0])))
+    assert arc_length == pytest.approx(big_r * (math.pi / 2 + math.acos(b / big_r)), rel=2e-3)  # below + beside
+    p = m.p[:, m.t]
+    area = (p[0, 1] - p[0, 0]) * (p[1, 2] - p[1, 0]) - (p[0, 2] - p[0, 0]) * (p[1, 1] - p[1, 0])
+    assert np.all(np.abs(area) > 0)
+    wall = (p[0].mean(axis=0) > 1.05) & (p[0].mean(axis=0) < b) & (p[1].mean(axis=0) > 0)
+    assert not np.any(wall)  # nothing meshed inside the tube's wall
 
 
 

@@ -96,7 +96,7 @@ def test_exterior_fem_resolves_the_flanged_mouth_and_converges_to_norris_and_she
     assert 2.2 < errors[0] / errors[1] < 3.2 and 2.2 < errors[1] / errors[2] < 3.2
     fem_f = T.exterior_fem(flanged, 4).f0_hz
     assert 0 < fem_f / T.line_hz(flanged) - 1 < 0.002
-    with pytest.raises(ValueError, match="flanged mouth only"):
+    with pytest.raises(ValueError, match="tube.mouth = 'fipple'.*3-D.*'flanged', 'unflanged'"):
         T.exterior_fem(td)
     from matcad.prediction.tube import predict_tube
     from matcad.spec import from_dict, to_dict
@@ -105,6 +105,63 @@ def test_exterior_fem_resolves_the_flanged_mouth_and_converges_to_norris_and_she
     data["tube"]["mouth"] = "flanged"
     assert predict_tube(from_dict(data), fem_level=4).routes_hz["exterior FEM, level 4 (rigid)"] == pytest.approx(
         fem_f, rel=1e-9)
+
+
+def _unflanged(td, wall_per_a, length=60.0):
+    """The template made unflanged, rigid cap, ``length`` of bore (60 mm: ka = 0.048), a wall of ``wall_per_a`` a."""
+    return dataclasses.replace(td, mouth="unflanged", length=length, tube_wall=wall_per_a * td.bore_diameter / 2)
+
+
+def test_exterior_fem_resolves_the_unflanged_mouth_fast(td):
+    """The unflanged rung at level 2 (~1 s): the free space around a thin-walled tube end puts the correction its
+    f1 implies near Levine & Schwinger's 0.6133 a, well below the flanged 0.8216 a; a fipple mouth stays refused;
+    predict's route is the same run."""
+    a = td.bore_diameter / 2
+    thin = _unflanged(td, 0.05)
+    delta = T.phase_correction_mm(thin, T.exterior_fem(thin, 2).f0_hz) / a
+    assert 0.58 < delta < 0.65
+    from matcad.prediction.tube import predict_tube
+    from matcad.spec import from_dict, to_dict
+
+    data = to_dict(load(TEMPLATE))
+    data["tube"]["mouth"] = "unflanged"
+    run = T.exterior_fem(T.tube_design(from_dict(data)), 2)  # the template's own 1.2 mm wall (0.6 a): thick
+    assert 0.6133 * a < T.phase_correction_mm(T.tube_design(from_dict(data)), run.f0_hz) < 0.8216 * a
+    assert predict_tube(from_dict(data), fem_level=2).routes_hz["exterior FEM, level 2 (rigid)"] == pytest.approx(
+        run.f0_hz, rel=1e-9)
+
+
+def _wall_interpolation(wall_per_a):
+    """The end correction per radius of a tube whose end face reaches out to b = a + w, interpolated between the
+    unflanged and the infinitely flanged end: 0.8216 + (a/b)(0.6133 − 0.8216) + 0.057 (a/b)(1 − (a/b)⁵) (Dalmont,
+    Nederveen & Joly 2001, as WWIDesigner's ThickFlangedOpenEndCalculator implements it; not read in the paper)."""
+    x = 1 / (1 + wall_per_a)
+    return T.FLANGED + x * (T.UNFLANGED - T.FLANGED) + 0.057 * x * (1 - x**5)
+
+
+@pytest.mark.slow
+def test_exterior_fem_unflanged_converges_rises_with_the_wall_and_ignores_the_exterior_radius(td, monkeypatch):
+    """The unflanged rung's verification (~10 s): with a thin wall (0.02 a, ka = 0.048) δ rises under refinement at
+    a steady log-log rate (order 1.0-1.2: the wall's edge is a knife edge at these cells), its Aitken limit
+    0.015 a above Levine & Schwinger's zero-thickness 0.6133 a, the wall's own share by the thick-flange
+    interpolation being 0.009 a; the wall's thickness raises δ monotonically from there towards the flanged
+    0.8216 a, within 0.006 a of that interpolation; and δ moves by < 2e-4 a between an exterior of 10 a and 20 a."""
+    a = td.bore_diameter / 2
+    thin = _unflanged(td, 0.02)
+    deltas = [T.phase_correction_mm(thin, T.exterior_fem(thin, level).f0_hz) / a for level in (2, 4, 8)]
+    steps = np.diff(deltas)
+    assert np.all(steps > 0) and 1.6 < steps[0] / steps[1] < 2.6
+    limit = deltas[2] + steps[1] ** 2 / (steps[0] - steps[1])  # Aitken; levels 4, 8, 16 give 0.0017 a less
+    assert 0 < limit - T.UNFLANGED < 0.016 and limit == pytest.approx(_wall_interpolation(0.02), abs=0.006)
+    walls = (0.05, 0.2, 1.0)
+    thick = [T.phase_correction_mm(t, T.exterior_fem(t, 8).f0_hz) / a for t in (_unflanged(td, w) for w in walls)]
+    assert deltas[2] < thick[0] < thick[1] < thick[2] < T.FLANGED
+    assert thick == pytest.approx([_wall_interpolation(w) for w in walls], abs=0.006)
+    by_radius = []
+    for radius in (10.0, 20.0):
+        monkeypatch.setattr("matcad.acoustics.fem.EXTERIOR_RADIUS_PER_A", radius)
+        by_radius.append(T.phase_correction_mm(thin, T.exterior_fem(thin, 4).f0_hz) / a)
+    assert abs(by_radius[0] - by_radius[1]) < 2e-4
 
 
 def test_edge_tone_window_is_strouhal_bounded_and_the_next_mode_needs_a_faster_jet(td):

@@ -5,7 +5,10 @@ draft) and the exterior below the plate (z < 0):
 - ``baffled``: a quarter disc of radius R around the mouth in a rigid baffle (the plate underside), with the
   spherical radiation condition ∂p/∂n = −(ik + 1/R) p on the arc (exact for the monopole near field);
 - ``mount``: the spacer gap of height h between plate and mount out to the gap radius R_g, with the
-  cylindrical condition ∂p/∂n = −(ik + 1/(2R_g)) p on r = R_g.
+  cylindrical condition ∂p/∂n = −(ik + 1/(2R_g)) p on r = R_g;
+- ``unflanged``: the open end of a tube in free space: a half disc of radius R around the mouth, less the tube's
+  rigid wall (bore radius a to a + w, ``wall`` = w) running from the mouth back along the tube to the arc, with the
+  same spherical condition on the arc (Levine & Schwinger 1948's geometry for w → 0).
 As built, the neck may taper (its mouth radius differs from its radius at the cavity, linearly along it) and air may
 be joined to the cavity at the plate (gaps in the stack): a groove in the plate from halfway between the neck and the
 cavity wall outwards, open to the cavity's floor, at most half the plate deep and reaching under the cap's base as far
@@ -50,6 +53,8 @@ class FemGeometry:
     gap_radius: float = 0.0
     mouth_radius: float | None = None
     side_volume: float = 0.0
+    wall: float = 0.0
+    """The tube's wall thickness at an ``unflanged`` mouth (mm, > 0 there; unused by the other mouths)."""
 
     @property
     def mouth_r(self) -> float:
@@ -141,9 +146,10 @@ def _block(r_of, zs: np.ndarray, s: np.ndarray):
     return _grid_cells(np.stack([r_of(ss, zz), zz], axis=-1), split_cross=False)
 
 
-def _quarter_disc(radii: np.ndarray):
-    """Quarter disc below z = 0 whose nodes on both axes sit exactly at ``radii`` (Fong's square-to-disc
-    map, then a radial remap); cells are cross-split so the arc's corner cell has no sliver."""
+def _quarter_disc(radii: np.ndarray, place=lambda x, y: (x, -y)):
+    """Quarter disc whose nodes on both axes sit exactly at ``radii`` (Fong's square-to-disc map, then a radial
+    remap), below z = 0; cells are cross-split so the arc's corner cell has no sliver. ``place`` maps the disc's
+    points (x, y ≥ 0, mm) to (r, z), arrays each; by default (x, −y), the quarter below the mouth."""
     n = len(radii) - 1
     u = np.linspace(0.0, 1.0, n + 1)
     uu, vv = np.meshgrid(u, u, indexing="ij")
@@ -151,7 +157,20 @@ def _quarter_disc(radii: np.ndarray):
     y = vv * np.sqrt(1 - uu * uu / 2)
     rho = np.hypot(x, y)
     scale = np.where(rho > 0, np.interp(rho, u, radii) / np.where(rho > 0, rho, 1.0), 0.0)
-    return _grid_cells(np.stack([x * scale, -y * scale], axis=-1), split_cross=True)
+    return _grid_cells(np.stack(place(x * scale, y * scale), axis=-1), split_cross=True)
+
+
+def _beside_wall(b: float, big_r: float):
+    """:func:`_quarter_disc`'s ``place`` for the air beside a tube's outer wall r = b (mm), z ≥ 0, up to the arc
+    of radius ``big_r`` (mm) about the mouth's centre: the disc of radius big_r − b centred on the wall's foot
+    (b, 0), stretched along each ray from the foot onto that arc, so its nodes on z = 0 stay at b + x and its
+    outer edge is the radiation arc itself."""
+    def place(x, y):
+        theta = np.arctan2(y, x)
+        reach = np.sqrt(big_r**2 - (b * np.sin(theta)) ** 2) - b * np.cos(theta)  # foot to arc along theta
+        stretch = reach / (big_r - b)
+        return b + x * stretch, y * stretch
+    return place
 
 
 @dataclass(frozen=True)
@@ -236,9 +255,28 @@ def air_blocks(g: FemGeometry, lay: Layout) -> list:
     elif g.mouth == "baffled":
         radii = np.concatenate([r_mouth, _graded(a_m, EXTERIOR_RADIUS_PER_A * a_m, lay.h)[1:]])
         blocks.append(_quarter_disc(radii))
+    elif g.mouth == "unflanged":
+        blocks += _unflanged_exterior(g, r_mouth, lay.h)
     else:
-        raise ValueError(f"mouth {g.mouth!r} invalid for the FEM, must be one of 'baffled', 'mount'")
+        raise ValueError(f"mouth {g.mouth!r} invalid for the FEM, must be one of 'baffled', 'mount', 'unflanged'")
     return blocks
+
+
+def _unflanged_exterior(g: FemGeometry, r_mouth: np.ndarray, h: float) -> list:
+    """The free-space exterior of an unflanged tube end (two blocks): the quarter disc below the mouth, its z = 0
+    edge on the mouth's nodes ``r_mouth``, across the wall's end face (cells ≤ h, one cell of w when w < h) and on
+    out to R graded from the wall's outer edge as the baffled exterior from the mouth's (first cell h, so every
+    cell but the end face's shrinks as 1/level); and the air beside the tube's outer wall (:func:`_beside_wall`)
+    on the same nodes of z = 0. R = ``EXTERIOR_RADIUS_PER_A`` mouth radii. Raises ValueError unless 0 < w < R − a."""
+    a_m, w = g.mouth_r, g.wall
+    big_r = EXTERIOR_RADIUS_PER_A * a_m
+    if not 0 < w < big_r - a_m:
+        raise ValueError(f"FemGeometry.wall = {w:g} mm invalid for mouth 'unflanged': must be > 0 and < "
+                         f"{big_r - a_m:g} mm (the tube's wall thickness, inside the exterior's radius)")
+    b = a_m + w
+    outside = _graded(b, big_r, h)
+    radii = np.concatenate([r_mouth, _uniform(a_m, b, h)[1:], outside[1:]])
+    return [_quarter_disc(radii), _quarter_disc(outside - b, _beside_wall(b, big_r))]
 
 
 def merge_blocks(blocks: list, h: float):
@@ -339,9 +377,12 @@ def _boundary_facets(m, g: FemGeometry):
     r, z = mid
     a = g.mouth_r
     tol = 1e-6 * a
-    if g.mouth == "baffled":
+    if g.mouth in ("baffled", "unflanged"):  # the arc: not the baffle (z = 0), nor the tube's outer wall r = a + w
         big_r = EXTERIOR_RADIUS_PER_A * a
-        radiation = boundary & (np.hypot(r, z) > 0.9 * big_r) & (z < -tol)
+        off_wall = z < -tol  # below the mouth; beside an unflanged tube, also off its outer wall
+        if g.mouth == "unflanged":
+            off_wall |= r > a + g.wall + tol
+        radiation = boundary & (np.hypot(r, z) > 0.9 * big_r) & off_wall
         kappa = 1.0 / big_r
     else:
         radiation = boundary & (r > g.gap_radius - tol)

@@ -45,7 +45,8 @@ WALL_SCAN_POINTS = 401
 class TubeDesign:
     """One fipple tube as built (mm, deg): bore, length mouth → cap seat, the cap's cavity depth, the open end's
     ``mouth`` ('fipple', 'unflanged', 'flanged'), windway height h and width B, edge distance W, the cap around
-    the cavity (outer diameter, top thickness, clamped height), the air and the wall material."""
+    the cavity (outer diameter, top thickness, clamped height), the air, the cap's wall material and the printed
+    tube's wall thickness ``tube_wall`` (mm, the spec's ``tube.wall``)."""
 
     bore_diameter: float
     length: float
@@ -59,6 +60,7 @@ class TubeDesign:
     cap_clamp_height: float
     air: Air
     wall: WallMaterial
+    tube_wall: float
 
     @property
     def column_mm(self) -> float:
@@ -82,7 +84,7 @@ def tube_design(spec) -> TubeDesign:
         cap_outer_diameter=spec.end_cap.outer_diameter, cap_top_thickness=spec.end_cap.top_thickness,
         cap_clamp_height=cap_flange_thickness_mm(spec), air=Air(spec.air.temperature_c, spec.air.speed_of_sound),
         wall=WallMaterial(w.model, w.shear_modulus_mpa, w.khz_modulus_factor, w.loss_factor,
-                          spec.silicone.density_g_cm3 * 1000.0))
+                          spec.silicone.density_g_cm3 * 1000.0), tube_wall=t.wall)
 
 
 def mouth_correction_mm(td: TubeDesign, factor: float = 1.0) -> float:
@@ -161,21 +163,25 @@ def fem_hz(td: TubeDesign, kappa_mm: float = 0.0, elements: int = 64, order: int
 def exterior_fem(td: TubeDesign, level: int | None = None):
     """The rigid-capped tube's f1 by the MAT taxel's axisymmetric P2 FEM (:func:`matcad.acoustics.fem.solve`,
     scikit-fem): the (r, z) half-plane with the bore as its neck (``length``), the cap's cavity as its cavity of the
-    same radius (``cap_depth``), and the mouth radiating into the exterior, a quarter disc of 15 a in a rigid
-    baffle with the spherical radiation condition (fem's 'baffled'). It resolves the radiating mouth instead of
-    assuming δ: its f1 tends to the quarter wave with Norris & Sheng's frequency-dependent flanged correction
-    (:func:`flanged_phase_correction_mm`). ``level``: elements across the bore's radius (default fem's). Returns a
-    :class:`matcad.acoustics.fem.FemResult` (f in Hz). Only ``mouth = 'flanged'`` is axisymmetric with an exterior
-    fem.py builds; raises ValueError for 'fipple' (a window in the wall: 3-D) and 'unflanged' (the exterior around
-    the tube's outside is not meshed)."""
+    same radius (``cap_depth``), and the mouth radiating into an exterior of radius 15 a with the spherical
+    radiation condition on its arc: for ``mouth = 'flanged'`` a quarter disc in a rigid baffle (fem's 'baffled'),
+    for ``'unflanged'`` the free space around the tube's end, the printed wall (``tube_wall``) running from the
+    mouth back to the arc (fem's 'unflanged'). It resolves the radiating mouth instead of assuming δ: flanged, its
+    f1 tends to the quarter wave with Norris & Sheng's frequency-dependent correction
+    (:func:`flanged_phase_correction_mm`); unflanged with a thin wall, its correction tends to Levine & Schwinger's
+    0.6133 a as ka → 0, rising with the wall's thickness towards the flanged value (docs/tube.md). ``level``:
+    elements across the bore's radius (default fem's). Returns a :class:`matcad.acoustics.fem.FemResult` (f in Hz).
+    Raises ValueError for 'fipple' (a window in the tube's wall: 3-D)."""
     from matcad.acoustics import fem
 
-    if td.mouth != "flanged":
-        raise ValueError(f"the axisymmetric exterior FEM models a flanged mouth only, not tube.mouth = "
-                         f"'{td.mouth}' (a fipple window is 3-D; an unflanged exterior is not meshed): docs/tube.md")
+    exteriors = {"flanged": "baffled", "unflanged": "unflanged"}
+    if td.mouth not in exteriors:
+        raise ValueError(f"tube.mouth = '{td.mouth}' has no axisymmetric exterior FEM (a fipple's window in the "
+                         f"tube's wall is 3-D), must be one of 'flanged', 'unflanged': docs/tube.md")
     a = td.bore_diameter / 2
     g = fem.FemGeometry(neck_radius=a, neck_length=td.length, cavity_radius=a, cavity_tip_radius=a,
-                        cavity_length=td.cap_depth, mouth="baffled")
+                        cavity_length=td.cap_depth, mouth=exteriors[td.mouth],
+                        wall=td.tube_wall if td.mouth == "unflanged" else 0.0)
     c = speed_of_sound(td.air)
     return fem.solve(g, 2 * math.pi * line_hz(td) / (c * 1e3), level or fem.DEFAULT_LEVEL, speed_of_sound_m_s=c)
 

@@ -1,5 +1,5 @@
-"""A fipple tube's prediction: the air column's routes (closed form, transmission line, 1-D FEM; for a flanged mouth
-on request the axisymmetric exterior FEM), the cap's
+"""A fipple tube's prediction: the air column's routes (closed form, transmission line, 1-D FEM; for a flanged or
+unflanged mouth on request the axisymmetric exterior FEM), the cap's
 wall (the MAT wall model as the closed end's compliance), the edge-tone window of the first two modes, and f(F)
 from the cap mechanics (the MAT cap pressed by a plate: its cavity's volume sets the closed end). Frequencies Hz,
 forces N, lengths mm. Sources: docs/tube.md.
@@ -90,8 +90,8 @@ def _wall_results(td: air.TubeDesign):
 def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePrediction:
     """The prediction of a ``kind = "tube"`` spec, with f at ``forces_n`` (N) from the cap mechanics (FElupe,
     imported only then); with ``fem_level`` (elements across the bore's radius) also the axisymmetric exterior
-    FEM's f1 of a flanged tube (scikit-fem, :func:`matcad.acoustics.tube.exterior_fem`; ValueError for the other
-    mouths)."""
+    FEM's f1 of a flanged or unflanged tube (scikit-fem, :func:`matcad.acoustics.tube.exterior_fem`; ValueError for
+    a fipple mouth)."""
     td = air.tube_design(spec)
     routes = {"closed form (rigid)": air.closed_form_hz(td), "line (rigid)": air.line_hz(td),
               "1-D FEM P2 (rigid)": air.fem_hz(td, 0.0, FEM_ELEMENTS, 2)}
