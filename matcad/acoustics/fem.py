@@ -29,12 +29,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from matcad.acoustics.fem_blocks import beside_wall, block, graded, graded_span, quarter_disc, uniform
 from matcad.acoustics.models import MM_PER_M
 
 DEFAULT_LEVEL = 8
 """Elements across the neck radius; the paper taxel converges to < 0.1 % here (benchmarks/error_vs_runtime.py)."""
 EXTERIOR_RADIUS_PER_A = 15.0
-GROWTH = 1.25
 MIN_Q = 1.0
 FIXED_POINT_ITERATIONS = 6
 
@@ -94,85 +94,6 @@ def geometry(d) -> FemGeometry:
 
 
 # ---------------------------------------------------------------- mesh
-def _graded(start: float, stop: float, first: float, growth: float = GROWTH) -> np.ndarray:
-    """Nodes from start to stop, first cell ``first`` long, each next one ``growth`` times longer."""
-    nodes = [start]
-    step = first
-    while nodes[-1] + step < stop - 0.5 * step:
-        nodes.append(nodes[-1] + step)
-        step *= growth
-    nodes.append(stop)
-    return np.array(nodes)
-
-
-def _uniform(start: float, stop: float, h: float) -> np.ndarray:
-    return np.linspace(start, stop, max(1, math.ceil((stop - start) / h - 1e-9)) + 1)
-
-
-def _graded_span(start: float, stop: float, h: float, h_max: float, fine_start=True, fine_end=True) -> np.ndarray:
-    """Nodes from start to stop: cells of ``h`` at the fine end(s), growing with the distance d from the nearest
-    fine end as h + (GROWTH − 1)·d, capped at ``h_max``; marched, then scaled to end exactly at ``stop``."""
-    span = stop - start
-
-    def size(x):
-        d = min([x] * fine_start + [span - x] * fine_end, default=span)
-        return min(h_max, h + (GROWTH - 1.0) * d)
-
-    nodes = [0.0]
-    while nodes[-1] < span * (1 - 1e-9):
-        nodes.append(nodes[-1] + size(nodes[-1]))
-    return start + np.array(nodes) * (span / nodes[-1])
-
-
-def _grid_cells(points: np.ndarray, split_cross: bool):
-    """Triangles of a (nu+1) x (nv+1) grid of points (index i*(nv+1)+j); cross split adds centre points."""
-    nu, nv = points.shape[0] - 1, points.shape[1] - 1
-    flat = points.reshape(-1, 2)
-    idx = np.arange(flat.shape[0]).reshape(nu + 1, nv + 1)
-    a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
-    c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
-    if not split_cross:
-        return flat, np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
-    centre = (flat[a] + flat[b] + flat[c] + flat[d]) / 4
-    m = flat.shape[0] + np.arange(len(a))
-    tris = np.vstack([np.column_stack([a, b, m]), np.column_stack([b, c, m]),
-                      np.column_stack([c, d, m]), np.column_stack([d, a, m])])
-    return np.vstack([flat, centre]), tris
-
-
-def _block(r_of, zs: np.ndarray, s: np.ndarray):
-    """Structured block: point (r_of(s_i, z_j), z_j)."""
-    ss, zz = np.meshgrid(s, zs, indexing="ij")
-    return _grid_cells(np.stack([r_of(ss, zz), zz], axis=-1), split_cross=False)
-
-
-def _quarter_disc(radii: np.ndarray, place=lambda x, y: (x, -y)):
-    """Quarter disc whose nodes on both axes sit exactly at ``radii`` (Fong's square-to-disc map, then a radial
-    remap), below z = 0; cells are cross-split so the arc's corner cell has no sliver. ``place`` maps the disc's
-    points (x, y ≥ 0, mm) to (r, z), arrays each; by default (x, −y), the quarter below the mouth."""
-    n = len(radii) - 1
-    u = np.linspace(0.0, 1.0, n + 1)
-    uu, vv = np.meshgrid(u, u, indexing="ij")
-    x = uu * np.sqrt(1 - vv * vv / 2)
-    y = vv * np.sqrt(1 - uu * uu / 2)
-    rho = np.hypot(x, y)
-    scale = np.where(rho > 0, np.interp(rho, u, radii) / np.where(rho > 0, rho, 1.0), 0.0)
-    return _grid_cells(np.stack(place(x * scale, y * scale), axis=-1), split_cross=True)
-
-
-def _beside_wall(b: float, big_r: float):
-    """:func:`_quarter_disc`'s ``place`` for the air beside a tube's outer wall r = b (mm), z ≥ 0, up to the arc
-    of radius ``big_r`` (mm) about the mouth's centre: the disc of radius big_r − b centred on the wall's foot
-    (b, 0), stretched along each ray from the foot onto that arc, so its nodes on z = 0 stay at b + x and its
-    outer edge is the radiation arc itself."""
-    def place(x, y):
-        theta = np.arctan2(y, x)
-        reach = np.sqrt(big_r**2 - (b * np.sin(theta)) ** 2) - b * np.cos(theta)  # foot to arc along theta
-        stretch = reach / (big_r - b)
-        return b + x * stretch, y * stretch
-    return place
-
-
 @dataclass(frozen=True)
 class Layout:
     """The node lines the air mesh is built on (mm); the coupled cap mesh reuses them so both meshes share
@@ -201,17 +122,17 @@ def layout(g: FemGeometry, level: int = DEFAULT_LEVEL, cavity_breaks: tuple[floa
     # away from the two re-entrant corners (mouth edge, neck-to-cavity step) cells grow to a size set by the
     # geometry's own scale, with P2 that keeps the smooth regions as accurate as the corners
     h_max = max(h, min(l, L, 2 * g.cavity_radius) / 6)
-    z_cav = _graded_span(l, l + L, h, h_max, fine_end=False)
+    z_cav = graded_span(l, l + L, h, h_max, fine_end=False)
     for z in cavity_breaks:
         z_cav[1 + int(np.argmin(np.abs(z_cav[1:-1] - z)))] = z
     width = max(float(np.max(cavity_wall_radius(g, z_cav))) - a, 0.0)
-    s = (_graded_span(0.0, width, min(h, width), max(min(h, width), h_max), fine_end=False) / width
+    s = (graded_span(0.0, width, min(h, width), max(min(h, width), h_max), fine_end=False) / width
          if width > 1e-9 * a else np.zeros(0))
     groove_r, groove_depth = np.zeros(0), 0.0
     if g.side_volume and len(s):  # the groove's inner wall, halfway from neck to wall, is a node line at any level
         s = np.unique(np.append(s, 0.5 * (float(cavity_wall_radius(g, l)) - a) / width))
         groove_r, groove_depth = _floor_groove(g, s, h, h_max)
-    return Layout(h, h_max, np.linspace(0.0, a, level + 1), _graded_span(0.0, l, h, h_max), z_cav, s,
+    return Layout(h, h_max, np.linspace(0.0, a, level + 1), graded_span(0.0, l, h, h_max), z_cav, s,
                   groove_r, groove_depth)
 
 
@@ -231,7 +152,7 @@ def _floor_groove(g: FemGeometry, s_annulus: np.ndarray, h: float, h_max: float)
     if g.side_volume <= inside * depth_max:
         return floor, g.side_volume / inside
     outer = math.sqrt(floor[0] ** 2 + g.side_volume / (math.pi * depth_max))
-    return np.concatenate([floor, _graded_span(big_r, outer, min(h, outer - big_r), h_max, fine_end=False)[1:]]), \
+    return np.concatenate([floor, graded_span(big_r, outer, min(h, outer - big_r), h_max, fine_end=False)[1:]]), \
         depth_max
 
 
@@ -240,21 +161,21 @@ def air_blocks(g: FemGeometry, lay: Layout) -> list:
     a = g.neck_radius
     r_neck, z_cav = lay.r_neck, lay.z_cavity
     neck_r = (lambda s, z: s) if g.mouth_radius is None else (lambda s, z: s / a * g.neck_radius_at(z))
-    blocks = [_block(neck_r, lay.z_neck, r_neck), _block(lambda s, z: s, z_cav, r_neck)]
+    blocks = [block(neck_r, lay.z_neck, r_neck), block(lambda s, z: s, z_cav, r_neck)]
     if len(lay.s_annulus):
-        blocks.append(_block(lambda s_, z: a + s_ * (cavity_wall_radius(g, z) - a), z_cav, lay.s_annulus))
+        blocks.append(block(lambda s_, z: a + s_ * (cavity_wall_radius(g, z) - a), z_cav, lay.s_annulus))
     if lay.groove_depth:
-        z = _uniform(g.neck_length - lay.groove_depth, g.neck_length, min(lay.h_max, max(lay.h, lay.groove_depth / 4)))
-        blocks.append(_block(lambda r, z_: r, z, lay.groove_r))
+        z = uniform(g.neck_length - lay.groove_depth, g.neck_length, min(lay.h_max, max(lay.h, lay.groove_depth / 4)))
+        blocks.append(block(lambda r, z_: r, z, lay.groove_r))
     a_m = g.mouth_r
     r_mouth = r_neck * (a_m / a)
     if g.mouth == "mount":
-        radii = np.concatenate([r_mouth, _graded(a_m, g.gap_radius, lay.h)[1:]])
-        z_gap = _uniform(-g.gap, 0.0, max(lay.h, g.gap / 16))
-        blocks.append(_block(lambda s, z: s, z_gap, radii))
+        radii = np.concatenate([r_mouth, graded(a_m, g.gap_radius, lay.h)[1:]])
+        z_gap = uniform(-g.gap, 0.0, max(lay.h, g.gap / 16))
+        blocks.append(block(lambda s, z: s, z_gap, radii))
     elif g.mouth == "baffled":
-        radii = np.concatenate([r_mouth, _graded(a_m, EXTERIOR_RADIUS_PER_A * a_m, lay.h)[1:]])
-        blocks.append(_quarter_disc(radii))
+        radii = np.concatenate([r_mouth, graded(a_m, EXTERIOR_RADIUS_PER_A * a_m, lay.h)[1:]])
+        blocks.append(quarter_disc(radii))
     elif g.mouth == "unflanged":
         blocks += _unflanged_exterior(g, r_mouth, lay.h)
     else:
@@ -266,7 +187,7 @@ def _unflanged_exterior(g: FemGeometry, r_mouth: np.ndarray, h: float) -> list:
     """The free-space exterior of an unflanged tube end (two blocks): the quarter disc below the mouth, its z = 0
     edge on the mouth's nodes ``r_mouth``, across the wall's end face (cells ≤ h, one cell of w when w < h) and on
     out to R graded from the wall's outer edge as the baffled exterior from the mouth's (first cell h, so every
-    cell but the end face's shrinks as 1/level); and the air beside the tube's outer wall (:func:`_beside_wall`)
+    cell but the end face's shrinks as 1/level); and the air beside the tube's outer wall (:func:`beside_wall`)
     on the same nodes of z = 0. R = ``EXTERIOR_RADIUS_PER_A`` mouth radii. Raises ValueError unless 0 < w < R − a."""
     a_m, w = g.mouth_r, g.wall
     big_r = EXTERIOR_RADIUS_PER_A * a_m
@@ -274,9 +195,9 @@ def _unflanged_exterior(g: FemGeometry, r_mouth: np.ndarray, h: float) -> list:
         raise ValueError(f"FemGeometry.wall = {w:g} mm invalid for mouth 'unflanged': must be > 0 and < "
                          f"{big_r - a_m:g} mm (the tube's wall thickness, inside the exterior's radius)")
     b = a_m + w
-    outside = _graded(b, big_r, h)
-    radii = np.concatenate([r_mouth, _uniform(a_m, b, h)[1:], outside[1:]])
-    return [_quarter_disc(radii), _quarter_disc(outside - b, _beside_wall(b, big_r))]
+    outside = graded(b, big_r, h)
+    radii = np.concatenate([r_mouth, uniform(a_m, b, h)[1:], outside[1:]])
+    return [quarter_disc(radii), quarter_disc(outside - b, beside_wall(b, big_r))]
 
 
 def merge_blocks(blocks: list, h: float):

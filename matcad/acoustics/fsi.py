@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.acoustics import fem
+from matcad.acoustics import fem, fem_blocks
 from matcad.acoustics.air import BULK_MODULUS_PA
 from matcad.acoustics.wall import UNIT_DENSITY, UNIT_SHEAR_PA
 
@@ -120,13 +120,13 @@ def coupled_mesh(g: fem.FemGeometry, cap: Cap, level: int = fem.DEFAULT_LEVEL) -
     b = cap.outer_radius
     h_solid = lay.h_max * fem.DEFAULT_LEVEL / level  # refines with the level like the air away from corners
     s = _cap_wall_nodes(g, lay, b, h_solid)
-    blocks.append(fem._block(lambda s_, z: fem.cavity_wall_radius(g, z) + s_ * (b - fem.cavity_wall_radius(g, z)),
+    blocks.append(fem_blocks.block(lambda s_, z: fem.cavity_wall_radius(g, z) + s_ * (b - fem.cavity_wall_radius(g, z)),
                              lay.z_cavity, s))
     tip = g.cavity_tip_radius
     a = g.neck_radius
     r_top = np.concatenate([lay.r_neck, a + lay.s_annulus[1:] * (tip - a), tip + s[1:] * (b - tip)])
     z_top = np.linspace(l + L, l + L + cap.top_thickness, _solid_count(cap.top_thickness, h_solid) + 1)
-    blocks.append(fem._block(lambda s_, z: s_, z_top, r_top))
+    blocks.append(fem_blocks.block(lambda s_, z: s_, z_top, r_top))
     m, starts = fem.merge_blocks(blocks, lay.h)
     cells = np.arange(m.t.shape[1])
     return CoupledMesh(m, cells[:starts[n_air]], cells[starts[n_air]:], lay)
