@@ -237,6 +237,27 @@ def test_designed_board_has_no_jet_finding(tmp_path, write_spec):
     assert "bands.allocation" in ids and "board.jet" not in ids
 
 
+def test_designed_board_says_what_check_warns_of(tmp_path, write_spec):
+    """`design --taxels` prints the written board's design-rule warnings and lists every finding in its JSON, the
+    same as `check` on the written file: four taxels on a 1/16 in sheet bend it 0.16 mm under a 5 N press and move
+    a pitch 16 Hz (`plate.bending`), which the design used to write without a word."""
+    base = write_spec(ARRAY_BASE.format(force="5.0").replace("length = 6.35", "length = 1.5875"))
+    out = tmp_path / "arr"
+    args = ("design", base, "--taxels", "4", "--band", "1700", "11000")
+    code, stdout, err = run_cli(*args, "--out", out, "--json")
+    assert code == 0, err
+    data = json.loads(stdout)
+    code, checked, err = run_cli("check", out / f"{data['name']}.toml", "--json")
+    assert code == 0, checked + err
+    assert data["findings"] == json.loads(checked)["findings"]
+    assert "plate.bending" in [f["id"] for f in data["findings"]]
+    code, text, err = run_cli(*args, "--out", tmp_path / "again")
+    assert code == 0, err
+    warned = [line.split()[1] for line in text.splitlines() if line.startswith("  warning ")]
+    assert "plate.bending" in warned
+    assert warned == [f["id"] for f in data["findings"] if f["level"] == "warning"]
+
+
 def test_taxels_that_do_not_fit_exit_2(tmp_path, write_spec):
     code, _, err = run_cli("design", _array_base(write_spec, "20.0"), "--taxels", "4", "--band", "4000", "5000",
                            "--out", tmp_path / "d")

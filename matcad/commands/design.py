@@ -90,6 +90,9 @@ def run(args) -> int:
                     "written": files})
     else:
         print(result.to_text())
+        warnings = [f for f in result.findings if f.level == "warning"]
+        if warnings:  # what `matcad check` would warn of on the written spec
+            print(findings_text(warnings))
         print(f"  {', '.join(files)} in {target}/")
     return EXIT_OK
 

@@ -38,7 +38,8 @@ PER_TAXEL = {"neck.diameter": "neck_diameter", "cavity.diameter": "cavity_diamet
 @dataclass(frozen=True)
 class Allocation:
     """The written array spec, each taxel's band (:class:`matcad.prediction.bands.TaxelBand`) and solution, the
-    guard (Hz), the asked band (Hz) and the run time (s)."""
+    guard (Hz), the asked band (Hz), the run time (s) and the design rules' findings on the written array (no
+    errors: those refuse it)."""
 
     spec: object
     bands: tuple
@@ -46,13 +47,15 @@ class Allocation:
     guard_hz: float
     band_hz: tuple[float, float]
     seconds: float
+    findings: tuple = ()
 
     def to_dict(self) -> dict:
         return {"name": self.spec.name, "band_hz": list(self.band_hz), "guard_hz": self.guard_hz,
                 "seconds": self.seconds, "room_left_hz": self.band_hz[1] - self.bands[-1].loaded_hz[1],
                 "taxels": [b.to_dict() | {"target_hz": s.target_hz, "error": s.error,
                                           "fields": {k: v[1] for k, v in s.fields.items()}}
-                           for b, s in zip(self.bands, self.solutions)]}
+                           for b, s in zip(self.bands, self.solutions)],
+                "findings": [f.to_dict() for f in self.findings]}
 
     def to_text(self) -> str:
         """What `matcad design --taxels` prints: the band shared (Hz), the guard, and each taxel's position (mm),
@@ -224,7 +227,8 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
         bad = "; ".join(f"{f.id}: {f.message}" for f in broken)
         raise RulesFailed(f"the {n}-taxel array breaks a design rule: {bad}", findings)
     placed = [dataclasses.replace(b, x_mm=t.x, y_mm=t.y) for b, t in zip(placed, taxels(out))]
-    return Allocation(out, tuple(placed), tuple(solutions), guard, (lo_hz, hi_hz), time.perf_counter() - start_time)
+    return Allocation(out, tuple(placed), tuple(solutions), guard, (lo_hz, hi_hz), time.perf_counter() - start_time,
+                      tuple(findings))
 
 
 def _fit_text(exc, k: int, n: int, lo: float, hi: float, placed) -> tuple:
