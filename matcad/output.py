@@ -27,11 +27,7 @@ import shutil
 from contextlib import contextmanager
 from pathlib import Path
 
-from matcad.errors import OutputError
-
-WRITTEN: list[Path] = []
-"""Folders this process has put in place, in order: a later failure (a full standard output after the kit was
-written) can then say truthfully what was written. The CLI clears it at the start of each run."""
+from matcad.errors import WRITTEN, OutputError
 
 MANIFEST = ".matcad-manifest.json"
 """Written last into every output folder: {"matcad": version, "files": {relative path: {bytes, sha256}}}."""
