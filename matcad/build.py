@@ -230,16 +230,17 @@ def write_archive(folder: Path, name: str) -> None:
             archive.writestr(info, path.read_bytes())
 
 
-def board_bands(spec) -> dict:
+def board_bands(spec, predictions=None) -> dict:
     """Every taxel's band as report data (:func:`matcad.prediction.bands.summary`). An array's loaded bands take
     the cap mechanics when it has no [calibration] (its rules need them anyway); a single taxel takes the cheap
     path (no FElupe) and never fails on its rise: without a calibration, or past where it holds, the loaded rise
-    is marked not computed and says why (`matcad predict --load` gives the mechanics curve)."""
+    is marked not computed and says why (`matcad predict --load` gives the mechanics curve). ``predictions``: each
+    taxel's unloaded prediction, when the caller has made them."""
     from matcad.prediction.bands import summary, taxel_bands
     from matcad.spec import is_array
 
     board = is_array(spec)
-    return summary(spec, taxel_bands(spec, mechanics=board, strict=board))
+    return summary(spec, taxel_bands(spec, mechanics=board, strict=board, predictions=predictions))
 
 
 def board_report(spec, board, predictions) -> list[dict]:
@@ -280,7 +281,7 @@ def build(spec, out_dir: Path | None = None, force: bool = False, progress=None)
     if failure.blocking:
         raise failure
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
-    bands = board_bands(spec)
+    bands = board_bands(spec, predictions)
     stage(2)
     with staged_output(target) as tmp:
         flats = laser_parts(spec)

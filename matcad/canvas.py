@@ -123,7 +123,11 @@ class Canvas:
         return Axes(self, box, xlim, ylim, equal)
 
     def save(self, path) -> None:
-        self.image.save(path, format="PNG", compress_level=3)  # ~2x faster than the default 6, ~7 % larger
+        """The picture as a PNG file at ``path``. A name ending in .png is left to Pillow to recognise: it then loads
+        its PNG writer alone, where ``format="PNG"`` loads four other formats' plugins first (BMP, GIF, JPEG, PPM;
+        ~10 ms)."""
+        png = str(path).lower().endswith(".png")
+        self.image.save(path, format=None if png else "PNG", compress_level=3)  # 2x faster than 6, 7 % larger
 
 
 class Axes:

@@ -126,8 +126,7 @@ def _fail(args, code: int, text: str, exc: BaseException | None = None) -> int:
     if getattr(args, "json", False) and not (_STDOUT and _STDOUT[0].used):
         import json
 
-        from matcad.errors import EXIT_CODES
-        from matcad.output import WRITTEN
+        from matcad.errors import EXIT_CODES, WRITTEN
 
         error = {"exit_code": code, "meaning": EXIT_CODES[code], "field": getattr(exc, "field", None),
                  "message": str(exc) if exc is not None else text, "written": [str(p) for p in WRITTEN]}
@@ -241,8 +240,7 @@ def _parse(top, argv: list[str]):
 
 
 def _dispatch(args) -> int:
-    from matcad.errors import LoopError, OutputError, SpecError
-    from matcad.output import WRITTEN
+    from matcad.errors import WRITTEN, LoopError, OutputError, SpecError
 
     WRITTEN.clear()  # a new run in the same interpreter
     stdout = sys.stdout = _Stdout(sys.stdout)

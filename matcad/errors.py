@@ -1,5 +1,5 @@
-"""The exit-code table and the exceptions the CLI maps to it (kept import-light: the CLI loads this on every
-command).
+"""The exit-code table, the exceptions the CLI maps to it and the record of folders written that its messages
+quote (kept import-light: the CLI loads this on every command).
 
   0   ok
   1   design-rule failure, or for analyze/calibrate/sense no trustworthy result (no tone, a tone at the band
@@ -17,6 +17,12 @@ EXIT_CODES = {EXIT_OK: "ok", EXIT_RULES: "design-rule failure or no trustworthy 
               EXIT_INPUT: "bad input or unusable file", EXIT_INTERNAL: "internal error (please report)",
               EXIT_INTERRUPT: "interrupted (SIGINT)", EXIT_TERMINATED: "terminated (SIGTERM)"}
 """One row per exit code, enforced by :func:`matcad.cli.main`."""
+
+WRITTEN: list = []
+"""Folders (paths) this process has put in place, in order (:func:`matcad.output.staged_output`): a later failure (a
+full standard output after the kit was written) can then say truthfully what was written. The CLI clears it at
+the start of each run; it lives here, not in :mod:`matcad.output`, so that a command writing no folder does not
+load the output machinery (hashlib, shutil) to report an error."""
 
 ECHO_MAX_CHARS = 80
 """Longest echo of a user's value in a message: a 100 MB field must not come back as a 100 MB error."""

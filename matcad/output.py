@@ -27,11 +27,7 @@ import shutil
 from contextlib import contextmanager
 from pathlib import Path
 
-from matcad.errors import OutputError
-
-WRITTEN: list[Path] = []
-"""Folders this process has put in place, in order: a later failure (a full standard output after the kit was
-written) can then say truthfully what was written. The CLI clears it at the start of each run."""
+from matcad.errors import WRITTEN, OutputError
 
 MANIFEST = ".matcad-manifest.json"
 """Written last into every output folder: {"matcad": version, "files": {relative path: {bytes, sha256}}}."""
@@ -133,14 +129,12 @@ def _check_target(target: Path) -> None:
 def _exchange(a: Path, b: Path) -> bool:
     """Atomically swap two folders (Linux renameat2 RENAME_EXCHANGE); False where unsupported."""
     import ctypes
-    import ctypes.util
     import sys
 
     if not sys.platform.startswith("linux"):
         return False
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        renameat2 = libc.renameat2
+    try:  # the C library this process already runs on (ctypes.util.find_library spawns ldconfig: ~40 ms)
+        renameat2 = ctypes.CDLL(None, use_errno=True).renameat2
     except (OSError, AttributeError):
         return False
     at_fdcwd, rename_exchange = -100, 2

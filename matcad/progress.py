@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import os
 import sys
-import threading
 import time
 from contextlib import contextmanager
 
@@ -49,6 +48,8 @@ class _Line:
     """The drawing callback: ``self(done, total)`` redraws the line when :data:`INTERVAL_S` has passed."""
 
     def __init__(self, label: str, unit: str, stream):
+        import threading  # only a drawn line ticks: a command run without a terminal loads no threading
+
         self.label, self.unit, self.stream = label, unit, stream
         self.start = time.monotonic()
         self.last = -INTERVAL_S

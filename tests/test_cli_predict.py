@@ -42,6 +42,18 @@ def test_predict_does_not_import_cad_kernel():
     assert proc.returncode == 0, proc.stderr
 
 
+def test_predict_loads_no_board_bands_output_folders_or_threads():
+    """One taxel's `predict` writes no folder and has no board: matcad.output (hashlib, shutil) and
+    matcad.prediction.bands stay unloaded, and without a terminal no progress line ticks (threading)
+    (issue 25: predict near its imports)."""
+    code = ("import sys; from matcad.cli import main; assert main(['predict', %r]) == 0; bad = [m for m in "
+            "('matcad.output', 'matcad.prediction.bands', 'hashlib', 'threading') if m in sys.modules]; "
+            "assert not bad, bad" % str(PAPER))
+    import subprocess
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+
+
 @pytest.mark.parametrize("text,field", [
     (MINIMAL.replace("diameter = 2.1", "diameter = -2.1"), "neck.diameter"),
     (MINIMAL.replace("diameter = 2.1", "diameter = 5.0"), "neck.diameter"),

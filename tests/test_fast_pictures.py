@@ -105,8 +105,10 @@ def test_engraving_table_draws_what_matplotlib_draws(height):
 
 
 def test_analyze_loads_neither_matplotlib_nor_scipy_ndimage(tmp_path):
-    """`analyze --band` in a fresh interpreter: the spectrogram is written and neither the plotting stack nor
-    scipy.ndimage (nor the spec package: --band needs no spec) is loaded (issue 25: analyze near its tracker)."""
+    """`analyze --band` in a fresh interpreter, twice into one folder: the spectrogram is written and neither the
+    plotting stack nor scipy.ndimage (nor the spec package: --band needs no spec) is loaded, nor Pillow's other
+    image formats (the PNG is saved by its name), nor subprocess (the second run swaps the folders through the C
+    library already loaded, not ctypes.util.find_library) (issue 25: analyze near its tracker)."""
     import subprocess
     import sys
     import wave
@@ -119,8 +121,9 @@ def test_analyze_loads_neither_matplotlib_nor_scipy_ndimage(tmp_path):
         w.setsampwidth(2)
         w.setframerate(fs)
         w.writeframes(np.round(0.3 * np.sin(2 * np.pi * 4700 * t) * 30000).astype("<i2").tobytes())
-    code = ("import sys; from matcad.cli import main; rc = main(['analyze', %r, '--band', '3900', '5600', '--out', %r]);"
-            " assert rc == 0; bad = [m for m in ('matplotlib', 'scipy.ndimage', 'matcad.spec') if m in sys.modules];"
+    code = ("import sys; from matcad.cli import main; argv = ['analyze', %r, '--band', '3900', '5600', '--out', %r];"
+            " assert main(argv) == 0 and main(argv) == 0; bad = [m for m in ('matplotlib', 'scipy.ndimage', "
+            "'matcad.spec', 'PIL.JpegImagePlugin', 'PIL.GifImagePlugin', 'subprocess') if m in sys.modules];"
             " assert not bad, bad" % (str(rec), str(tmp_path / "a")))
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr

@@ -77,6 +77,27 @@ def test_silicone_batch_volume_and_mass():
     assert "PLA" in batch.message and "SLA" not in batch.message
 
 
+def test_silicone_batch_and_bom_lay_out_no_mold(monkeypatch):
+    """The batch to mix is the casting guide's, without the mold's layout and vent plan (a laser-only kit has no
+    mold; its vent search was most of the rules' time)."""
+    from matcad.parts import casting
+    from matcad.report.data import silicone_bom
+    from matcad.rules.printing import silicone_batch
+
+    spec = spec_mod.load(PAPER)
+    guide = casting.casting_guide(spec)
+
+    def no_layout(spec):
+        raise AssertionError("the batch laid out the mold")
+
+    monkeypatch.setattr(casting, "layout", no_layout)
+    (batch,) = silicone_batch(spec)
+    assert batch.value == round(guide.batch_g, 3) and guide.batch_reason in batch.message
+    bom = silicone_bom(spec)
+    assert (bom["caps_per_pour"], bom["cast_volume_ml"], bom["needed_mass_g"], bom["batch_mass_g"]) == (
+        guide.caps, guide.cast_volume_ml, guide.needed_g, guide.batch_g)
+
+
 def test_sla_mold_gets_the_inhibition_warning_and_no_pla_wording():
     sla = _paper_with(machine__printer="sla")
     found = {f.id: f for f in check(sla)}

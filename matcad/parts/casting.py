@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from matcad.materials import grade
 from matcad.parts.features import cap_volume_mm3
-from matcad.parts.mold_layout import layout
+from matcad.parts.mold_layout import layout, mold_slots
 from matcad.parts.print_profile import PRINT_FILE
 
 if TYPE_CHECKING:
@@ -79,17 +79,26 @@ class CastingGuide:
         return asdict(self)
 
 
-def casting_guide(spec: Spec, jobs: tuple[str, ...] = ()) -> CastingGuide:
-    """The pour for ``spec``: batch = max(cast volume × waste factor × density, :data:`MIN_BATCH_G`) (g). ``jobs``
-    are the 3MF files written that hold the mold halves (named in the print step; before a build, the printer's
-    job file and its numbered siblings)."""
+@dataclass(frozen=True)
+class Pour:
+    """One pour of the mold: its caps, their cast volume (ml), the mass they need with the waste factor and the
+    batch to mix (g), and why that batch."""
+
+    caps: int
+    cast_volume_ml: float
+    needed_g: float
+    batch_g: float
+    batch_reason: str
+
+
+def pour(spec: Spec) -> Pour:
+    """The pour of ``spec``'s ``mold.count`` caps (:func:`matcad.parts.mold_layout.mold_slots`): batch = max(cast
+    volume × waste factor × density, :data:`MIN_BATCH_G`) (g). It needs no mold layout: a kit without a mold (a
+    laser-only build) still buys and mixes its silicone."""
     from matcad.spec import taxel_spec, taxels
 
-    g = grade(spec.silicone.grade)
-    mold = MOLD_MATERIALS[spec.machine.printer]
     caps = spec.mold.count
-    lay = layout(spec)
-    volumes = [cap_volume_mm3(taxel_spec(spec, t)) for t in lay.slots]
+    volumes = [cap_volume_mm3(taxel_spec(spec, t)) for t in mold_slots(taxels(spec), caps)]
     cast_ml = (volumes[0] * caps if len(set(volumes)) == 1 else sum(volumes)) / 1000
     needed = cast_ml * spec.silicone.waste_factor * spec.silicone.density_g_cm3
     batch = max(needed, MIN_BATCH_G)
@@ -97,6 +106,19 @@ def casting_guide(spec: Spec, jobs: tuple[str, ...] = ()) -> CastingGuide:
               f"least {MIN_BATCH_G:g} g so the ratio can be weighed on a 0.01 g scale and cup residue does not eat "
               "the batch" if needed < MIN_BATCH_G else f"the caps need {needed:.2f} g with x{spec.silicone.waste_factor:g} "
               "for cup, sprues and vents")
+    return Pour(caps, cast_ml, needed, batch, reason)
+
+
+def casting_guide(spec: Spec, jobs: tuple[str, ...] = ()) -> CastingGuide:
+    """The pour for ``spec`` (:func:`pour`) and how to make it in the mold laid out for it. ``jobs`` are the 3MF
+    files written that hold the mold halves (named in the print step; before a build, the printer's job file and
+    its numbered siblings)."""
+    from matcad.spec import taxels
+
+    g = grade(spec.silicone.grade)
+    mold = MOLD_MATERIALS[spec.machine.printer]
+    p = pour(spec)
+    lay = layout(spec)
     vents = len(lay.plan.inner) + len(lay.plan.outer)
     c = lay.clamp
     nuts = (f"the {len(lay.bolts)} captive {c.bolt} nuts in the base (pressed into the traps under it after "
@@ -116,7 +138,7 @@ def casting_guide(spec: Spec, jobs: tuple[str, ...] = ()) -> CastingGuide:
         + (" (the taxel names on the lid and the base side by side)" if board else "")
         + f"; {len(lay.bolts)} x {c.bolt} x {c.length_mm or 0:g} mm bolts through the lid into {nuts}, finger-tight "
         "and even until the lid sits on the base; the mold stands flat on its base: set it level, fill ports up.",
-        f"Weigh {batch:.1f} g of {g.label} ({g.mix_ratio}), mix 3 min scraping sides and bottom, degas in vacuum "
+        f"Weigh {p.batch_g:.1f} g of {g.label} ({g.mix_ratio}), mix 3 min scraping sides and bottom, degas in vacuum "
         f"if you can; pot life {g.pot_life_min:g} min at 23 °C.",
         f"Fill each cap through its {spec.mold.fill_port:g} mm fill port with a syringe, slowly, one cap at a time: "
         "the silicone runs down the body wall to the bottom of the pocket (the membrane) and rises round the core "
@@ -138,8 +160,8 @@ def casting_guide(spec: Spec, jobs: tuple[str, ...] = ()) -> CastingGuide:
         "plate: it must sit flat with no nub (a nub holds the flange off the plate and the cavity leaks)",
         "nothing to trim inside the cavity: the core pin has no vent, so the membrane's inside is clean",
     )
-    return CastingGuide(grade=g.label, mold_material=mold.label, caps=caps, cast_volume_ml=cast_ml,
-                        needed_g=needed, batch_g=batch, batch_reason=reason, mix_ratio=g.mix_ratio,
+    return CastingGuide(grade=g.label, mold_material=mold.label, caps=p.caps, cast_volume_ml=p.cast_volume_ml,
+                        needed_g=p.needed_g, batch_g=p.batch_g, batch_reason=p.batch_reason, mix_ratio=g.mix_ratio,
                         pot_life_min=g.pot_life_min, cure_h_room=g.cure_h_room, max_cure_c=mold.max_cure_c,
                         cure_note=mold.note, release=RELEASE_AGENT, inhibition=mold.inhibition,
                         vents_per_cap=vents, steps=steps, trim=trim)

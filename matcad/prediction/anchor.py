@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 from matcad.acoustics.uncertainty import TEMPERATURE_TOL_C, BudgetLine, total
 from matcad.spec import calibrated_spec
@@ -86,7 +87,13 @@ class CalibrationAnchor:
         variance = (cal.cov[0, 0] if cal.covariance is not None else 0.0) + (cal.residual_std_mm3 or 0.0) ** 2 \
             + cal.cycle_std_mm3 ** 2
         self.sd = 0.5 * math.sqrt(variance) / cal.v0_mm3 if variance > 0 else CALIBRATION_F0_SD
-        self.physics = _physics_hz(measured)
+        self.calibrated = measured  # the calibrated taxel's own spec
+
+    @cached_property
+    def physics(self) -> float:
+        """The calibrated taxel's physics f0 (Hz), computed for the first design varied from it: the calibrated
+        taxel itself has a ratio of exactly 1 and needs none."""
+        return _physics_hz(self.calibrated)
 
     def ratio(self, spec) -> float:
         """This design's physics f0 over the calibrated taxel's (1 exactly when ``spec`` draws the calibrated

@@ -159,12 +159,15 @@ def taxel_band(spec, name: str = "t1", x_mm: float = 0.0, y_mm: float = 0.0, mec
                      x_mm, y_mm)
 
 
-def taxel_bands(spec, mechanics: bool = True, strict: bool = True) -> list[TaxelBand]:
+def taxel_bands(spec, mechanics: bool = True, strict: bool = True, predictions=None) -> list[TaxelBand]:
     """One :class:`TaxelBand` per taxel of ``spec``, in :func:`matcad.spec.taxels` order (Hz, mm); ``mechanics``
-    and ``strict`` as for :func:`taxel_band`."""
+    and ``strict`` as for :func:`taxel_band`; ``predictions`` are the taxels' ``predict(taxel_spec(spec, t))`` in
+    the same order when the caller has them."""
     from matcad.spec import taxel_spec, taxels
 
-    return [taxel_band(taxel_spec(spec, t), t.name, t.x, t.y, mechanics, strict=strict) for t in taxels(spec)]
+    board = taxels(spec)
+    return [taxel_band(taxel_spec(spec, t), t.name, t.x, t.y, mechanics, prediction=p, strict=strict)
+            for t, p in zip(board, predictions or [None] * len(board), strict=True)]
 
 
 def summary(spec, bands) -> dict:

@@ -91,20 +91,20 @@ def bill_of_materials(spec, flats: list[Flat], mold: MoldLayout | None) -> dict:
 
 def silicone_bom(spec) -> dict:
     """The silicone to buy and mix, the same numbers the casting guide pours (g, ml, mm³): per distinct cap its
-    taxels, volume and mass, then one pour of the mold."""
-    from matcad.parts.casting import casting_guide
+    taxels, volume and mass, then one pour of the mold (:func:`matcad.parts.casting.pour`)."""
+    from matcad.parts.casting import pour
     from matcad.parts.mold_layout import cap_groups
     from matcad.spec import taxel_spec, taxels
 
-    guide = casting_guide(spec)
+    p = pour(spec)
     rho = spec.silicone.density_g_cm3
     caps = []
     for group in cap_groups(taxels(spec)):
         v = cap_volume_mm3(taxel_spec(spec, group[0]))
         caps.append({"taxels": [t.name for t in group], "cap_volume_mm3": v, "cap_mass_g": v / 1000 * rho})
     return {"caps": caps, "cap_volume_mm3": caps[0]["cap_volume_mm3"], "cap_mass_g": caps[0]["cap_mass_g"],
-            "caps_per_pour": guide.caps, "cast_volume_ml": guide.cast_volume_ml, "needed_mass_g": guide.needed_g,
-            "batch_mass_g": guide.batch_g, "batch_ml": guide.batch_g / rho, "density_g_cm3": rho}
+            "caps_per_pour": p.caps, "cast_volume_ml": p.cast_volume_ml, "needed_mass_g": p.needed_g,
+            "batch_mass_g": p.batch_g, "batch_ml": p.batch_g / rho, "density_g_cm3": rho}
 
 
 def drill_bom(spec) -> list[dict]:

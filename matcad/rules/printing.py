@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from matcad.parts.casting import MIN_BATCH_G, MOLD_MATERIALS, casting_guide
+from matcad.materials import grade
+from matcad.parts.casting import MIN_BATCH_G, MOLD_MATERIALS, pour
 from matcad.parts.coupon import FDM_THETA_MIN_DEG
 from matcad.parts.mold_layout import NUT_ROOF_MM, appendages, layout, plan_vents
 from matcad.parts.registry import Kind, wanted
@@ -144,11 +145,13 @@ def cap_wall(spec) -> list[Finding]:
 
 
 def silicone_batch(spec) -> list[Finding]:
-    guide = casting_guide(spec)
-    return [Finding("silicone.batch", "info", round(guide.batch_g, 3), MIN_BATCH_G,
-                    f"{guide.caps} cap(s) = {guide.cast_volume_ml:.3f} ml cast; mix {guide.batch_g:.1f} g of "
-                    f"{guide.grade} ({guide.mix_ratio}): {guide.batch_reason}; pot life {guide.pot_life_min:g} min, "
-                    f"cure {guide.cure_h_room:g} h at 23 C or <= {guide.max_cure_c:g} C in {guide.mold_material} molds",
+    """The silicone to mix for one pour (:func:`matcad.parts.casting.pour`; no mold layout: a laser-only kit has
+    none), its pot life and cure."""
+    p, g, mold = pour(spec), grade(spec.silicone.grade), MOLD_MATERIALS[spec.machine.printer]
+    return [Finding("silicone.batch", "info", round(p.batch_g, 3), MIN_BATCH_G,
+                    f"{p.caps} cap(s) = {p.cast_volume_ml:.3f} ml cast; mix {p.batch_g:.1f} g of "
+                    f"{g.label} ({g.mix_ratio}): {p.batch_reason}; pot life {g.pot_life_min:g} min, "
+                    f"cure {g.cure_h_room:g} h at 23 C or <= {mold.max_cure_c:g} C in {mold.label} molds",
                     "")]
 
 
