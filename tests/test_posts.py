@@ -131,3 +131,15 @@ def test_built_mount_carries_the_posts_to_the_plate_underside(board, tmp_path):
         assert (cx, cy, radius) == pytest.approx((x, y, r), abs=0.01)
         near = np.hypot(mesh.vertices[:, 0] - x, mesh.vertices[:, 1] - y) <= r + 1e-6
         assert mesh.vertices[near, 2].max() == pytest.approx(0.0, abs=1e-6)
+
+
+@pytest.mark.parametrize("template", ["mat-paper", "mat-array-4", "mat-sla-array", "mat-laser-only"])
+def test_templates_carry_no_posts(template):
+    """Posts are off unless asked for: every template's mount, labels and bending are those of a plate without
+    them (their kits are byte-identical but for the two new fields in report.json's resolved spec)."""
+    from matcad.parts.features import plate_post_positions_mm
+    from matcad.rules.plate import support_posts
+    from tests.conftest import ROOT
+
+    s = spec_mod.load(ROOT / "templates" / f"{template}.toml")
+    assert not s.plate.support_posts and plate_post_positions_mm(s) == [] and support_posts(s) == []

@@ -25,10 +25,11 @@ part's features print up to ~0.2 mm oversize (:data:`matcad.parts.features.PIN_F
 set by hand sits a few tenths off its bore's axis."""
 POST_MOUTH_GAPS = 3.0
 """Least distance from a support post to a neck's mouth edge, in mount gaps (spacer.height). The 'mount' mouth's
-model (:func:`matcad.acoustics.models.mount_end_correction_mm`) takes the gap's radial flow as unobstructed; a
-post blocks part of it, an effect not modelled. Its size, estimated in docs/arrays.md from the same radial-flow
-inertance, is a fraction of a hertz at this distance: the radial flow out of a mouth spreads over the gap within
-about a gap height of its edge, so three keep the post in the fully spread flow."""
+model (:func:`matcad.acoustics.models.mount_end_correction_mm`) takes the gap's radial flow as starting a gap height
+beyond the mouth's edge (r = a + h) and unobstructed out to the vent radius; three gaps keep a post well outside
+the region where the flow turns from the neck into the gap. What a post does to the radial flow is not modelled:
+docs/arrays.md estimates it from the same radial-flow inertance (at most ~5 Hz, 0.1 % of f0, on the capacity
+boards)."""
 
 
 @dataclass(frozen=True)
