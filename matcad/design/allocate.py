@@ -11,7 +11,9 @@ message says how far the N bands reach. The taxels go in two staggered columns o
 (:func:`stagger`: every neck downstream of a needle sits between two of its rows) with the pitches that keep the
 cap flanges the laser's smallest web apart and every neck out of every jet (:func:`stagger_pitch`, the
 ``board.jet`` rule's geometry), on a plate grown by the layout's extent; the written array must pass every rule
-with no ``board.jet`` finding. Frequencies Hz, lengths mm.
+with no ``board.jet`` finding. A board whose plate would bend (``plate.bending``) is written with support posts under it
+(``plate.support_posts``) when the posts fit it (no ``plate.posts`` error: each post 3 mount gaps from every mouth);
+otherwise it is written as it was, with its warning. Frequencies Hz, lengths mm.
 """
 
 from __future__ import annotations
@@ -222,6 +224,11 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
         start = band.loaded_hz[1] + guard
     out = array_spec(base, points, solutions, name or f"{spec.name}-{n}taxels")
     findings = check(out)
+    if any(f.id == "plate.bending" for f in findings) and not out.plate.support_posts:  # posts hold it flat
+        posted = dataclasses.replace(out, plate=dataclasses.replace(out.plate, support_posts=True))
+        with_posts = check(posted)
+        if not any(f.level == "error" for f in with_posts):  # posts that do not fit leave the board as it was
+            out, findings = posted, with_posts
     broken = [f for f in findings if f.level == "error" or f.id == "board.jet"]
     if broken:  # board.jet cannot fire on the stagger (stagger_pitch): checked on the solved necks all the same
         bad = "; ".join(f"{f.id}: {f.message}" for f in broken)

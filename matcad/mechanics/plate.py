@@ -8,7 +8,10 @@ Roark's Formulas for Stress and Strain (Young & Budynas, 7th ed., Table 8.1, cas
 beam in small deflection, the limit of a long narrow board. Left out, each named where :func:`deflection_mm` is
 used: the holes, the guides bolted over the plate (unbonded, holed by the flanges: they add little), the
 two-way action of a squarer plate on point supports (softer than the beam there), large deflection (beyond about
-half the thickness a plate held in-plane stiffens; one on bolts in clearance holes barely is).
+half the thickness a plate held in-plane stiffens; one on bolts in clearance holes barely is). With support
+posts under it (:func:`matcad.parts.stack.plate_deflection_mm`) the same simply supported beam spans the bay
+between the support lines either side of the load, and a cantilever (:func:`cantilever_deflection_mm`) carries
+the load from the post line out to the neck.
 """
 
 from __future__ import annotations
@@ -36,3 +39,12 @@ def deflection_mm(force_n: float, load_mm: float, at_mm, span_mm: float, width_m
     near = force_n * (l - a) * x * (l * l - (l - a) ** 2 - x * x)
     far = force_n * a * (l - x) * (2 * l * x - x * x - a * a)
     return np.where(x <= a, near, far) / (6.0 * ei * l)
+
+
+def cantilever_deflection_mm(force_n: float, length_mm: float, width_mm: float, thickness_mm: float,
+                             modulus_mpa: float) -> float:
+    """Deflection (mm, in the load's direction) at the free end of a cantilever of ``length_mm`` and rectangular
+    section ``width_mm`` x ``thickness_mm`` (modulus ``modulus_mpa``), fixed at its root and loaded by ``force_n``
+    at its free end: W l³ / (3 E I) (Roark, Table 8.1 case 1a). Exact for a slender beam in small deflection; 0
+    for a zero length."""
+    return force_n * length_mm ** 3 / (3.0 * modulus_mpa * second_moment_mm4(width_mm, thickness_mm))

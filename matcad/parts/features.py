@@ -127,6 +127,28 @@ def plate_bolt_positions_mm(spec) -> list[tuple[float, float]]:
     return [(-x, -y), (x, -y), (x, y), (-x, y)]
 
 
+def plate_post_positions_mm(spec) -> list[tuple[float, float]]:
+    """Support post centres (x, y) under the neck plate, when ``plate.support_posts`` (else none; mm): on the centre
+    line between each two neighbouring columns of necks (taxels sharing an x; :func:`matcad.design.allocate.stagger`
+    makes two), one midway in y between each two necks of those columns that follow each other in y. On the
+    stagger that puts a post between a left-column row and the right-column row half a row below it: the right
+    neck's own needle runs along its row toward +x and the left needle's jet along the left row, so the post stands
+    between them, and the necks' mouths either side of it are equally far. A board of one column (or one taxel)
+    has no such line and no posts. Every part, rule and drawing takes the posts from here; the ``plate.posts`` rule
+    (:mod:`matcad.rules.plate`) checks each against the jets, needles, mouths, bolts and dowels."""
+    from matcad.spec import taxels
+
+    if not spec.plate.support_posts:
+        return []
+    board = taxels(spec)
+    columns = sorted({t.x for t in board})
+    out = []
+    for left, right in zip(columns, columns[1:]):
+        ys = sorted({t.y for t in board if t.x in (left, right)}, reverse=True)
+        out += [((left + right) / 2, (a + b) / 2) for a, b in zip(ys, ys[1:])]
+    return out
+
+
 def plate_dowel_positions_mm(spec) -> list[tuple[float, float]]:
     """Dowel centres (x, y): mid-edge on ±y, offset in x so the stack only assembles one way (mm)."""
     inset = spec.plate.bolt_inset + spec.fasteners.dowel_diameter / 2

@@ -2,14 +2,17 @@
 
 Assembly frame (shared with every part): plate underside z = 0, neck axis = z axis. The mount's top face is
 at z = −spacer.height and it is ``mount.thickness`` thick. Bolts from the stack thread into self-tapping
-pilots; dowels press into it; with ``spacer.style = "standoff"`` the spacers are printed on it.
+pilots; dowels press into it; with ``spacer.style = "standoff"`` the spacers are printed on it, and with
+``plate.support_posts`` the support posts under the plate (:func:`matcad.parts.features.plate_post_positions_mm`),
+exactly the gap tall: the press only ever pushes the plate down onto them, so they carry compression and need no
+fastening.
 """
 
 import math
 
 from matcad.parts.features import (EAR_THICKNESS_MM, EAR_WIDTH_MM, FIXING_BOLT, SELF_TAP_PILOT_MM, bolt_clearance_mm,
                                    ear_holes_mm, needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
-                                   plate_bolt_positions_mm, plate_dowel_positions_mm)
+                                   plate_bolt_positions_mm, plate_dowel_positions_mm, plate_post_positions_mm)
 from matcad.parts.registry import Kind, Part, PrintPose
 
 
@@ -45,15 +48,16 @@ def needle_bore(taxel, bore_diameter: float, reach: float):
 def mount_extent_mm(spec) -> tuple[float, float, float]:
     """The mount's bounding box in its print pose (x, y, z mm): the block plate.width wide, its ears
     :data:`~matcad.parts.features.EAR_WIDTH_MM` beyond the plate's depth on ±y, ``mount.thickness`` tall plus the
-    standoffs (spacer.height) when they are printed on it."""
-    standoffs = spec.spacer.height if spec.spacer.style == "standoff" else 0.0
+    standoffs or support posts (spacer.height) when they are printed on it."""
+    standoffs = spec.spacer.height if spec.spacer.style == "standoff" or plate_post_positions_mm(spec) else 0.0
     return spec.plate.width, spec.plate.depth + 2 * EAR_WIDTH_MM, spec.mount.thickness + standoffs
 
 
 def needle_mount(spec):
-    """The mount solid in the assembly frame (mm): block, fixing ears, standoffs (if printed), bolt pilots,
-    dowel holes, one needle bore per taxel (at its θ and y, aimed at its own neck), and on a board each bore's taxel
-    name recessed beside its mouth on the top face. No manifold: each needle takes its own air line."""
+    """The mount solid in the assembly frame (mm): block, fixing ears, standoffs (if printed), support posts (if
+    any), bolt pilots, dowel holes, one needle bore per taxel (at its θ and y, aimed at its own neck), and on a
+    board each bore's taxel name recessed beside its mouth on the top face. No manifold: each needle takes its own
+    air line."""
     from build123d import Box, Pos
 
     from matcad.parts.labels import PRINTED_LABEL_DEPTH_MM
@@ -69,6 +73,8 @@ def needle_mount(spec):
     if spec.spacer.style == "standoff":
         for x, y in plate_bolt_positions_mm(spec):
             body += cylinder_up(spec.spacer.size / 2, gap, x, y, top)
+    for x, y in plate_post_positions_mm(spec):
+        body += cylinder_up(spec.plate.post_diameter / 2, gap, x, y, top)
     pilot = SELF_TAP_PILOT_MM[spec.fasteners.bolt] / 2
     dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
                                  spec.fasteners.dowel_fit_printed) / 2
@@ -97,7 +103,8 @@ def bore_mouth_mm(spec, taxel) -> tuple[float, float, float]:
 
 def mount_labels(spec) -> tuple:
     """A board's taxel names recessed in the mount's top face, each beside its needle bore's mouth, clear of the
-    other mouths, the bolt pilots (or standoffs) and the dowel holes; () for a single taxel (mm)."""
+    other mouths, the bolt pilots (or standoffs), the dowel holes and the support posts; () for a single taxel
+    (mm)."""
     from matcad.parts.labels import PRINTED_LABEL_HEIGHTS_MM, place_labels
     from matcad.spec import taxels
 
@@ -109,7 +116,8 @@ def mount_labels(spec) -> tuple:
     dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
                                  spec.fasteners.dowel_fit_printed) / 2
     keepout = (mouths + [(x, y, post) for x, y in plate_bolt_positions_mm(spec)]
-               + [(x, y, dowel) for x, y in plate_dowel_positions_mm(spec)])
+               + [(x, y, dowel) for x, y in plate_dowel_positions_mm(spec)]
+               + [(x, y, spec.plate.post_diameter / 2) for x, y in plate_post_positions_mm(spec)])
     return place_labels([(t.name, x, y) for t, (x, y, _) in zip(board, mouths)], keepout, spec.plate.width,
                         spec.plate.depth, heights=PRINTED_LABEL_HEIGHTS_MM)
 

@@ -10,11 +10,13 @@ of materials and the fabrication plan all read these heights from here.
 
 from __future__ import annotations
 
+import numpy as np
+
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.materials import ACRYLIC_MODULUS_MPA
-from matcad.mechanics.plate import deflection_mm
-from matcad.parts.features import plate_bolt_positions_mm
-from matcad.spec import cap_flange_thickness_mm
+from matcad.mechanics.plate import cantilever_deflection_mm, deflection_mm
+from matcad.parts.features import plate_bolt_positions_mm, plate_post_positions_mm
+from matcad.spec import cap_flange_diameter_mm, cap_flange_thickness_mm
 
 
 def clamp_seat_z_mm(spec) -> float:
@@ -56,15 +58,44 @@ def plate_beam(spec) -> tuple[str, float, float]:
     return "x", max(xs) - min(xs), spec.plate.depth
 
 
+def post_bay_mm(spec, pressed) -> tuple[float, float, float, float]:
+    """Where the support posts (:func:`matcad.parts.features.plate_post_positions_mm`, at least one) hold the plate
+    around the taxel ``pressed`` (anything with x, y and a cap): (the support line below it in y and the one above,
+    each a row of posts or a bolt row, whichever is nearer; the arm from the nearest post line, in x, to its neck;
+    the strip's width, its cap flange's diameter) in mm."""
+    posts = plate_post_positions_mm(spec)
+    lines = {y for _, y in posts} | {y for _, y in plate_bolt_positions_mm(spec)}
+    below = max(y for y in lines if y <= pressed.y)
+    above = min(y for y in lines if y >= pressed.y)
+    arm = min(abs(pressed.x - x) for x, _ in posts)
+    return below, above, arm, cap_flange_diameter_mm(pressed)
+
+
 def plate_deflection_mm(spec, force_n: float, pressed, taxels):
     """How far the neck plate (cast acrylic, :data:`matcad.materials.ACRYLIC_MODULUS_MPA`, neck.length thick) bends
     down toward the mount under each of ``taxels`` when ``force_n`` presses on the taxel ``pressed`` (a
-    :class:`matcad.spec.Taxel`, or anything with x and y): :func:`matcad.mechanics.plate.deflection_mm` on
-    :func:`plate_beam` (mm, an array in the order of ``taxels``)."""
-    axis, span, width = plate_beam(spec)
+    :class:`matcad.spec.Taxel`, or anything with x, y and a cap; mm, an array in the order of ``taxels``).
 
-    def along(t) -> float:
-        return getattr(t, axis) + span / 2
+    Without support posts: :func:`matcad.mechanics.plate.deflection_mm` on :func:`plate_beam`. With them
+    (:func:`post_bay_mm`), two parts added: the strip of the plate under the pressed cap, its flange's diameter
+    wide, as a beam along y simply supported on the two support lines either side of the load (a post row or a bolt
+    row; Roark Table 8.1 case 1e), and the same strip across, a cantilever from the post line out to the pressed neck
+    (case 1a), the post line taken as its fixed root. Assumptions, each on the soft side but the last: the rest of
+    the plate's width, which only adds stiffness to the strip that carries the load, is left out; a taxel beyond
+    either support line bends 0 (a continuous plate lifts there, which opens its gap); a neighbour takes the
+    strip's bending along y only, not the cantilever, which is the pressed taxel's own; the post line is a clamp,
+    though the plate may turn about it where no neck across the line holds it — a point post does not hold a line,
+    so this is an estimate, the reason the strip is taken no wider than the cap that loads it."""
+    if not plate_post_positions_mm(spec):
+        axis, span, width = plate_beam(spec)
 
-    return deflection_mm(force_n, along(pressed), [along(t) for t in taxels], span, width, spec.neck.length,
-                         ACRYLIC_MODULUS_MPA)
+        def along(t) -> float:
+            return getattr(t, axis) + span / 2
+
+        return deflection_mm(force_n, along(pressed), [along(t) for t in taxels], span, width, spec.neck.length,
+                             ACRYLIC_MODULUS_MPA)
+    below, above, arm, width = post_bay_mm(spec, pressed)
+    bay = deflection_mm(force_n, pressed.y - below, [t.y - below for t in taxels], above - below, width,
+                        spec.neck.length, ACRYLIC_MODULUS_MPA)
+    own = cantilever_deflection_mm(force_n, arm, width, spec.neck.length, ACRYLIC_MODULUS_MPA)
+    return bay + np.array([own if t is pressed else 0.0 for t in taxels])

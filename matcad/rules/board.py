@@ -94,19 +94,28 @@ def spacing(spec) -> list[Finding]:
 
 def jet_clearance_mm(jet, neck) -> tuple[float, float]:
     """How far the neck mouth of taxel ``neck`` stays outside the jet of taxel ``jet``'s needle (negative: inside),
-    as (free jet, jet along the plate): the free jet is a cone of half-angle :data:`JET_HALF_ANGLE_DEG` from the
-    needle's tip along its axis up to the plate underside; past there the jet runs along the plate in its axis'
-    direction (+x), still widening at that angle with the distance travelled (mm; inf where it never passes)."""
+    as (free jet, jet along the plate): :func:`disc_jet_clearance_mm` on the mouth, a disc in the plate's
+    underside (mm; inf where the jet never passes)."""
+    return disc_jet_clearance_mm(jet, neck.x, neck.y, neck.neck.diameter / 2)
+
+
+def disc_jet_clearance_mm(jet, x: float, y: float, radius: float, z: float = 0.0) -> tuple[float, float]:
+    """How far a disc of ``radius`` centred on (``x``, ``y``, ``z``), parallel to the plate, stays outside the jet
+    of taxel ``jet``'s needle (negative: inside), as (free jet, jet along the plate): the free jet is a cone of
+    half-angle :data:`JET_HALF_ANGLE_DEG` from the needle's tip along its axis up to the plate underside; past there
+    the jet runs along the plate in its axis' direction (+x), still widening at that angle with the distance
+    travelled (mm; inf where it never passes). A neck's mouth is the disc at z = 0; a support post, a column
+    through the gap, is tested as discs at several z."""
     tip = needle_tip_mm(jet)
     mouth, u = needle_axis_mm(jet)
     spread = math.tan(math.radians(JET_HALF_ANGLE_DEG))
     r0 = jet.needle.outer_diameter / 2
     s_plate = sum((m - p) * c for m, p, c in zip(mouth, tip, u))
     free = wall = math.inf
-    disc = [(f * neck.neck.diameter / 2, 2 * math.pi * k / JET_SAMPLES) for f in (0.0, 0.5, 1.0)
+    disc = [(f * radius, 2 * math.pi * k / JET_SAMPLES) for f in (0.0, 0.5, 1.0)
             for k in range(JET_SAMPLES)]  # the mouth is an opening: the jet may cross its middle, not its rim
     for rho, a in disc:
-        q = (neck.x + rho * math.cos(a), neck.y + rho * math.sin(a), 0.0)
+        q = (x + rho * math.cos(a), y + rho * math.sin(a), z)
         rel = [qi - ti for qi, ti in zip(q, tip)]
         s = sum(r * c for r, c in zip(rel, u))
         if 0 < s <= s_plate:

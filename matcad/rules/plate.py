@@ -3,13 +3,14 @@ that does to the pitch of every taxel on it (Hz, mm, N)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from matcad.listening import EDGE_BINS, EXCLUDE_BINS, guard_hz
 from matcad.materials import ACRYLIC_MODULUS_MPA
-from matcad.parts.stack import plate_beam, plate_deflection_mm
+from matcad.parts.stack import plate_beam, plate_deflection_mm, post_bay_mm
 from matcad.rules.finding import Finding
 
 BENDING_GUARD_SHARE = EDGE_BINS / (EXCLUDE_BINS + EDGE_BINS)
@@ -18,6 +19,17 @@ EDGE_BINS of band edge. The guard is a tone's main lobe (EXCLUDE_BINS) plus EDGE
 refuses a ridge as hugging the band's edge; the predicted bands know nothing of the plate bending, so a change
 larger than those bins can carry a tone at its band's edge out of the band the loop listens in (2 of 8 bins: 10.8
 Hz at 44.1 kHz, 11.7 Hz at 96 kHz)."""
+POST_CLEARANCE_MM = 0.5
+"""Least gap between a support post and a needle, a bolt's spacer or a dowel hole on the mount's top face: an FDM
+part's features print up to ~0.2 mm oversize (:data:`matcad.parts.features.PIN_FIT_ALLOWANCE_MM`), and a needle
+set by hand sits a few tenths off its bore's axis."""
+POST_MOUTH_GAPS = 3.0
+"""Least distance from a support post to a neck's mouth edge, in mount gaps (spacer.height). The 'mount' mouth's
+model (:func:`matcad.acoustics.models.mount_end_correction_mm`) takes the gap's radial flow as starting a gap height
+beyond the mouth's edge (r = a + h) and unobstructed out to the vent radius; three gaps keep a post well outside
+the region where the flow turns from the neck into the gap. What a post does to the radial flow is not modelled:
+docs/arrays.md estimates it from the same radial-flow inertance (at most ~5 Hz, 0.1 % of f0, on the capacity
+boards)."""
 
 
 @dataclass(frozen=True)
@@ -91,6 +103,75 @@ def shift_bound_hz(spec, board, w) -> float:
     return worst
 
 
+def post_clearances_mm(spec) -> list[dict]:
+    """For each support post (:func:`matcad.parts.features.plate_post_positions_mm`), its (x, y) and how far its
+    edge stays from: every needle's jet (the ``board.jet`` rule's cone, :func:`matcad.rules.board
+    .disc_jet_clearance_mm`, the post tested as discs at the plate's underside, mid-gap and the mount's top face;
+    negative: inside), every needle above the mount (its axis from the bore's mouth in the mount's top face up to
+    its tip, each section a circle of r / sin θ, the bore's radius: the needle and its bore's mouth), every neck's
+    mouth edge, every bolt's spacer or standoff (a laser spacer square's corner) and every dowel hole in the mount
+    (mm)."""
+    from matcad.parts.features import (needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
+                                       plate_bolt_positions_mm, plate_dowel_positions_mm, plate_post_positions_mm)
+    from matcad.parts.needle_mount import bore_mouth_mm
+    from matcad.rules.board import disc_jet_clearance_mm
+    from matcad.spec import taxels
+
+    board = taxels(spec)
+    gap, r = spec.spacer.height, spec.plate.post_diameter / 2
+    spacer = spec.spacer.size / 2 * (1.0 if spec.spacer.style == "standoff" else 2 ** 0.5)
+    dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
+                                 spec.fasteners.dowel_fit_printed) / 2
+
+    def needle(x, y, t) -> float:
+        bx, by, br = bore_mouth_mm(spec, t)
+        tip = needle_tip_mm(t)
+        return min(math.hypot(x - (bx + (tip[0] - bx) * k / 50), y - by) for k in range(51)) - br - r
+
+    out = []
+    for x, y in plate_post_positions_mm(spec):
+        jets = [min(disc_jet_clearance_mm(t, x, y, r, z)) for t in board for z in (0.0, -gap / 2, -gap)]
+        out.append({"x": x, "y": y, "jet": min(jets),
+                    "needle": min(needle(x, y, t) for t in board),
+                    "mouth": min(math.hypot(x - t.x, y - t.y) - t.neck.diameter / 2 - r for t in board),
+                    "bolt": min(math.hypot(x - bx, y - by) - spacer - r for bx, by in plate_bolt_positions_mm(spec)),
+                    "dowel": min(math.hypot(x - dx, y - dy) - dowel - r
+                                 for dx, dy in plate_dowel_positions_mm(spec))})
+    return out
+
+
+def support_posts(spec) -> list[Finding]:
+    """With plate.support_posts: an error when the board has no line for them (one column), when plate
+    .post_diameter is thinner than the printer's thinnest wall, and per post and obstacle when a post stands in a
+    needle's jet, within :data:`POST_CLEARANCE_MM` of a needle, a spacer or a dowel hole, or within
+    :data:`POST_MOUTH_GAPS` mount gaps of a neck's mouth (:func:`post_clearances_mm`)."""
+    from matcad.rules.printing import min_wall_mm
+
+    if not spec.plate.support_posts:
+        return []
+    rows = post_clearances_mm(spec)
+    fix = "set plate.support_posts = false, a smaller plate.post_diameter, or move the taxels ([[taxel]] x, y)"
+    if not rows:
+        return [Finding("plate.posts", "error", 0, ">= 1", "plate.support_posts = true, but the board has no two "
+                        "columns of necks to put posts between", "set plate.support_posts = false")]
+    out = []
+    wall = min_wall_mm(spec)
+    if spec.plate.post_diameter < wall:
+        out.append(Finding("plate.posts", "error", spec.plate.post_diameter, wall,
+                           f"plate.post_diameter = {spec.plate.post_diameter:g} mm is thinner than the printer's "
+                           f"thinnest wall ({wall:g} mm)", f"set plate.post_diameter >= {wall:g}"))
+    limits = {"jet": (0.0, "a needle's jet"), "needle": (POST_CLEARANCE_MM, "a needle"),
+              "mouth": (POST_MOUTH_GAPS * spec.spacer.height, f"a neck's mouth ({POST_MOUTH_GAPS:g} mount gaps)"),
+              "bolt": (POST_CLEARANCE_MM, "a bolt's spacer"), "dowel": (POST_CLEARANCE_MM, "a dowel hole")}
+    for row in rows:
+        for key, (limit, what) in limits.items():
+            if row[key] < limit:
+                out.append(Finding("plate.posts", "error", round(row[key], 3), round(limit, 3),
+                                   f"the support post at ({row['x']:.2f}, {row['y']:.2f}) "
+                                   f"(Ø{spec.plate.post_diameter:g} mm) keeps {row[key]:.2f} mm from {what} (< {limit:.2f} mm)", fix))
+    return out
+
+
 def plate_bending(spec) -> list[Finding]:
     """A warning when the plate, bent by one taxel pressed with mechanics.max_force_n, moves any taxel's pitch by
     more than :data:`BENDING_GUARD_SHARE` of the band guard, or reaches the mount under a taxel (its mouth closes).
@@ -107,13 +188,12 @@ def plate_bending(spec) -> list[Finding]:
     worst = max(rows, key=lambda b: (b.shift_hz is None, abs(b.shift_hz or 0.0), b.deflection_mm))
     if worst.shift_hz is not None and abs(worst.shift_hz) <= limit:
         return []
-    axis, span, width = plate_beam(spec)
     whose = "its own" if worst.heard == worst.pressed else f"{worst.heard}'s"
     how = (f"{worst.pressed} pressed with {worst.force_n:g} N bends the {spec.neck.length:g} mm plate (neck.length) "
-           f"{worst.deflection_mm:.3g} mm under {worst.heard} (a beam {width:g} mm wide on the bolt rows {span:.1f} "
-           f"mm apart along {axis}, simply supported, E = {ACRYLIC_MODULUS_MPA:g} MPa; Roark Table 8.1 case 1e)")
+           f"{worst.deflection_mm:.3g} mm under {worst.heard} ({_support_text(spec, worst.pressed)})")
+    posts = "" if spec.plate.support_posts else ", support posts under it (plate.support_posts = true)"
     fix = ("stiffen the plate: a thicker sheet (neck.length sets every pitch: re-run `matcad design`), a shorter "
-           "board, or a support under the plate between its bolt rows (not modelled); or lower mechanics.max_force_n")
+           f"board{posts}; or lower mechanics.max_force_n")
     if worst.shift_hz is None:
         return [Finding("plate.bending", "warning", round(worst.deflection_mm, 4), worst.gap_mm,
                         f"{how}: more than the {worst.gap_mm:g} mm mount gap (spacer.height): the plate reaches the "
@@ -125,4 +205,20 @@ def plate_bending(spec) -> list[Finding]:
                     f"{guard:.0f} Hz band guard)", fix)]
 
 
-RULES = (plate_bending,)
+def _support_text(spec, pressed: str) -> str:
+    """How :func:`matcad.parts.stack.plate_deflection_mm` held the plate when the taxel named ``pressed`` was
+    pressed: the beam on the bolt rows, or the strip on the posts."""
+    from matcad.parts.features import plate_post_positions_mm
+    from matcad.spec import taxels
+
+    if not plate_post_positions_mm(spec):
+        axis, span, width = plate_beam(spec)
+        return (f"a beam {width:g} mm wide on the bolt rows {span:.1f} mm apart along {axis}, simply supported, "
+                f"E = {ACRYLIC_MODULUS_MPA:g} MPa; Roark Table 8.1 case 1e")
+    below, above, arm, width = post_bay_mm(spec, next(t for t in taxels(spec) if t.name == pressed))
+    return (f"a strip {width:g} mm wide, the cap flange, simply supported on the support lines {above - below:.1f} mm "
+            f"apart either side of it and a cantilever {arm:.2f} mm from the post line to the neck, E = "
+            f"{ACRYLIC_MODULUS_MPA:g} MPa; Roark Table 8.1 cases 1e and 1a")
+
+
+RULES = (plate_bending, support_posts)

@@ -18,12 +18,13 @@ MIN_FILL_PORT_MM = 2.0
 MIN_SILICONE_WALL_MM = 1.0
 
 
-def _min_wall_mm(spec) -> float:
+def min_wall_mm(spec) -> float:
+    """The thinnest printed wall (mm): two nozzle widths on FDM, :data:`MIN_WALL_SLA_MM` on SLA."""
     return 2 * spec.machine.nozzle if spec.machine.printer == "fdm" else MIN_WALL_SLA_MM
 
 
 def printable_walls(spec) -> list[Finding]:
-    limit = _min_wall_mm(spec)
+    limit = min_wall_mm(spec)
     walls = {"mold.wall": spec.mold.wall, "mold.floor": spec.mold.floor,
              "mold.lid_thickness": spec.mold.lid_thickness}
     name, thinnest = min(walls.items(), key=lambda kv: kv[1])

@@ -77,6 +77,14 @@ class Plate(Section):
     bolt_inset: float = param("bolt and dowel centres inset from the plate edges", "mm", 2.5, lo=0.0,
                               hi=LENGTH_MAX_MM)
     laser_kerf: float | None = _sheet_kerf("neck plate")
+    support_posts: bool = param("print support posts on the needle mount under the plate, on the centre line "
+                                "between a board's two columns (matcad.parts.features.plate_post_positions_mm): "
+                                "they carry a pressed taxel's force so a long thin plate stays flat "
+                                "(plate.bending); `design --taxels` sets it when the board would bend",
+                                default=False, kind="bool")
+    post_diameter: float = length_mm("support post diameter: >= 2 FDM nozzle widths (print.wall), small enough "
+                                     "to stay 3 mount gaps from the mouths of the 12-taxel capacity board "
+                                     "(docs/arrays.md)", 1.5)
 
 
 @dataclass(frozen=True)
