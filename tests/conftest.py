@@ -43,6 +43,19 @@ steps = 4
 """MINIMAL with a cheap cap-mechanics run (coarse neo-Hookean, 4 steps to 1 mm): seconds, not tens."""
 
 
+def spec_with(path, **over):
+    """The spec in TOML file ``path`` with fields replaced: ``section__field=value`` (validated, a Spec)."""
+    import tomllib
+
+    from matcad import spec as spec_mod
+
+    data = tomllib.loads(Path(path).read_text())
+    for key, value in over.items():
+        section, field = key.split("__")
+        data.setdefault(section, {})[field] = value
+    return spec_mod.from_dict(data)
+
+
 def run_cli(*args, cwd=None):
     """Run `python -m matcad ARGS` in a fresh process: (exit code, stdout, stderr)."""
     proc = subprocess.run([sys.executable, "-m", "matcad", *map(str, args)], capture_output=True,

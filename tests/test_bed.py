@@ -2,24 +2,15 @@
 neck plate bent by a pressed taxel (plate.bending): the rules fire with their numbers on specs that break them,
 stay silent on the templates, and the plate's closed form holds against statics."""
 
-import tomllib
 
 import numpy as np
 import pytest
 
 from matcad import spec as spec_mod
 from matcad.rules import check
-from tests.conftest import PAPER, ROOT, TEMPLATES
+from tests.conftest import PAPER, ROOT, TEMPLATES, spec_with
 
 SLA_ARRAY = ROOT / "templates" / "mat-sla-array.toml"
-
-
-def _with(path, **over):
-    data = tomllib.loads(path.read_text())
-    for key, value in over.items():
-        section, field = key.split("__")
-        data.setdefault(section, {})[field] = value
-    return spec_mod.from_dict(data)
 
 
 def _found(spec, rule_id):
@@ -38,44 +29,44 @@ def test_default_beds_by_printer():
     assert (sla.print_volume_x, sla.print_volume_y, sla.print_volume_z) == (120.0, 68.0, 150.0)  # Prusa SL1
     assert (fdm.laser_bed_x, fdm.laser_bed_y) == (300.0, 200.0)  # K40-class
     with pytest.raises(spec_mod.SpecError, match="machine.print_volume_x"):
-        _with(PAPER, machine__print_volume_x=-5.0)
+        spec_with(PAPER, machine__print_volume_x=-5.0)
 
 
 def test_print_bed_names_part_size_field_and_volume():
     """The paper's mold base is 36.8 x 20.8 x 10.76 mm, its mount 24 x 42 x 8 mm: a 30 x 30 mm bed holds neither
     (even turned), a 10 mm build height only the lid's 7.76 mm."""
-    found = {f.message.split(":")[0]: f for f in _found(_with(PAPER, machine__print_volume_x=30.0,
+    found = {f.message.split(":")[0]: f for f in _found(spec_with(PAPER, machine__print_volume_x=30.0,
                                                               machine__print_volume_y=30.0), "print.bed")}
     assert set(found) == {"end_cap_mold_base", "end_cap_mold_lid", "needle_mount"}
     base = found["end_cap_mold_base"]
     assert base.level == "error" and base.value == pytest.approx([36.8, 20.8, 10.76]) and base.limit == [30, 30, 220]
     assert "36.8 x 20.8 x 10.8 mm" in base.message and "machine.print_volume_x/y/z = 30 x 30 x 220 mm" in base.message
     assert "mold.count" not in base.fix  # one cap per mold already
-    assert not _found(_with(PAPER, machine__print_volume_x=45.0, machine__print_volume_y=25.0), "print.bed")  # the
+    assert not _found(spec_with(PAPER, machine__print_volume_x=45.0, machine__print_volume_y=25.0), "print.bed")  # the
     # 24 x 42 mm mount fits a 45 x 25 mm bed only turned
-    low = _found(_with(PAPER, machine__print_volume_z=10.0), "print.bed")
+    low = _found(spec_with(PAPER, machine__print_volume_z=10.0), "print.bed")
     assert [f.message.split(":")[0] for f in low] == ["end_cap_mold_base"]  # the lid is 7.76 mm
 
 
 def test_print_bed_fix_names_the_caps_per_mold_that_fit():
     """Four caps in a 77.2 mm SLA mold (caps 12.95 mm apart + ends): a 60 mm display holds 2 per mold."""
-    found = _found(_with(SLA_ARRAY, machine__print_volume_x=60.0, machine__print_volume_y=45.0), "print.bed")
+    found = _found(spec_with(SLA_ARRAY, machine__print_volume_x=60.0, machine__print_volume_y=45.0), "print.bed")
     molds = [f for f in found if f.message.startswith("end_cap_mold")]
     assert molds and all("set mold.count = 2" in f.fix for f in molds)
-    two = _with(SLA_ARRAY, machine__print_volume_x=60.0, machine__print_volume_y=45.0, mold__count=2)
+    two = spec_with(SLA_ARRAY, machine__print_volume_x=60.0, machine__print_volume_y=45.0, mold__count=2)
     assert not [f for f in _found(two, "print.bed") if f.message.startswith("end_cap_mold")]
 
 
 def test_laser_bed_names_sheet_size_and_usable_bed():
     """The paper's plate sheet is 37.25 x 24.25 mm as nested (kerf and reference square); a 50 x 40 mm bed less its
     10 mm margins holds 30 x 20 mm."""
-    found = _found(_with(PAPER, machine__laser_bed_x=50.0, machine__laser_bed_y=40.0), "laser.bed")
+    found = _found(spec_with(PAPER, machine__laser_bed_x=50.0, machine__laser_bed_y=40.0), "laser.bed")
     plate = next(f for f in found if f.message.startswith("sheet_plate"))
     assert plate.level == "error" and plate.value == pytest.approx([37.25, 24.25]) and plate.limit == [30, 20]
     assert "machine.laser_bed_x/y = 50 x 40 mm less 10 mm margins holds 30 x 20 mm" in plate.message
     assert plate.fix.startswith("neck_plate alone does not fit")
     # on 40 x 30 mm the two 24.18 mm guides nest in two rows, 51.4 mm tall: each fits alone, the sheet does not
-    rows = {f.message.split(":")[0]: f for f in _found(_with(PAPER, machine__laser_bed_x=60.0,
+    rows = {f.message.split(":")[0]: f for f in _found(spec_with(PAPER, machine__laser_bed_x=60.0,
                                                              machine__laser_bed_y=50.0), "laser.bed")}
     assert "sheet_plate" not in rows and rows["sheet_guide"].value == pytest.approx([37.18, 51.36])
     assert "several runs" in rows["sheet_guide"].fix
@@ -86,7 +77,7 @@ def test_nesting_follows_the_laser_bed():
     from matcad.export.sheets import kit_sheets
 
     wide = kit_sheets(spec_mod.load(PAPER))["guide"].extents
-    narrow = kit_sheets(_with(PAPER, machine__laser_bed_x=60.0))["guide"].extents
+    narrow = kit_sheets(spec_with(PAPER, machine__laser_bed_x=60.0))["guide"].extents
     assert narrow[2] - narrow[0] < wide[2] - wide[0] and narrow[3] - narrow[1] > 2 * (wide[3] - wide[1]) - 1
 
 
@@ -122,19 +113,19 @@ def test_plate_bending_on_a_long_plate():
     from matcad.acoustics.design import design
     from matcad.rules.plate import BENDING_GUARD_SHARE, bendings
 
-    spec = _with(PAPER, plate__depth=140.0)
+    spec = spec_with(PAPER, plate__depth=140.0)
     (row,) = bendings(spec)
     ei = 3300.0 * 24.0 * 6.35 ** 3 / 12
     span = 140.0 - 2 * (2.5 + 1.0)
     assert row.deflection_mm == pytest.approx(20.0 * span ** 3 / (48 * ei), rel=1e-9)
-    bent = _with(PAPER, plate__depth=140.0, spacer__height=1.59 - row.deflection_mm)
+    bent = spec_with(PAPER, plate__depth=140.0, spacer__height=1.59 - row.deflection_mm)
     same_model = predict_design(design(bent)).physics_f0_hz - predict_design(design(spec)).physics_f0_hz
     assert row.shift_hz == pytest.approx(same_model, rel=1e-9)
     (finding,) = _found(spec, "plate.bending")
     assert finding.level == "warning" and finding.value == pytest.approx(row.shift_hz, abs=1e-3)
     assert finding.limit == pytest.approx(BENDING_GUARD_SHARE * 43.07, abs=0.01)
     assert f"{row.deflection_mm:.3g} mm under t1" in finding.message and "bolt rows 133.0 mm apart" in finding.message
-    (thin,) = _found(_with(PAPER, plate__depth=140.0, neck__length=3.0), "plate.bending")
+    (thin,) = _found(spec_with(PAPER, plate__depth=140.0, neck__length=3.0), "plate.bending")
     assert "reaches the mount" in thin.message and thin.value > 1.59 and thin.limit == 1.59
 
 
@@ -149,7 +140,7 @@ def test_the_cavity_free_bound_holds_the_model(path, over):
     is under the limit: the bound must hold every pitch change the model gives."""
     from matcad.rules.plate import bendings, deflections, shift_bound_hz
 
-    spec = _with(path, **over)
+    spec = spec_with(path, **over)
     board, w = deflections(spec)
     assert w.max() < spec.spacer.height
     shifts = [abs(b.shift_hz) for b in bendings(spec)]

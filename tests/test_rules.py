@@ -4,16 +4,11 @@ import pytest
 
 from matcad import spec as spec_mod
 from matcad.rules import check
-from tests.conftest import PAPER, ROOT
+from tests.conftest import PAPER, ROOT, spec_with
 
 
 def _paper_with(**over):
-    import tomllib
-    data = tomllib.loads(PAPER.read_text())
-    for key, value in over.items():
-        section, field = key.split("__")
-        data.setdefault(section, {})[field] = value
-    return spec_mod.from_dict(data)
+    return spec_with(PAPER, **over)
 
 
 def _levels(spec, rule_id):
