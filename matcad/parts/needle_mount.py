@@ -45,6 +45,12 @@ def needle_bore(taxel, bore_diameter: float, reach: float):
     return _on_needle_axis(taxel, mouth_point, bore_diameter / 2, reach)
 
 
+def dowel_hole_radius_mm(spec) -> float:
+    """Radius (mm) of the dowel holes printed in the mount: the dowel's press-fit hole on this printer."""
+    return pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
+                                spec.fasteners.dowel_fit_printed) / 2
+
+
 def mount_extent_mm(spec) -> tuple[float, float, float]:
     """The mount's bounding box in its print pose (x, y, z mm): the block plate.width wide, its ears
     :data:`~matcad.parts.features.EAR_WIDTH_MM` beyond the plate's depth on ±y, ``mount.thickness`` tall plus the
@@ -76,8 +82,7 @@ def needle_mount(spec):
     for x, y in plate_post_positions_mm(spec):
         body += cylinder_up(spec.plate.post_diameter / 2, gap, x, y, top)
     pilot = SELF_TAP_PILOT_MM[spec.fasteners.bolt] / 2
-    dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
-                                 spec.fasteners.dowel_fit_printed) / 2
+    dowel = dowel_hole_radius_mm(spec)
     bores = []
     for t in taxels(spec):
         reach = (thick + gap + spec.plate.width + spec.plate.depth) / max(math.sin(math.radians(
@@ -113,8 +118,7 @@ def mount_labels(spec) -> tuple:
         return ()
     mouths = [bore_mouth_mm(spec, t) for t in board]
     post = (spec.spacer.size if spec.spacer.style == "standoff" else SELF_TAP_PILOT_MM[spec.fasteners.bolt]) / 2
-    dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
-                                 spec.fasteners.dowel_fit_printed) / 2
+    dowel = dowel_hole_radius_mm(spec)
     keepout = (mouths + [(x, y, post) for x, y in plate_bolt_positions_mm(spec)]
                + [(x, y, dowel) for x, y in plate_dowel_positions_mm(spec)]
                + [(x, y, spec.plate.post_diameter / 2) for x, y in plate_post_positions_mm(spec)])

@@ -111,17 +111,16 @@ def post_clearances_mm(spec) -> list[dict]:
     its tip, each section a circle of r / sin θ, the bore's radius: the needle and its bore's mouth), every neck's
     mouth edge, every bolt's spacer or standoff (a laser spacer square's corner) and every dowel hole in the mount
     (mm)."""
-    from matcad.parts.features import (needle_axis_mm, needle_tip_mm, pin_hole_diameter_mm,
+    from matcad.parts.features import (needle_axis_mm, needle_tip_mm,
                                        plate_bolt_positions_mm, plate_dowel_positions_mm, plate_post_positions_mm)
-    from matcad.parts.needle_mount import bore_mouth_mm
+    from matcad.parts.needle_mount import bore_mouth_mm, dowel_hole_radius_mm
     from matcad.rules.board import disc_jet_clearance_mm
     from matcad.spec import taxels
 
     board = taxels(spec)
     gap, r = spec.spacer.height, spec.plate.post_diameter / 2
     spacer = spec.spacer.size / 2 * (1.0 if spec.spacer.style == "standoff" else 2 ** 0.5)
-    dowel = pin_hole_diameter_mm(spec.fasteners.dowel_diameter, spec.machine.printer,
-                                 spec.fasteners.dowel_fit_printed) / 2
+    dowel = dowel_hole_radius_mm(spec)
 
     def needle(x, y, t) -> float:
         bx, by, br = bore_mouth_mm(spec, t)
@@ -168,7 +167,8 @@ def support_posts(spec) -> list[Finding]:
             if row[key] < limit:
                 out.append(Finding("plate.posts", "error", round(row[key], 3), round(limit, 3),
                                    f"the support post at ({row['x']:.2f}, {row['y']:.2f}) "
-                                   f"(Ø{spec.plate.post_diameter:g} mm) keeps {row[key]:.2f} mm from {what} (< {limit:.2f} mm)", fix))
+                                   f"(Ø{spec.plate.post_diameter:g} mm) keeps {row[key]:.2f} mm from {what} "
+                                   f"(< {limit:.2f} mm)", fix))
     return out
 
 
