@@ -162,7 +162,8 @@ def capacity(forces=(5.0,), seeds=5, mic_distance_m=None):
             worst_mean = worst_rms = 0.0
             heard, per_seed = [], []
             for seed in range(seeds):
-                rec = synth_board.board_recording(listen, [b.rise for b in bands], force, seconds=6.0, seed=seed,
+                rec = synth_board.board_recording([(b.name, b.loaded_hz) for b in bands], [b.rise for b in bands],
+                                                  force, seconds=6.0, seed=seed,
                                                   fs=rate, mic_distance_m=mic_distance_m)
                 tracks = analyze_board([rec.x], rec.fs, listen)
                 count, errors_hz = 0, []

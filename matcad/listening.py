@@ -49,6 +49,27 @@ def guard_hz(sample_rate_hz: float) -> float:
     return (EXCLUDE_BINS + EDGE_BINS) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
 
 
+def edge_zone_hz(sample_rate_hz: float) -> float:
+    """Width (Hz) of the zone inside a band's edge where the board loop takes a ridge as the tone leaving the band
+    (:func:`matcad.loop.board.off_edge`): EDGE_BINS + 1 bins of the tracker's spectrum. 16.2 Hz at 44.1 kHz, 17.6 Hz
+    at 96 kHz."""
+    return (EDGE_BINS + 1) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
+
+
+def loaded_listening_band(loaded_hz: tuple[float, float], sample_rate_hz: float) -> tuple[float, float]:
+    """The band (low, high) Hz the board loop listens in for a taxel whose *loaded* band is ``loaded_hz``
+    (:func:`matcad.prediction.bands.listening_bands`): widened either side by :func:`edge_zone_hz` and one bin more,
+    so that a tone anywhere in its loaded band — which already holds the model's uncertainty and the rise under load
+    up to the maximum force — is read with a bin (~4 sd of a frame's pitch) to spare, and only a tone outside it
+    reaches the edge zone. Taken from the guard between two loaded bands (:func:`guard_hz`, EXCLUDE_BINS + EDGE_BINS
+    = 8 bins): two neighbours' listening bands meet and do not overlap, and a tone at its own band's edge stays 4
+    bins from its neighbour's listening band, at the first null of its Hann main lobe (±4 bins at 2× padding).
+    (A band of exactly the loaded one left a rest pitch in its bottom 17.6 Hz unread at 96 kHz: the 16-taxel 1/8 in
+    board's t2, 15 Hz above its band's edge, lost 107 of 139 frames.)"""
+    edge = edge_zone_hz(sample_rate_hz) * (EDGE_BINS + 2) / (EDGE_BINS + 1)
+    return loaded_hz[0] - edge, loaded_hz[1] + edge
+
+
 def trackable(band_hz: tuple[float, float], sample_rate_hz: float) -> tuple[float, float]:
     """``band_hz`` (low, high Hz) widened about its centre to :data:`BAND_BINS` + 1 bins of the tracker's spectrum
     at ``sample_rate_hz`` (Hz) when it is narrower (the extra bin: a band off the bin grid still holds
@@ -74,13 +95,8 @@ CALIBRATED_MARGIN = Margin(0.8, 1.25)
 """A calibration's frequency range over its force range (``sense``): wide on both sides so that a tone just
 outside the calibrated range (a force beyond it, air warmer or colder than at calibration) is still tracked and
 reported as outside the calibrated range rather than lost as "no tone"."""
-LOADED_MARGIN = Margin(1.0, 1.0)
-"""A board taxel's *loaded* band (:func:`matcad.prediction.bands.listening_bands`): used as it is — it already
-holds the model's uncertainty and the rise under load up to the maximum force, and the bands of a valid board are
-only a guard apart, so widening one would take in a neighbour's tone."""
-
-
 def listening_band(band_hz: tuple[float, float], margin: Margin) -> tuple[float, float]:
     """The band (low, high) Hz the loop listens in for a taxel whose known band is ``band_hz`` (Hz), widened by
-    ``margin`` (:data:`PREDICTED_MARGIN`, :data:`CALIBRATED_MARGIN` or :data:`LOADED_MARGIN`)."""
+    ``margin`` (:data:`PREDICTED_MARGIN` or :data:`CALIBRATED_MARGIN`; a board's loaded band:
+    :func:`loaded_listening_band`)."""
     return band_hz[0] * margin.low, band_hz[1] * margin.high

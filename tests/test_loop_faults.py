@@ -13,7 +13,7 @@ import wave
 import numpy as np
 import pytest
 
-from matcad.listening import CALIBRATED_MARGIN, LOADED_MARGIN, PREDICTED_MARGIN, listening_band
+from matcad.listening import CALIBRATED_MARGIN, PREDICTED_MARGIN, listening_band
 from matcad.loop import synth
 from matcad.loop.analyze import analyze
 from matcad.acoustics.eq5fit import fit
@@ -37,7 +37,31 @@ def test_listening_band_margins():
     """Each known band widened by its own factors, low edge below high edge (Hz)."""
     assert listening_band((4000.0, 5000.0), PREDICTED_MARGIN) == pytest.approx((3600.0, 6250.0))
     assert listening_band((4000.0, 5000.0), CALIBRATED_MARGIN) == pytest.approx((3200.0, 6250.0))
-    assert listening_band((4000.0, 5000.0), LOADED_MARGIN) == (4000.0, 5000.0)
+
+
+@pytest.mark.parametrize("fs", [44100.0, 96000.0])
+def test_board_reads_a_tone_anywhere_in_its_loaded_band(fs):
+    """A board taxel resting 5 Hz above its loaded band's low edge (inside its 95 % band) is read, beside a
+    neighbour singing at its own band's top a guard below: the listening band is the loaded band widened by the edge
+    zone (:func:`matcad.listening.loaded_listening_band`). Listening in the bare loaded band (the fault) drops those
+    frames as the tone leaving its band."""
+    from matcad.errors import LoopError
+    from matcad.listening import guard_hz, loaded_listening_band
+    from matcad.loop.board import analyze_board
+
+    low = (1500.0, 1590.0)
+    high = (low[1] + guard_hz(fs), low[1] + guard_hz(fs) + 90.0)
+    assert loaded_listening_band(low, fs)[1] <= loaded_listening_band(high, fs)[0] + 1e-9  # they do not overlap
+    n = int(3.0 * fs)
+    x = (synth.taxel(np.full(n, low[1]), fs, 1) + synth.taxel(np.full(n, high[0] + 5.0), fs, 2)
+         + synth.coloured_noise(n, fs, 3, 1.0, 0.01))
+    a, b = (t.analysis for t in analyze_board([x], fs, [("a", loaded_listening_band(low, fs)),
+                                                          ("b", loaded_listening_band(high, fs))]))
+    assert abs(a.median_hz - low[1]) < 1.0 and a.voiced.mean() > 0.9
+    assert abs(b.median_hz - (high[0] + 5.0)) < 1.0 and b.voiced.mean() > 0.9
+    assert not any("edge" in w for w in (*a.warnings, *b.warnings))
+    with pytest.raises(LoopError, match="hugs the band edge"):  # both at an edge of the bare loaded bands
+        analyze_board([x], fs, [("a", low), ("b", high)])
 
 
 def test_analyze_spec_listens_in_the_predicted_band_widened_and_finds_the_tone(tmp_path):

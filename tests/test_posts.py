@@ -143,3 +143,38 @@ def test_templates_carry_no_posts(template):
 
     s = spec_mod.load(ROOT / "templates" / f"{template}.toml")
     assert not s.plate.support_posts and plate_post_positions_mm(s) == [] and support_posts(s) == []
+
+
+def test_rows_spread_until_posts_fit():
+    """`design --taxels` on a board whose necks leave no room for posts spreads the stagger's rows
+    (:func:`matcad.design.allocate.post_pitch`): the 12-taxel board's necks 0.35 mm wider leave the posts 4.68 mm from
+    the widest mouth (< 3 mount gaps, 4.77 mm) at its 7.7 mm half row; the least spread that clears them (8.0 mm),
+    read from the relaid board's geometry, has every post at least 3 gaps from every mouth, and one layout step
+    less does not."""
+    from types import SimpleNamespace
+
+    from matcad.design.allocate import LAYOUT_STEPS_PER_MM, array_spec, board_base, post_pitch, stagger_pitch
+    from matcad.design.solve import parse_vary
+    from matcad.rules.plate import POST_MOUTH_GAPS, post_clearances_mm, support_posts
+    from matcad.spec import taxel_spec, taxels
+
+    s = _board(True)
+    single = taxel_spec(s, taxels(s)[0])
+    vary = parse_vary(single, ["neck.diameter=0.5:7", "cavity.length", "cavity.diameter=2.1:12"])
+    solutions = [SimpleNamespace(fields={"neck.diameter": (None, d + 0.35), "cavity.diameter": (None, cd),
+                                         "cavity.length": (None, cl)}) for d, cd, cl in TAXELS]
+
+    def relaid(pitch):
+        base, points = board_base(single, 12, vary, pitch)
+        spec = array_spec(base, points, solutions, "spread")
+        return dataclasses.replace(spec, plate=dataclasses.replace(spec.plate, support_posts=True))
+
+    start = stagger_pitch(single, 7.0)
+    assert start == pytest.approx((PITCH_X, HALF_ROW))
+    assert "mouth" in " ".join(f.message for f in support_posts(relaid(start))) and "(< 4.77 mm)" in support_posts(
+        relaid(start))[0].message
+    pitch = post_pitch(single, 12, vary, solutions, "spread")
+    assert pitch[0] == PITCH_X and pitch[1] > HALF_ROW
+    assert support_posts(relaid(pitch)) == []
+    assert min(r["mouth"] for r in post_clearances_mm(relaid(pitch))) >= POST_MOUTH_GAPS * s.spacer.height
+    assert support_posts(relaid((pitch[0], pitch[1] - 1 / LAYOUT_STEPS_PER_MM)))

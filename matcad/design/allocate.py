@@ -13,7 +13,9 @@ cap flanges the laser's smallest web apart and every neck out of every jet (:fun
 ``board.jet`` rule's geometry), on a plate grown by the layout's extent; the written array must pass every rule
 with no ``board.jet`` finding. A board whose plate would bend (``plate.bending``) is written with support posts under it
 (``plate.support_posts``) when the posts fit it (no ``plate.posts`` error: each post 3 mount gaps from every mouth);
-otherwise it is written as it was, with its warning. Frequencies Hz, lengths mm.
+when they do not, the rows are spread apart until they do (:func:`post_pitch`) and every taxel is solved again on the
+longer plate; a board that has no room for posts either way is written as it was, with its warning. Frequencies Hz,
+lengths mm.
 """
 
 from __future__ import annotations
@@ -153,12 +155,12 @@ def stagger_pitch(base, neck_mm: float) -> tuple[float, float]:
         steps += 1
 
 
-def board_base(base, n: int, vary):
+def board_base(base, n: int, vary, pitch: tuple[float, float] | None = None):
     """(the single-taxel spec every taxel is solved on, the n :func:`stagger` positions, jet-free for the widest
-    neck ``vary`` allows, :func:`stagger_pitch`): the varied fields leave the cap's footprint alone (its outside is
-    resolved), and the plate grows by the layout's extent — before solving, because the mount mouth's end
-    correction depends on the plate (mm)."""
-    points = stagger(n, *stagger_pitch(base, widest_neck_mm(base, vary)))
+    neck ``vary`` allows, :func:`stagger_pitch`, or at ``pitch`` = (pitch_x, half_row) when given): the varied
+    fields leave the cap's footprint alone (its outside is resolved), and the plate grows by the layout's extent —
+    before solving, because the mount mouth's end correction depends on the plate (mm)."""
+    points = stagger(n, *(pitch or stagger_pitch(base, widest_neck_mm(base, vary))))
     xs, ys = [p[0] for p in points], [p[1] for p in points]
     plate = dataclasses.replace(base.plate, width=round(base.plate.width + max(xs) - min(xs), 6),
                                 depth=round(base.plate.depth + max(ys) - min(ys), 6))
@@ -186,7 +188,6 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     ``progress(taxels placed, n)`` (:mod:`matcad.progress`) is told as each is placed. Raises
     :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
     from matcad.listening import guard_hz
-    from matcad.prediction.bands import taxel_band
     from matcad.rules import check
     from matcad.spec import MAX_TAXELS, taxel_spec, taxels
 
@@ -199,8 +200,41 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     if bad:
         raise ValueError(f"--vary {bad[0]}: with --taxels only per-taxel fields vary: {', '.join(CONTINUOUS)} "
                          "(the neck length is the plate's sheet, shared by every taxel)")
-    base, points = board_base(taxel_spec(spec, taxels(spec)[0]), n, vary)
+    single = taxel_spec(spec, taxels(spec)[0])
+    base, points = board_base(single, n, vary)
     guard = guard_hz(spec.microphone.sample_rate_hz)
+    name = name or f"{spec.name}-{n}taxels"
+    placed, solutions = _place(base, n, lo_hz, hi_hz, vary, guard, progress)
+    out = array_spec(base, points, solutions, name)
+    findings = check(out)
+    if any(f.id == "plate.bending" for f in findings) and not out.plate.support_posts:  # posts hold it flat
+        posted = _with_posts(out)
+        with_posts = check(posted)
+        pitch = None if _fits(with_posts) else post_pitch(single, n, vary, solutions, name)
+        if pitch is not None:  # no room for posts between the rows: the rows spread until there is, solved again
+            spread, points = board_base(single, n, vary, pitch)
+            spread_placed, spread_solutions = _place(spread, n, lo_hz, hi_hz, vary, guard, None)
+            posted = _with_posts(array_spec(spread, points, spread_solutions, name))
+            with_posts = check(posted)
+            if _fits(with_posts):
+                placed, solutions = spread_placed, spread_solutions
+        if _fits(with_posts):  # posts that do not fit leave the board as it was
+            out, findings = posted, with_posts
+    broken = [f for f in findings if f.level == "error" or f.id == "board.jet"]
+    if broken:  # board.jet cannot fire on the stagger (stagger_pitch): checked on the solved necks all the same
+        bad = "; ".join(f"{f.id}: {f.message}" for f in broken)
+        raise RulesFailed(f"the {n}-taxel array breaks a design rule: {bad}", findings)
+    placed = [dataclasses.replace(b, x_mm=t.x, y_mm=t.y) for b, t in zip(placed, taxels(out))]
+    return Allocation(out, tuple(placed), tuple(solutions), guard, (lo_hz, hi_hz), time.perf_counter() - start_time,
+                      tuple(findings))
+
+
+def _place(base, n: int, lo_hz: float, hi_hz: float, vary, guard: float, progress) -> tuple[list, list]:
+    """The n bands placed upward from ``lo_hz``, the guard (Hz) apart, each taxel solved on ``base`` (see the
+    module docstring): (bands, solutions). Raises :class:`Unreachable` / :class:`RulesFailed` with
+    :func:`_fit_text`'s account when taxel k cannot be placed below ``hi_hz``."""
+    from matcad.prediction.bands import taxel_band
+
     shape = taxel_band(base)
     ratio = shape.f0_hz / shape.loaded_hz[0]
     start, placed, solutions = lo_hz, [], []
@@ -222,20 +256,38 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
             progress(k, n)
         ratio = band.f0_hz / band.loaded_hz[0]
         start = band.loaded_hz[1] + guard
-    out = array_spec(base, points, solutions, name or f"{spec.name}-{n}taxels")
-    findings = check(out)
-    if any(f.id == "plate.bending" for f in findings) and not out.plate.support_posts:  # posts hold it flat
-        posted = dataclasses.replace(out, plate=dataclasses.replace(out.plate, support_posts=True))
-        with_posts = check(posted)
-        if not any(f.level == "error" for f in with_posts):  # posts that do not fit leave the board as it was
-            out, findings = posted, with_posts
-    broken = [f for f in findings if f.level == "error" or f.id == "board.jet"]
-    if broken:  # board.jet cannot fire on the stagger (stagger_pitch): checked on the solved necks all the same
-        bad = "; ".join(f"{f.id}: {f.message}" for f in broken)
-        raise RulesFailed(f"the {n}-taxel array breaks a design rule: {bad}", findings)
-    placed = [dataclasses.replace(b, x_mm=t.x, y_mm=t.y) for b, t in zip(placed, taxels(out))]
-    return Allocation(out, tuple(placed), tuple(solutions), guard, (lo_hz, hi_hz), time.perf_counter() - start_time,
-                      tuple(findings))
+    return placed, solutions
+
+
+def _with_posts(spec):
+    """``spec`` with support posts under its plate (plate.support_posts)."""
+    return dataclasses.replace(spec, plate=dataclasses.replace(spec.plate, support_posts=True))
+
+
+def _fits(findings) -> bool:
+    """No design-rule error among ``findings``."""
+    return not any(f.level == "error" for f in findings)
+
+
+def post_pitch(single, n: int, vary, solutions, name: str) -> tuple[float, float] | None:
+    """The least spread of :func:`stagger_pitch`'s rows that gives support posts room, for these solved necks:
+    (pitch_x, half_row) in mm with ``half_row`` raised in 1/:data:`LAYOUT_STEPS_PER_MM` steps, pitch_x kept, until
+    the ``plate.posts`` rule (:func:`matcad.rules.plate.support_posts`) finds nothing on the relaid array; None
+    when ``half_row`` reaches pitch_x + the mouths' keepout without that. A post stands midway between two
+    consecutive necks of the stagger, half their distance from each: spreading the rows moves it away from both
+    mouths and out of both jets, which run along the rows."""
+    from matcad.rules.plate import POST_MOUTH_GAPS, support_posts
+
+    pitch_x, half_row = stagger_pitch(single, widest_neck_mm(single, vary))
+    top = half_row + pitch_x + 2 * POST_MOUTH_GAPS * single.spacer.height
+    steps = round(half_row * LAYOUT_STEPS_PER_MM)
+    while steps / LAYOUT_STEPS_PER_MM <= top:
+        steps += 1
+        pitch = (pitch_x, steps / LAYOUT_STEPS_PER_MM)
+        base, points = board_base(single, n, vary, pitch)
+        if not support_posts(_with_posts(array_spec(base, points, solutions, name))):
+            return pitch
+    return None
 
 
 def _fit_text(exc, k: int, n: int, lo: float, hi: float, placed) -> tuple:

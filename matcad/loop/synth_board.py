@@ -55,7 +55,8 @@ def board_recording(bands, rises, max_force_n: float, seconds: float = 8.0, seed
                     rt60_s: float = BOARD_RT60_S, silent=(),
                     mic_distance_m: float = MIC_DISTANCE_M) -> synth.BoardRecording:
     """Every taxel of a board singing at once in a room (pink noise, reverb, tablet microphone): ``bands`` (name,
-    (low, high) Hz) are the listening bands, ``rises`` each taxel's f(max)/f(0); the ``pressed`` ones (indices;
+    (low, high) Hz) are the loaded bands (each taxel's unloaded pitch is drawn inside, :func:`unloaded_pitch`; its
+    listening band is wider, :func:`matcad.listening.loaded_listening_band`), ``rises`` each taxel's f(max)/f(0); the ``pressed`` ones (indices;
     default every third from the second) pressed to ``max_force_n`` (N) at staggered times, the others held at 20
     %; levels spread uniformly over ±``level_spread_db``/2 dB; harmonics at ``harmonics_db``; the ``silent`` ones
     (indices) do not sing (truth NaN).
@@ -82,6 +83,18 @@ def board_recording(bands, rises, max_force_n: float, seconds: float = 8.0, seed
     x = synth.room(x, fs, seed, rt60=rt60_s, wet=synth.reverb_share(mic_distance_m, rt60_s))
     return synth.BoardRecording(x, fs, tuple(names), np.array(freqs), np.array(forces),
                                 tuple(tuple(b) for _, b in bands))
+
+
+def spec_recording(spec, seed: int = 0, seconds: float = 6.0, **options) -> synth.BoardRecording:
+    """:func:`board_recording` of a board spec's taxels: each in its loaded band with its rise
+    (:func:`matcad.prediction.bands.taxel_bands`), pressed to mechanics.max_force_n (N), at the microphone's sample
+    rate (Hz); ``options`` as for :func:`board_recording`."""
+    from matcad.prediction.bands import taxel_bands
+
+    bands = taxel_bands(spec)
+    return board_recording([(b.name, b.loaded_hz) for b in bands], [b.rise for b in bands],
+                           spec.mechanics.max_force_n, seconds=seconds, seed=seed,
+                           fs=spec.microphone.sample_rate_hz, **options)
 
 
 FAULTS = ("pressed-out", "overblown-out")

@@ -183,7 +183,9 @@ def summary(spec, bands) -> dict:
 
 def listening_bands(spec) -> list[tuple[str, tuple[float, float]]]:
     """(taxel name, band Hz the recording loop listens in) per taxel of ``spec``, in taxels(spec) order: each
-    taxel's loaded band (:func:`taxel_bands`) with :data:`matcad.listening.LOADED_MARGIN`."""
-    from matcad.listening import LOADED_MARGIN, listening_band
+    taxel's loaded band (:func:`taxel_bands`) with the edge zone either side
+    (:func:`matcad.listening.loaded_listening_band`)."""
+    from matcad.listening import loaded_listening_band
 
-    return [(b.name, listening_band(b.loaded_hz, LOADED_MARGIN)) for b in taxel_bands(spec)]
+    fs = spec.microphone.sample_rate_hz
+    return [(b.name, loaded_listening_band(b.loaded_hz, fs)) for b in taxel_bands(spec)]
