@@ -106,10 +106,12 @@ area_convention = "d2/4"
 THREE = ["neck.diameter=0.5:7", "cavity.length", "cavity.diameter=2.1:12"]
 LENGTH = ["cavity.length=0.3:30"]
 CAPACITY = ((44100.0, 12, (1700.0, 11000.0), 1.5875, THREE), (44100.0, 24, (1700.0, 19800.0), 1.5875, LENGTH),
-            (96000.0, 16, (1200.0, 30000.0), 0.8, THREE), (96000.0, 16, (2000.0, 40000.0), 0.8, LENGTH),
+            (96000.0, 16, (1200.0, 30000.0), 0.8, THREE), (96000.0, 16, (1200.0, 30000.0), 3.175, THREE),
+            (96000.0, 16, (2000.0, 40000.0), 0.8, LENGTH),
             (96000.0, 24, (1700.0, 43000.0), 0.8, LENGTH))
 """(sample rate Hz, taxels asked, band Hz, sheet = neck length mm, --vary). The three-field route of
-matcad.design.solve stops near 10.5 / 12.1 kHz; the cavity length alone reaches higher (a shorter cavity)."""
+matcad.design.solve stops near 10.5 / 12.1 kHz; the cavity length alone reaches higher (a shorter cavity). The 1/8 in
+row is the 96 kHz board whose plate stays flat on its posts (docs/arrays.md)."""
 
 
 def _most_that_fit(s, n, band, vary):

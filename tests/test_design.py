@@ -202,8 +202,8 @@ def test_taxel_layout_is_jet_free_by_construction(vary, widest):
     template = spec_mod.load(ROOT / "templates" / "mat-array-4.toml")
     base = spec_mod.taxel_spec(template, spec_mod.taxels(template)[0])
     assert widest_neck_mm(base, vary) == widest
-    solved = SimpleNamespace(fields={"neck.diameter": (base.neck.diameter, widest),
-                                     "cavity.diameter": (base.cavity.diameter, max(widest, base.cavity.diameter))})
+    solved = SimpleNamespace(spec=base, fields={"neck.diameter": (base.neck.diameter, widest), "cavity.diameter": (
+        base.cavity.diameter, max(widest, base.cavity.diameter))})
     for n in range(2, 25):
         plate, points = board_base(base, n, vary)
         spec = array_spec(plate, points, [solved] * n, f"s{n}")
@@ -381,6 +381,8 @@ def test_sixteen_taxels_at_96_khz_on_a_flat_board(tmp_path, write_spec):
     path = out / f"{data['name']}.toml"
     written = spec_mod.load(path)
     assert written.plate.support_posts and len(plate_post_positions_mm(written)) == 15
+    jets = [f for f in check(written) if f.id == "jet.strouhal"]  # each needle's flow matched to its pitch
+    assert len(jets) == 16 and all(f.level == "info" and abs(f.value - 1) < 0.01 for f in jets)
     assert max(abs(b.shift_hz) for b in bendings(written)) <= BENDING_GUARD_SHARE * guard_hz(96000.0)
     code, stdout, err = run_cli("check", path)
     assert code == 0 and "plate.bending" not in stdout and "plate.posts" not in stdout, stdout + err

@@ -55,3 +55,40 @@ def window(f_hz: float, mode: int, edge_distance_mm: float, windway_height_mm: f
     return Window(mode=mode, f_hz=f_hz, u_min_m_s=f_hz * w_m / ST_WINDOW[1], u_optimum_m_s=u_opt,
                   u_max_m_s=f_hz * w_m / ST_WINDOW[0], flow_optimum_l_min=u_opt * area_m2 * 60e3,
                   pressure_optimum_pa=0.5 * AIR_DENSITY_KG_M3 * u_opt**2)
+
+
+# --- the MAT taxel's needle jet ------------------------------------------------------------------------------------
+
+PAPER_JET = {"f_hz": 4000.0, "neck_diameter_mm": 2.10, "flow_l_min": 1.5, "needle_diameter_mm": 1.52}
+"""The one operating point a MAT taxel is known to sing at (paper Sec. II and IV): ~4.0 kHz measured, a 2.10 mm
+neck, about 1.5 L/min through a 1.52 mm needle 2.10 mm from the orifice at 75°, a combination the authors chose
+by sweeping distance and angle for signal clarity and strength."""
+MAT_ST_SPAN = (ST_WINDOW[0] / ST_OPTIMUM, ST_WINDOW[1] / ST_OPTIMUM)
+"""A MAT taxel's Strouhal window relative to the paper's operating point: the flue's ±50 % on St
+(:data:`ST_WINDOW` about :data:`ST_OPTIMUM`) carried over, centred on the paper's point — an assumption (the paper
+reports one point, chosen for the strongest, clearest tone, not the range over which the taxel speaks)."""
+MACH_LIMIT = 0.3
+"""Jet Mach number above which the edge-tone picture (an incompressible jet) and a needle's steady flow no longer
+hold (the usual incompressibility bound, |Δρ/ρ| ≈ M²/2 ≈ 5 %)."""
+
+
+def needle_jet_speed_m_s(flow_l_min: float, needle_diameter_mm: float) -> float:
+    """The mean jet speed (m/s) of a flow (L/min) out of a needle of diameter ``needle_diameter_mm`` taken as its
+    bore: U = Q / (π d² / 4). The paper gives one needle diameter; a needle's bore is smaller than its outside, but
+    St relative to the paper's (:func:`mat_strouhal_ratio`) does not depend on which is used as long as the needle
+    has the paper's bore-to-outside ratio."""
+    import math
+
+    return flow_l_min / 60e3 / (math.pi / 4 * (needle_diameter_mm * 1e-3) ** 2)
+
+
+def mat_strouhal(f_hz: float, neck_diameter_mm: float, flow_l_min: float, needle_diameter_mm: float) -> float:
+    """St = f d / U of a MAT taxel at ``f_hz`` whose neck (d, mm) the needle's jet (:func:`needle_jet_speed_m_s`)
+    crosses."""
+    return f_hz * neck_diameter_mm * 1e-3 / needle_jet_speed_m_s(flow_l_min, needle_diameter_mm)
+
+
+def mat_strouhal_ratio(f_hz: float, neck_diameter_mm: float, flow_l_min: float, needle_diameter_mm: float) -> float:
+    """A MAT taxel's St over the paper's (:data:`PAPER_JET`): 1 at the paper's operating point; St ∝ f d D² / Q,
+    so the ratio is free of the bore-or-outside question (:func:`needle_jet_speed_m_s`)."""
+    return mat_strouhal(f_hz, neck_diameter_mm, flow_l_min, needle_diameter_mm) / mat_strouhal(**PAPER_JET)

@@ -36,7 +36,8 @@ LAYOUT_STEPS_PER_MM = 10
 """The layout's pitches are whole tenths of a millimetre: necks at multiples of 0.05 mm, readable in the spec."""
 PER_TAXEL = {"neck.diameter": "neck_diameter", "cavity.diameter": "cavity_diameter",
              "cavity.length": "cavity_length"}
-"""Fields a [[taxel]] entry may set for itself (the neck length is the plate's sheet, shared)."""
+"""Fields a [[taxel]] entry may set for itself that `design --taxels` varies (the neck length is the plate's sheet,
+shared); each entry also gets the needle flow that matches its pitch (:func:`matched_flow_l_min`)."""
 
 
 @dataclass(frozen=True)
@@ -177,8 +178,21 @@ def array_spec(base, points, solutions, name: str):
     data["name"] = name
     data["taxel"] = [{"name": f"t{i}", "x": round(x, 6), "y": round(y, 6)}
                      | {PER_TAXEL[k]: v[1] for k, v in s.fields.items()}
+                     | {"needle_flow_l_min": matched_flow_l_min(s.spec)}
                      for i, ((x, y), s) in enumerate(zip(points, solutions), 1)]
     return from_dict(data)
+
+
+def matched_flow_l_min(spec) -> float:
+    """The needle flow (L/min, to 0.01) that puts a solved single taxel's jet at the paper's operating point
+    (``jet.strouhal``, :func:`matcad.acoustics.edgetone.mat_strouhal_ratio`: St ∝ f d D² / Q), from its predicted
+    f0; a board's taxels span several kHz, and one shared flow leaves the lowest and highest outside the window."""
+    from matcad.acoustics.edgetone import mat_strouhal_ratio
+    from matcad.prediction import predict
+
+    needle = spec.needle
+    ratio = mat_strouhal_ratio(predict(spec).f0_hz, spec.neck.diameter, needle.flow_l_min, needle.outer_diameter)
+    return round(needle.flow_l_min * ratio, 2)
 
 
 def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = None,

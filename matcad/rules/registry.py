@@ -8,11 +8,11 @@ here (docs/extending.md). A module of :data:`SPEC_MODULES` may also name, in ``T
 
 from __future__ import annotations
 
-from matcad.rules import acoustic, bands, board, laser, plate, printing, stack, tube
+from matcad.rules import acoustic, bands, board, jet, laser, plate, printing, stack, tube
 
 SPEC_MODULES = (laser, printing, stack, bands, board, plate)
 """Modules whose ``RULES`` are functions of the spec: ``rule(spec) -> list[Finding]``."""
-PREDICTION_MODULES = (acoustic,)
+PREDICTION_MODULES = (acoustic, jet)
 """Modules whose ``RULES`` judge one taxel's predicted sound: ``rule(taxel_spec, prediction) -> list[Finding]``,
 run on every taxel with its own prediction."""
 TUBE_MODULES = (tube,)

@@ -21,7 +21,7 @@ from matcad.spec.sections import Cavity, EndCap, Neck, Needle, TaxelEntry
 ENTRY_FIELDS = {
     "cavity.diameter": "cavity_diameter", "cavity.length": "cavity_length", "neck.diameter": "neck_diameter",
     "end_cap.outer_diameter": "cap_outer_diameter", "end_cap.top_thickness": "cap_top_thickness",
-    "needle.theta_deg": "needle_theta_deg", "needle.y": "needle_y"}
+    "needle.theta_deg": "needle_theta_deg", "needle.y": "needle_y", "needle.flow_l_min": "needle_flow_l_min"}
 """Shared-table field → the [[taxel]] key that overrides it for one taxel."""
 
 

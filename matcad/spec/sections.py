@@ -150,6 +150,9 @@ class Needle(Section):
     length: float = length_mm("exposed needle length modelled for collision checks", 25.0)
     fit: str = param("needle fit in the printed bore", default="slip", kind="choice",
                      choices=("clearance", "slip", "press"))
+    flow_l_min: float = param("air flow through the needle (the paper blew about 1.5 L/min, read on a 1-10 L/min "
+                              "meter); sets the jet speed the jet.strouhal rule checks against the paper's "
+                              "operating point", "L/min", 1.5, lo=0.01, hi=100.0, lo_open=False)
 
 
 @dataclass(frozen=True)
@@ -402,6 +405,8 @@ class TaxelEntry(Section):
                                            None, lo=0.0, hi=90.0)
     needle_y: float | None = param("this taxel's needle offset y (see needle.y); default [needle]", "mm", None,
                                    lo=-LENGTH_MAX_MM, hi=LENGTH_MAX_MM, lo_open=False)
+    needle_flow_l_min: float | None = param("this taxel's needle flow (see needle.flow_l_min); default [needle]",
+                                            "L/min", None, lo=0.01, hi=100.0, lo_open=False)
     calibration: Calibration | None = param(
         "this taxel's Eq. 5 calibration as a [taxel.calibration] sub-table, the fields of [calibration] (`matcad "
         "calibrate --taxel NAME` writes it); `sense --spec` uses it, `--calibration NAME=FILE` overrides it",

@@ -202,14 +202,18 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, mo
                  failed_checks) -> dict:
     """rule_errors, rule_warnings, failing_rules (and status/reason where a rule raised) of the chunk's valid
     variants, as :func:`matcad.sweep.tasks.rule_verdicts` gives them one by one."""
+    from matcad.acoustics.design import speed_of_sound
     from matcad.acoustics.predict import warning_count
-    from matcad.rules import acoustic
+    from matcad.rules import acoustic, jet
 
     n = len(chunk)
     numbers = [memo.apply(chunk) for memo in memos]
+    d = v.design()
     sound = acoustic.array_counts(chunk.field(base, "microphone.sample_rate_hz"),
                                   chunk.field(base, "microphone.floor_hz"), low, high,
-                                  warning_count(v.design(), f0, failed_checks))
+                                  warning_count(d, f0, failed_checks))
+    sound |= jet.array_counts(f0, chunk.field(base, "neck.diameter"), chunk.field(base, "needle.flow_l_min"),
+                              chunk.field(base, "needle.outer_diameter"), speed_of_sound(d.air))
     matrix = np.stack(numbers + [np.asarray(c, dtype=np.int64) for c in sound.values()], axis=1) if n else \
         np.zeros((0, len(memos) + len(sound)), dtype=np.int64)
     uniq, inverse = np.unique(matrix, axis=0, return_inverse=True)
