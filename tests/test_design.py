@@ -396,3 +396,29 @@ def test_sixteen_taxels_at_96_khz_on_a_flat_board(tmp_path, write_spec):
         a = t.analysis
         assert a is not None, t.reason
         assert abs(np.mean(a.track_hz[a.voiced] - rec.truth_at(k, a.times_s[a.voiced]))) < 1.0, t.name
+
+
+def test_taxels_choose_the_plate_sheet_among_stock_sheets(tmp_path, write_spec):
+    """`design --taxels 3 --vary neck.length neck.diameter`: a 6.35 mm sheet tops out at 4.9 kHz, below 5-6.5 kHz (1 N
+    each), so the plate goes to the stock sheet nearest it (in ratio) on which the three bands fit and the plate stays flat; every nearer
+    sheet is named as passed over, and the written board's bands lie in the band (recomputed from the file)."""
+    from matcad.design.solve import _stock_order
+    from matcad.prediction.bands import taxel_bands
+
+    base = write_spec(ARRAY_BASE.format(force="1.0"))
+    out = tmp_path / "arr"
+    code, stdout, err = run_cli("design", base, "--taxels", "3", "--band", "5000", "6500", "--vary", "neck.length",
+                                "neck.diameter", "--out", out, "--json")
+    assert code == 0, err
+    data = json.loads(stdout)
+    written = spec_mod.load(out / f"{data['name']}.toml")
+    sheet = written.neck.length
+    assert sheet in STOCK_ACRYLIC_MM and sheet < 6.35
+    order = _stock_order(spec_mod.load(base))
+    nearer = order[:order.index(sheet)]
+    note = data["notes"][0]
+    assert note.startswith(f"neck.length = {sheet:g} mm") and all(f"{t:g} mm (" in note for t in nearer)
+    assert all(5000 <= b.loaded_hz[0] < b.loaded_hz[1] <= 6500 for b in taxel_bands(written))
+    assert "plate.bending" not in {f["id"] for f in data["findings"]}
+    code, _, err = run_cli("design", base, "--taxels", "3", "--band", "5000", "6500", "--vary", "neck.length")
+    assert code == 2 and "at least one" in err

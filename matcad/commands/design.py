@@ -29,7 +29,7 @@ def solve(spec, args):
     an :class:`matcad.design.allocate.Allocation` (--taxels N in --band LO HI)."""
     import dataclasses
 
-    from matcad.design.solve import CONTINUOUS, parse_vary
+    from matcad.design.solve import parse_vary
 
     if spec.kind == "tube":
         return _tube(spec, args)
@@ -50,7 +50,7 @@ def solve(spec, args):
 
     if not args.band:
         raise ValueError("--taxels needs --band LO HI (Hz)")
-    vary = parse_vary(spec, args.vary or ["neck.diameter"], CONTINUOUS)
+    vary = parse_vary(spec, args.vary or ["neck.diameter"])  # allocate says which fields a board may vary
     with line(f"design {spec.name}", "taxels", quiet=args.json) as progress:
         return allocate(spec, args.taxels, *args.band, vary, args.name, progress)
 

@@ -26,7 +26,7 @@ import time
 from dataclasses import dataclass
 
 from matcad.design import RulesFailed, Unreachable
-from matcad.design.solve import CONTINUOUS, solve
+from matcad.design.solve import CONTINUOUS, SHEET, solve
 
 TARGET_MARGIN = 1e-3
 """Relative precision of each taxel's f0 target (the bisection stops there: 5 Hz at 5 kHz)."""
@@ -53,6 +53,7 @@ class Allocation:
     band_hz: tuple[float, float]
     seconds: float
     findings: tuple = ()
+    notes: tuple = ()
 
     def to_dict(self) -> dict:
         return {"name": self.spec.name, "band_hz": list(self.band_hz), "guard_hz": self.guard_hz,
@@ -60,7 +61,7 @@ class Allocation:
                 "taxels": [b.to_dict() | {"target_hz": s.target_hz, "error": s.error,
                                           "fields": {k: v[1] for k, v in s.fields.items()}}
                            for b, s in zip(self.bands, self.solutions)],
-                "findings": [f.to_dict() for f in self.findings]}
+                "findings": [f.to_dict() for f in self.findings], "notes": list(self.notes)}
 
     def to_text(self) -> str:
         """What `matcad design --taxels` prints: the band shared (Hz), the guard, and each taxel's position (mm),
@@ -72,7 +73,7 @@ class Allocation:
             lines.append(f"  {b.name} at ({b.x_mm:g}, {b.y_mm:g}) mm: f0 {b.f0_hz:.0f} Hz, unloaded "
                          f"{b.unloaded_hz[0]:.0f}-{b.unloaded_hz[1]:.0f} Hz, loaded {b.loaded_hz[0]:.0f}-"
                          f"{b.loaded_hz[1]:.0f} Hz; {fields}")
-        return "\n".join(lines)
+        return "\n".join(lines + [f"  note: {note}" for note in self.notes])
 
 
 def _one(base, name: str, start: float, stop: float, vary, ratio: float):
@@ -210,10 +211,14 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
         raise ValueError(f"--taxels {n} invalid, must be 2-{MAX_TAXELS} (a board of one is --target-hz)")
     if not (math.isfinite(lo_hz) and math.isfinite(hi_hz) and 0 < lo_hz < hi_hz):
         raise ValueError(f"--band {lo_hz:g} {hi_hz:g} invalid, must be 0 < LO < HI (Hz)")
-    bad = [k for k in vary if k not in CONTINUOUS]
-    if bad:
-        raise ValueError(f"--vary {bad[0]}: with --taxels only per-taxel fields vary: {', '.join(CONTINUOUS)} "
-                         "(the neck length is the plate's sheet, shared by every taxel)")
+    bad = [k for k in vary if k not in (*CONTINUOUS, SHEET)]
+    if bad or set(vary) == {SHEET}:
+        raise ValueError(f"--vary {(bad or [SHEET])[0]}: with --taxels the per-taxel fields vary "
+                         f"({', '.join(CONTINUOUS)}; at least one), and {SHEET}, the plate's sheet shared by every "
+                         "taxel, among the stock sheets")
+    if SHEET in vary:
+        return _over_sheets(spec, n, lo_hz, hi_hz, {k: r for k, r in vary.items() if k != SHEET}, name, progress,
+                            start_time)
     single = taxel_spec(spec, taxels(spec)[0])
     base, points = board_base(single, n, vary)
     guard = guard_hz(spec.microphone.sample_rate_hz)
@@ -241,6 +246,37 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     placed = [dataclasses.replace(b, x_mm=t.x, y_mm=t.y) for b, t in zip(placed, taxels(out))]
     return Allocation(out, tuple(placed), tuple(solutions), guard, (lo_hz, hi_hz), time.perf_counter() - start_time,
                       tuple(findings))
+
+
+def _over_sheets(spec, n: int, lo_hz: float, hi_hz: float, vary, name, progress, start_time: float) -> Allocation:
+    """``--vary neck.length`` with ``--taxels``: the plate's sheet among the stock sheets, nearest ``spec``'s first
+    (:func:`matcad.design.solve._stock_order`): the first on which the n bands fit and the plate stays flat (no
+    ``plate.bending`` finding, support posts allowed); when none stays flat, the first on which they fit, with its
+    warning. A note says which sheets were tried and why each was passed over."""
+    from matcad.design.solve import _stock_order, with_fields
+
+    tried, fitted, failure = [], None, None
+    for sheet in _stock_order(spec):
+        try:
+            a = allocate(with_fields(spec, {SHEET: sheet}), n, lo_hz, hi_hz, vary, name, progress)
+        except (Unreachable, RulesFailed) as exc:
+            failure = failure or exc
+            tried.append(f"{sheet:g} mm ({'a design rule' if isinstance(exc, RulesFailed) else 'bands do not fit'})")
+            continue
+        except ValueError:  # a sheet the spec's own ranges refuse
+            continue
+        if not any(f.id == "plate.bending" for f in a.findings):
+            fitted = a
+            break
+        tried.append(f"{sheet:g} mm (the plate bends)")
+        fitted = fitted or a
+    if fitted is None:
+        raise failure or Unreachable(f"no stock sheet fits {n} bands in {lo_hz:g}-{hi_hz:g} Hz")
+    how = ("the plate stays flat" if not any(f.id == "plate.bending" for f in fitted.findings)
+           else "no sheet kept the plate flat")
+    note = (f"{SHEET} = {fitted.spec.neck.length:g} mm: the stock sheet nearest {spec.neck.length:g} mm on which the "
+            f"{n} bands fit and {how}" + (f"; passed over: {', '.join(tried)}" if tried else ""))
+    return dataclasses.replace(fitted, seconds=time.perf_counter() - start_time, notes=(*fitted.notes, note))
 
 
 def _place(base, n: int, lo_hz: float, hi_hz: float, vary, guard: float, progress) -> tuple[list, list]:
