@@ -402,7 +402,7 @@ def test_taxels_choose_the_plate_sheet_among_stock_sheets(tmp_path, write_spec):
     """`design --taxels 3 --vary neck.length neck.diameter`: a 6.35 mm sheet tops out at 4.9 kHz, below 5-6.5 kHz (1 N
     each), so the plate goes to the stock sheet nearest it (in ratio) on which the three bands fit and the plate stays flat; every nearer
     sheet is named as passed over, and the written board's bands lie in the band (recomputed from the file)."""
-    from matcad.design.solve import _stock_order
+    from matcad.design.solve import stock_order
     from matcad.prediction.bands import taxel_bands
 
     base = write_spec(ARRAY_BASE.format(force="1.0"))
@@ -414,7 +414,7 @@ def test_taxels_choose_the_plate_sheet_among_stock_sheets(tmp_path, write_spec):
     written = spec_mod.load(out / f"{data['name']}.toml")
     sheet = written.neck.length
     assert sheet in STOCK_ACRYLIC_MM and sheet < 6.35
-    order = _stock_order(spec_mod.load(base))
+    order = stock_order(spec_mod.load(base))
     nearer = order[:order.index(sheet)]
     note = data["notes"][0]
     assert note.startswith(f"neck.length = {sheet:g} mm") and all(f"{t:g} mm (" in note for t in nearer)

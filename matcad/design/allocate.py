@@ -250,13 +250,13 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
 
 def _over_sheets(spec, n: int, lo_hz: float, hi_hz: float, vary, name, progress, start_time: float) -> Allocation:
     """``--vary neck.length`` with ``--taxels``: the plate's sheet among the stock sheets, nearest ``spec``'s first
-    (:func:`matcad.design.solve._stock_order`): the first on which the n bands fit and the plate stays flat (no
+    (:func:`matcad.design.solve.stock_order`): the first on which the n bands fit and the plate stays flat (no
     ``plate.bending`` finding, support posts allowed); when none stays flat, the first on which they fit, with its
     warning. A note says which sheets were tried and why each was passed over."""
-    from matcad.design.solve import _stock_order, with_fields
+    from matcad.design.solve import stock_order, with_fields
 
     tried, fitted, failure = [], None, None
-    for sheet in _stock_order(spec):
+    for sheet in stock_order(spec):
         try:
             a = allocate(with_fields(spec, {SHEET: sheet}), n, lo_hz, hi_hz, vary, name, progress)
         except (Unreachable, RulesFailed) as exc:

@@ -218,7 +218,7 @@ def _roots(route: _Route, target_hz: float) -> tuple[list[float], tuple[float, f
     return sorted(roots, key=abs), seen
 
 
-def _stock_order(spec) -> list[float]:
+def stock_order(spec) -> list[float]:
     """Stock sheets (mm), nearest the start's neck.length first (in ratio)."""
     from matcad.parts.features import STOCK_ACRYLIC_MM
 
@@ -241,7 +241,7 @@ def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -
         raise ValueError("--target-hz solves one taxel: give a single-taxel spec (--taxels N --band LO HI designs a "
                          "board)")
     model, base = chosen_model(spec)
-    sheets = _stock_order(spec) if SHEET in vary else [spec.neck.length]
+    sheets = stock_order(spec) if SHEET in vary else [spec.neck.length]
     continuous = {p: (r or default_range(spec, p)) for p, r in vary.items() if p != SHEET}
     candidates, reached, evaluations, failed = [], [], 0, None
     for sheet in sheets:
