@@ -212,3 +212,15 @@ def test_strong_threshold_is_15_db_over_the_floor():
     """Two frames are enough when one stands 15.5 dB over the floor; at 14.5 dB they are not."""
     assert _voiced([15.5, 9.0]).all()
     assert not _voiced([14.5, 9.0]).any()
+
+
+def test_a_band_narrower_than_the_tracker_needs_is_widened_about_its_centre():
+    """:func:`matcad.listening.trackable`: a band under BAND_BINS + 1 bins (a tightly anchored taxel's) grows about
+    its centre to exactly that width; a wider one is left as it is (Hz)."""
+    from matcad.listening import BAND_BINS, ZERO_PAD, trackable, window_samples
+
+    for fs in (44100.0, 96000.0):
+        need = (BAND_BINS + 1) * fs / (ZERO_PAD * window_samples(fs))
+        low, high = trackable((4600.0, 4630.0), fs)
+        assert high - low == pytest.approx(need) and (low + high) / 2 == pytest.approx(4615.0)
+        assert trackable((4000.0, 4000.0 + 2 * need), fs) == (4000.0, 4000.0 + 2 * need)
