@@ -202,8 +202,9 @@ def test_taxel_layout_is_jet_free_by_construction(vary, widest):
     template = spec_mod.load(ROOT / "templates" / "mat-array-4.toml")
     base = spec_mod.taxel_spec(template, spec_mod.taxels(template)[0])
     assert widest_neck_mm(base, vary) == widest
-    solved = SimpleNamespace(spec=base, fields={"neck.diameter": (base.neck.diameter, widest), "cavity.diameter": (
-        base.cavity.diameter, max(widest, base.cavity.diameter))})
+    solved = SimpleNamespace(spec=base, f0_hz=5000.0, fields={
+        "neck.diameter": (base.neck.diameter, widest),
+        "cavity.diameter": (base.cavity.diameter, max(widest, base.cavity.diameter))})
     for n in range(2, 25):
         plate, points = board_base(base, n, vary)
         spec = array_spec(plate, points, [solved] * n, f"s{n}")
@@ -400,8 +401,9 @@ def test_sixteen_taxels_at_96_khz_on_a_flat_board(tmp_path, write_spec):
 
 def test_taxels_choose_the_plate_sheet_among_stock_sheets(tmp_path, write_spec):
     """`design --taxels 3 --vary neck.length neck.diameter`: a 6.35 mm sheet tops out at 4.9 kHz, below 5-6.5 kHz (1 N
-    each), so the plate goes to the stock sheet nearest it (in ratio) on which the three bands fit and the plate stays flat; every nearer
-    sheet is named as passed over, and the written board's bands lie in the band (recomputed from the file)."""
+    each), so the plate goes to the stock sheet nearest it (in ratio) on which the three bands fit and the plate
+    stays flat; every nearer sheet is named as passed over, and the written board's bands lie in the band
+    (recomputed from the file)."""
     from matcad.design.solve import stock_order
     from matcad.prediction.bands import taxel_bands
 

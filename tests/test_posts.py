@@ -161,8 +161,9 @@ def test_rows_spread_until_posts_fit():
     s = _board(True)
     single = taxel_spec(s, taxels(s)[0])
     vary = parse_vary(single, ["neck.diameter=0.5:7", "cavity.length", "cavity.diameter=2.1:12"])
-    solutions = [SimpleNamespace(spec=single, fields={"neck.diameter": (None, d + 0.35), "cavity.diameter": (None, cd),
-                                         "cavity.length": (None, cl)}) for d, cd, cl in TAXELS]
+    solutions = [SimpleNamespace(spec=single, f0_hz=5000.0, fields={
+        "neck.diameter": (None, d + 0.35), "cavity.diameter": (None, cd), "cavity.length": (None, cl)})
+        for d, cd, cl in TAXELS]
 
     def relaid(pitch):
         base, points = board_base(single, 12, vary, pitch)

@@ -179,20 +179,20 @@ def array_spec(base, points, solutions, name: str):
     data["name"] = name
     data["taxel"] = [{"name": f"t{i}", "x": round(x, 6), "y": round(y, 6)}
                      | {PER_TAXEL[k]: v[1] for k, v in s.fields.items()}
-                     | {"needle_flow_l_min": matched_flow_l_min(s.spec)}
+                     | {"needle_flow_l_min": matched_flow_l_min(s.spec, s.f0_hz)}
                      for i, ((x, y), s) in enumerate(zip(points, solutions), 1)]
     return from_dict(data)
 
 
-def matched_flow_l_min(spec) -> float:
+def matched_flow_l_min(spec, f0_hz: float) -> float:
     """The needle flow (L/min, to 0.01) that puts a solved single taxel's jet at the paper's operating point
-    (``jet.strouhal``, :func:`matcad.acoustics.edgetone.mat_strouhal_ratio`: St ∝ f d D² / Q), from its predicted
-    f0; a board's taxels span several kHz, and one shared flow leaves the lowest and highest outside the window."""
+    (``jet.strouhal``, :func:`matcad.acoustics.edgetone.mat_strouhal_ratio`: St ∝ f d D² / Q) at its predicted
+    ``f0_hz`` (Hz); a board's taxels span several kHz, and one shared flow leaves the lowest and highest outside the
+    window."""
     from matcad.acoustics.edgetone import mat_strouhal_ratio
-    from matcad.prediction import predict
 
     needle = spec.needle
-    ratio = mat_strouhal_ratio(predict(spec).f0_hz, spec.neck.diameter, needle.flow_l_min, needle.outer_diameter)
+    ratio = mat_strouhal_ratio(f0_hz, spec.neck.diameter, needle.flow_l_min, needle.outer_diameter)
     return round(needle.flow_l_min * ratio, 2)
 
 

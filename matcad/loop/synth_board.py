@@ -56,9 +56,9 @@ def board_recording(bands, rises, max_force_n: float, seconds: float = 8.0, seed
                     mic_distance_m: float = MIC_DISTANCE_M) -> synth.BoardRecording:
     """Every taxel of a board singing at once in a room (pink noise, reverb, tablet microphone): ``bands`` (name,
     (low, high) Hz) are the loaded bands (each taxel's unloaded pitch is drawn inside, :func:`unloaded_pitch`; its
-    listening band is wider, :func:`matcad.listening.loaded_listening_band`), ``rises`` each taxel's f(max)/f(0); the ``pressed`` ones (indices;
-    default every third from the second) pressed to ``max_force_n`` (N) at staggered times, the others held at 20
-    %; levels spread uniformly over ±``level_spread_db``/2 dB; harmonics at ``harmonics_db``; the ``silent`` ones
+    listening band is wider, :func:`matcad.listening.loaded_listening_band`), ``rises`` each taxel's f(max)/f(0);
+    the ``pressed`` ones (indices; default every third from the second) pressed to ``max_force_n`` (N) at
+    staggered times, the others held at 20 %; levels spread uniformly over ±``level_spread_db``/2 dB; harmonics at ``harmonics_db``; the ``silent`` ones
     (indices) do not sing (truth NaN).
 
     The room is the lab of :data:`synth.LAB_VOLUME_M3` with reverberation time ``rt60_s`` (s), heard
