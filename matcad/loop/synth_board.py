@@ -58,8 +58,8 @@ def board_recording(bands, rises, max_force_n: float, seconds: float = 8.0, seed
     (low, high) Hz) are the loaded bands (each taxel's unloaded pitch is drawn inside, :func:`unloaded_pitch`; its
     listening band is wider, :func:`matcad.listening.loaded_listening_band`), ``rises`` each taxel's f(max)/f(0);
     the ``pressed`` ones (indices; default every third from the second) pressed to ``max_force_n`` (N) at
-    staggered times, the others held at 20 %; levels spread uniformly over ±``level_spread_db``/2 dB; harmonics at ``harmonics_db``; the ``silent`` ones
-    (indices) do not sing (truth NaN).
+    staggered times, the others held at 20 %; levels spread uniformly over ±``level_spread_db``/2 dB; harmonics
+    at ``harmonics_db``; the ``silent`` ones (indices) do not sing (truth NaN).
 
     The room is the lab of :data:`synth.LAB_VOLUME_M3` with reverberation time ``rt60_s`` (s), heard
     ``mic_distance_m`` (m) from the board: its reverberant share follows from the critical distance
