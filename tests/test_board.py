@@ -341,3 +341,16 @@ def test_assembly_places_every_taxels_cap_and_needle(spec):
         tip = needle_tip_mm(t)
         assert parts[f"needle_{t.name}"].bounding_box().max.Z == pytest.approx(-t.needle.tip_clearance, abs=1e-6)
         assert abs(parts[f"needle_{t.name}"].bounding_box().center().Y - tip[1]) < 1e-6
+
+
+def test_a_finding_every_taxel_shares_is_listed_once():
+    """A board's one-taxel geometry rules run on each taxel (matcad.rules.check); the guide sheet's squeeze, the
+    same on every cap of templates/mat-array-4.toml, is one seal.squeeze finding naming t1-t4 (four identical lines
+    before), while findings that differ per taxel stay one per taxel."""
+    from matcad.rules import check
+    from matcad.spec import load
+
+    findings = check(load(ROOT / "templates" / "mat-array-4.toml"))
+    seal = [f for f in findings if f.id == "seal.squeeze"]
+    assert len(seal) == 1 and seal[0].message.startswith("t1, t2, t3, t4: ")
+    assert [f.message.split(":")[0] for f in findings if f.id == "jet.strouhal"] == ["t1", "t2", "t3", "t4"]

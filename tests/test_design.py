@@ -293,32 +293,51 @@ def test_taxels_interleave_with_harmonics_and_check_warns(tmp_path, write_spec):
     assert code == 0 and "bands.harmonic" in stdout and "warning" in stdout, stdout + err
 
 
+def _capacity_board(write_spec, out, taxels: int, band: tuple[str, str], sheet: str, rate: str = "",
+                    needle_mount: bool = False):
+    """`design --taxels` of the capacity boards (issue 24; benchmarks/design.py --capacity-only): 5 N per taxel on a
+    ``sheet`` mm calipered sheet, neck and cavity free, at ``rate`` Hz when given; (design --json, written spec
+    path), `check` of it passed."""
+    text = ARRAY_BASE.format(force="5.0").replace("length = 6.35", f"length = {sheet}")
+    if needle_mount:
+        text = text.replace("needle_mount = false", "needle_mount = true")
+    text += f"[microphone]\nsample_rate_hz = {rate}\n" if rate else ""
+    code, stdout, err = run_cli("design", write_spec(text), "--taxels", str(taxels), "--band", *band, "--vary",
+                                "neck.diameter=0.5:7", "cavity.length", "cavity.diameter=2.1:12", "--out", out,
+                                "--json")
+    assert code == 0, err
+    data = json.loads(stdout)
+    path = out / f"{data['name']}.toml"
+    code, stdout, err = run_cli("check", path)
+    assert code == 0, stdout + err
+    return data, path
+
+
+def _tracked_within_1_hz(written, seed: int = 0) -> None:
+    """Every taxel of ``written`` tracked within 1 Hz (mean over its voiced frames) on a synthetic board recording
+    (matcad.loop.synth_board.spec_recording: presses on every third, harmonics at -20/-30 dB), heard in its
+    listening bands."""
+    from matcad.loop import synth_board
+    from matcad.loop.board import analyze_board
+    from matcad.prediction.bands import listening_bands
+
+    listen = listening_bands(written)
+    rec = synth_board.spec_recording(written, seed)
+    for k, t in enumerate(analyze_board([rec.x], rec.fs, listen)):
+        a = t.analysis
+        assert a is not None, t.reason
+        assert abs(np.mean(a.track_hz[a.voiced] - rec.truth_at(k, a.times_s[a.voiced]))) < 1.0, t.name
+
+
 @pytest.mark.slow
 def test_twelve_taxels_on_one_microphone(tmp_path, write_spec):
     """Issue 24's capacity target at 44.1 kHz: 12 taxels with 5 N each (a 1/16 in sheet, neck and cavity free),
     `check` without errors, and every taxel tracked within 1 Hz (mean over voiced frames) on a synthetic board
     recording with presses on every third and harmonics at -20/-30 dB (benchmarks/design.py --capacity-only)."""
-    from matcad.loop import synth_board
-    from matcad.loop.board import analyze_board
-    from matcad.prediction.bands import listening_bands
-
-    base = write_spec(ARRAY_BASE.format(force="5.0").replace("length = 6.35", "length = 1.5875"))
-    out = tmp_path / "arr"
-    code, stdout, err = run_cli("design", base, "--taxels", "12", "--band", "1700", "11000", "--vary",
-                                "neck.diameter=0.5:7", "cavity.length", "cavity.diameter=2.1:12", "--out", out,
-                                "--json")
-    assert code == 0, err
-    path = out / f"{json.loads(stdout)['name']}.toml"
-    code, stdout, err = run_cli("check", path)
-    assert code == 0, stdout + err
+    _, path = _capacity_board(write_spec, tmp_path / "arr", 12, ("1700", "11000"), "1.5875")
     written = spec_mod.load(path)
-    listen = listening_bands(written)
-    rec = synth_board.spec_recording(written)
-    tracks = analyze_board([rec.x], rec.fs, listen)
-    for k, t in enumerate(tracks):
-        a = t.analysis
-        assert a is not None, t.reason
-        assert abs(np.mean(a.track_hz[a.voiced] - rec.truth_at(k, a.times_s[a.voiced]))) < 1.0, t.name
+    assert len(spec_mod.taxels(written)) == 12
+    _tracked_within_1_hz(written)
 
 
 @pytest.mark.slow
@@ -329,29 +348,10 @@ def test_sixteen_taxels_at_96_khz(tmp_path, write_spec, seed):
     third, harmonics at -20/-30 dB). Deliberate fault caught: without the predicted harmonics discounted before
     tracking (matcad.loop.overtones) and the room's tails before press steps left out, the cavity-length board's
     t8 read t1's moving 2f (75.7 Hz off, seed 1; benchmarks/design.py --capacity-only runs 5 seeds and both routes)."""
-    from matcad.loop import synth_board
-    from matcad.loop.board import analyze_board
-    from matcad.prediction.bands import listening_bands
-
-    base = write_spec(ARRAY_BASE.format(force="5.0").replace("length = 6.35", "length = 0.8")
-                      + "[microphone]\nsample_rate_hz = 96000.0\n")
-    out = tmp_path / "arr"
-    code, stdout, err = run_cli("design", base, "--taxels", "16", "--band", "1200", "30000", "--vary",
-                                "neck.diameter=0.5:7", "cavity.length", "cavity.diameter=2.1:12", "--out", out,
-                                "--json")
-    assert code == 0, err
-    path = out / f"{json.loads(stdout)['name']}.toml"
-    code, stdout, err = run_cli("check", path)
-    assert code == 0, stdout + err
+    _, path = _capacity_board(write_spec, tmp_path / "arr", 16, ("1200", "30000"), "0.8", "96000.0")
     written = spec_mod.load(path)
-    listen = listening_bands(written)
-    assert len(listen) == 16
-    rec = synth_board.spec_recording(written, seed)
-    tracks = analyze_board([rec.x], rec.fs, listen)
-    for k, t in enumerate(tracks):
-        a = t.analysis
-        assert a is not None, t.reason
-        assert abs(np.mean(a.track_hz[a.voiced] - rec.truth_at(k, a.times_s[a.voiced]))) < 1.0, t.name
+    assert len(spec_mod.taxels(written)) == 16
+    _tracked_within_1_hz(written, seed)
 
 
 @pytest.mark.slow
@@ -362,41 +362,23 @@ def test_sixteen_taxels_at_96_khz_on_a_flat_board(tmp_path, write_spec):
     `check` passes with no plate.bending finding (every taxel's pitch moves at most 2.0 Hz under a 5 N press; limit
     11.7 Hz), `build` writes the kit with the posted needle mount, and every taxel is tracked within 1 Hz on a
     synthetic board recording at 96 kHz (harmonics at -20/-30 dB, presses on every third)."""
-    from matcad.loop import synth_board
-    from matcad.loop.board import analyze_board
-    from matcad.parts.features import plate_post_positions_mm
-    from matcad.prediction.bands import listening_bands
-    from matcad.rules.plate import BENDING_GUARD_SHARE, bendings
     from matcad.listening import guard_hz
+    from matcad.parts.features import plate_post_positions_mm
+    from matcad.rules.plate import BENDING_GUARD_SHARE, bendings
 
-    base = write_spec(ARRAY_BASE.format(force="5.0").replace("length = 6.35", "length = 3.175")
-                      .replace("needle_mount = false", "needle_mount = true")
-                      + "[microphone]\nsample_rate_hz = 96000.0\n")
-    out = tmp_path / "arr"
-    code, stdout, err = run_cli("design", base, "--taxels", "16", "--band", "1200", "30000", "--vary",
-                                "neck.diameter=0.5:7", "cavity.length", "cavity.diameter=2.1:12", "--out", out,
-                                "--json")
-    assert code == 0, err
-    data = json.loads(stdout)
+    data, path = _capacity_board(write_spec, tmp_path / "arr", 16, ("1200", "30000"), "3.175", "96000.0",
+                                 needle_mount=True)
     assert "plate.bending" not in {f["id"] for f in data["findings"]}
-    path = out / f"{data['name']}.toml"
     written = spec_mod.load(path)
     assert written.plate.support_posts and len(plate_post_positions_mm(written)) == 15
     jets = [f for f in check(written) if f.id == "jet.strouhal"]  # each needle's flow matched to its pitch
     assert len(jets) == 16 and all(f.level == "info" and abs(f.value - 1) < 0.01 for f in jets)
     assert max(abs(b.shift_hz) for b in bendings(written)) <= BENDING_GUARD_SHARE * guard_hz(96000.0)
-    code, stdout, err = run_cli("check", path)
-    assert code == 0 and "plate.bending" not in stdout and "plate.posts" not in stdout, stdout + err
+    assert not {"plate.bending", "plate.posts"} & {f.id for f in check(written)}
     code, stdout, err = run_cli("build", path, "--out", tmp_path / "kit")
     assert code == 0, stdout + err
     assert {"needle_mount.stl", "neck_plate.dxf", "spacer.dxf"} <= {p.name for p in (tmp_path / "kit").iterdir()}
-    listen = listening_bands(written)
-    assert len(listen) == 16
-    rec = synth_board.spec_recording(written)
-    for k, t in enumerate(analyze_board([rec.x], rec.fs, listen)):
-        a = t.analysis
-        assert a is not None, t.reason
-        assert abs(np.mean(a.track_hz[a.voiced] - rec.truth_at(k, a.times_s[a.voiced]))) < 1.0, t.name
+    _tracked_within_1_hz(written)
 
 
 def test_taxels_choose_the_plate_sheet_among_stock_sheets(tmp_path, write_spec):

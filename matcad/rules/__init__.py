@@ -17,7 +17,8 @@ __all__ = ["Finding", "check", "errors", "findings_text", "verdict_dict"]
 
 def check(spec, prediction=None) -> list[Finding]:
     """Run every rule on ``spec``; ``prediction`` (:func:`matcad.prediction.predict` of a single-taxel spec) is computed when
-    not given; a board's acoustic rules run on each taxel's own prediction."""
+    not given; a board's acoustic rules run on each taxel's own prediction. A board's one-taxel geometry rules run on
+    each taxel; a finding that several taxels share word for word is listed once, naming them ("t1, t2: ...")."""
     if spec.kind == "tube":
         return _tube(spec, prediction)
     from matcad.prediction import predict
@@ -31,10 +32,13 @@ def check(spec, prediction=None) -> list[Finding]:
         for rule in module.RULES:
             if rule not in per_taxel:
                 findings += rule(spec)
-    for taxel in board if per_taxel else ():  # a board's one-taxel geometry rules, on each taxel's own geometry
+    shared: dict = {}  # a board's one-taxel geometry rules, on each taxel's own geometry
+    for taxel in board if per_taxel else ():
         one = taxel_spec(spec, taxel)
         for rule in per_taxel:
-            findings += [replace(f, message=f"{taxel.name}: {f.message}") for f in rule(one)]
+            for f in rule(one):
+                shared.setdefault(repr(f), (f, []))[1].append(taxel.name)
+    findings += [replace(f, message=f"{', '.join(names)}: {f.message}") for f, names in shared.values()]
     for taxel in board:  # the sound rules per taxel, on its own prediction; a board's messages name the taxel
         one = taxel_spec(spec, taxel)
         p = (prediction or predict(one)) if len(board) == 1 else predict(one)
