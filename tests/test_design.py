@@ -371,8 +371,8 @@ def test_sixteen_taxels_at_96_khz_on_a_flat_board(tmp_path, write_spec):
     assert "plate.bending" not in {f["id"] for f in data["findings"]}
     written = spec_mod.load(path)
     assert written.plate.support_posts and len(plate_post_positions_mm(written)) == 15
-    jets = [f for f in check(written) if f.id == "jet.strouhal"]  # each needle's flow matched to its pitch
-    assert len(jets) == 16 and all(f.level == "info" and abs(f.value - 1) < 0.01 for f in jets)
+    jets = [f for f in check(written) if f.id == "jet.strouhal"]  # each needle's flow matched to its pitch, to
+    assert len(jets) == 16 and all(f.level == "info" and abs(f.value - 1) < 0.02 for f in jets)  # 0.01 L/min
     assert max(abs(b.shift_hz) for b in bendings(written)) <= BENDING_GUARD_SHARE * guard_hz(96000.0)
     assert not {"plate.bending", "plate.posts"} & {f.id for f in check(written)}
     code, stdout, err = run_cli("build", path, "--out", tmp_path / "kit")
