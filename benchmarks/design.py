@@ -105,13 +105,15 @@ area_convention = "d2/4"
 """
 THREE = ["neck.diameter=0.5:7", "cavity.length", "cavity.diameter=2.1:12"]
 LENGTH = ["cavity.length=0.3:30"]
-CAPACITY = ((44100.0, 12, (1700.0, 11000.0), 1.5875, THREE), (44100.0, 24, (1700.0, 19800.0), 1.5875, LENGTH),
+CAPACITY = ((44100.0, 12, (1700.0, 11000.0), 1.5875, THREE), (44100.0, 12, (1700.0, 19800.0), 3.175, LENGTH),
+            (44100.0, 24, (1700.0, 19800.0), 1.5875, LENGTH),
             (96000.0, 16, (1200.0, 30000.0), 0.8, THREE), (96000.0, 16, (1200.0, 30000.0), 3.175, THREE),
-            (96000.0, 16, (2000.0, 40000.0), 0.8, LENGTH),
+            (96000.0, 16, (2000.0, 40000.0), 0.8, LENGTH), (96000.0, 16, (1700.0, 43000.0), 3.175, LENGTH),
             (96000.0, 24, (1700.0, 43000.0), 0.8, LENGTH))
 """(sample rate Hz, taxels asked, band Hz, sheet = neck length mm, --vary). The three-field route of
 matcad.design.solve stops near 10.5 / 12.1 kHz; the cavity length alone reaches higher (a shorter cavity). The 1/8 in
-row is the 96 kHz board whose plate stays flat on its posts (docs/arrays.md)."""
+rows are 96 kHz boards whose plate stays flat on its posts (docs/arrays.md); the cavity-length one keeps every cap's
+wall (the three-field one lets the cavity reach 12 mm in a 7.95 mm cap)."""
 
 
 def _most_that_fit(s, n, band, vary):
@@ -127,7 +129,8 @@ def _most_that_fit(s, n, band, vary):
         except (Unreachable, RulesFailed) as exc:  # the top band breaking acoustic.band_high, too
             why = why or str(exc)
             hit = re.search(r"taxel (\d+) of", str(exc))
-            n = min(n - 1, int(hit.group(1)) - 1) if hit else n - 1
+            k = int(hit.group(1)) if hit else 1
+            n = min(n - 1, k - 1) if k > 1 else n - 1  # taxel 1 failing is the board itself: a plate past the bed
     return None, why
 
 
@@ -242,8 +245,10 @@ def room_shift(seeds=5, step_hz=0.1):
                   f"{100 * np.mean(wide >= 1.0):.1f} % | {wide.max():.1f} | {narrow.max():.1f} |", flush=True)
 
 
-SWEEP = ((44100.0, (1700.0, 19800.0), 1.5875, 40), (96000.0, (1700.0, 43000.0), 0.8, 48))
-"""(sample rate Hz, band Hz up to 0.45 fs, sheet mm, taxels asked: more than fit) of the capacity figure."""
+SWEEP = ((44100.0, (1700.0, 19800.0), 1.5875, 40), (44100.0, (1700.0, 19800.0), 3.175, 40),
+         (96000.0, (1700.0, 43000.0), 0.8, 48), (96000.0, (1700.0, 43000.0), 3.175, 48))
+"""(sample rate Hz, band Hz up to 0.45 fs, sheet mm, taxels asked: more than fit) of the capacity figure: the 1/8 in
+rows are boards whose plate the support posts can hold flat (docs/arrays.md)."""
 ROUTES = {("neck.diameter=0.5:7", "cavity.length", "cavity.diameter"): "neck, cavity diameter and length",
           tuple(LENGTH): "cavity length alone"}
 """The --vary routes of the capacity figure, with their legend text: the cavity diameter in its default range,
@@ -257,9 +262,10 @@ def capacity_sweep(forces, path):
     (:func:`capacity_figure`)."""
     import tomllib
 
-    print("\ncapacity sweep: the most taxels that fit below 0.45 fs (rigid walls, Eq. 5 rise, calipered sheet)")
-    print("| rate [kHz] | vary | max force [N] | fit | reach [Hz] | design [s] |")
-    print("|---:|---|---:|---:|---|---:|")
+    print("\ncapacity sweep: the most taxels that fit below 0.45 fs (rigid walls, Eq. 5 rise, calipered sheet); "
+          "plate: flat, or bends (plate.bending, with support posts where they fit)")
+    print("| rate [kHz] | sheet [mm] | vary | max force [N] | fit | reach [Hz] | plate | design [s] |")
+    print("|---:|---:|---|---:|---:|---|---|---:|")
     results = []
     for rate, band, sheet, ask in SWEEP:
         for vary in ROUTES:
@@ -268,18 +274,20 @@ def capacity_sweep(forces, path):
                 t0 = time.perf_counter()
                 a, _ = _most_that_fit(s, ask, band, parse_vary(s, list(vary)))
                 bands = () if a is None else tuple(b.loaded_hz for b in a.bands)
-                results.append((rate, vary, force, bands))
+                flat = a is not None and not any(f.id == "plate.bending" for f in a.findings)
+                results.append((rate, sheet, vary, force, bands, flat))
                 reach = f"{bands[0][0]:.0f}-{bands[-1][1]:.0f}" if bands else "-"
-                print(f"| {rate / 1e3:g} | {' '.join(vary)} | {force:g} | {len(bands)} | {reach} | "
-                      f"{time.perf_counter() - t0:.0f} |", flush=True)
+                print(f"| {rate / 1e3:g} | {sheet:g} | {' '.join(vary)} | {force:g} | {len(bands)} | {reach} | "
+                      f"{'flat' if flat else 'bends'} | {time.perf_counter() - t0:.0f} |", flush=True)
     capacity_figure(results, path)
 
 
 def capacity_figure(results, path):
     """The capacity figure (issue 24): left, taxels per microphone against the max force per taxel, per sample
-    rate and route (the guard in the legend); right, every design's loaded bands (Hz, log axis) at the first
-    force, with the microphone's top, 0.45 fs (:data:`matcad.rules.acoustic.NYQUIST_MARGIN`). ``results``:
-    (rate Hz, --vary, max force N, loaded bands Hz) per design."""
+    rate, sheet and route (the guard in the legend; a filled marker: the plate stays flat, hollow: it bends,
+    ``plate.bending``); right, every design's loaded bands (Hz, log axis) at the first force, with the microphone's
+    top, 0.45 fs (:data:`matcad.rules.acoustic.NYQUIST_MARGIN`). ``results``: (rate Hz, sheet mm, --vary, max force
+    N, loaded bands Hz, flat) per design."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -289,14 +297,17 @@ def capacity_figure(results, path):
     from matcad.listening import guard_hz
     from matcad.rules.acoustic import NYQUIST_MARGIN
 
-    fig, (left, right) = plt.subplots(1, 2, figsize=(12, 5), gridspec_kw={"width_ratios": [1, 1.6]})
-    first = results[0][2]
-    rows = [r for r in results if r[2] == first]
-    for k, (rate, vary, _, bands) in enumerate(rows):
+    fig, (left, right) = plt.subplots(1, 2, figsize=(14, 7.5), gridspec_kw={"width_ratios": [1, 1.4]})
+    first = results[0][3]
+    rows = [r for r in results if r[3] == first]
+    for k, (rate, sheet, vary, _, bands, _) in enumerate(rows):
         colour = f"C{k}"
-        same = sorted((force, len(b)) for r, v, force, b in results if r == rate and v == vary)
-        left.plot(*zip(*same), marker="o", color=colour,
-                  label=f"{rate / 1e3:g} kHz, {ROUTES[vary]} (guard {guard_hz(rate):.0f} Hz)")
+        same = sorted((force, len(b), flat) for r, t, v, force, b, flat in results
+                      if (r, t, v) == (rate, sheet, vary))
+        left.plot([x for x, _, _ in same], [n for _, n, _ in same], color=colour,
+                  label=f"{rate / 1e3:g} kHz, {sheet:g} mm sheet, {ROUTES[vary]} (guard {guard_hz(rate):.0f} Hz)")
+        for force, n, flat in same:
+            left.plot([force], [n], marker="o", color=colour, markerfacecolor=colour if flat else "white")
         for lo, hi in bands:
             right.plot([lo, hi], [k, k], color=colour, linewidth=7, solid_capstyle="butt")
         top = NYQUIST_MARGIN * rate
@@ -304,12 +315,13 @@ def capacity_figure(results, path):
         right.annotate(f"{len(bands)}", (bands[-1][1] if bands else top, k), xytext=(4, -4),
                        textcoords="offset points", fontsize=9)
     left.set(xlabel="max force per taxel [N]", ylabel="taxels on one microphone",
-             title="design --taxels: rigid walls, Eq. 5 rise", ylim=(0, None))
-    left.legend(fontsize=7)
+             title="design --taxels, rigid walls, Eq. 5 rise\n(filled: the plate stays flat; hollow: it bends)",
+             ylim=(0, None))
+    left.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12))
     left.grid(True, alpha=0.3)
     ticks = [1e3, 2e3, 5e3, 1e4, 2e4, 5e4]
     right.set(xscale="log", xlabel="loaded band [Hz]", yticks=range(len(rows)),
-              yticklabels=[f"{r / 1e3:g} kHz\n{ROUTES[v]}" for r, v, _, _ in rows],
+              yticklabels=[f"{r / 1e3:g} kHz, {t:g} mm\n{ROUTES[v]}" for r, t, v, _, _, _ in rows],
               title=f"loaded bands to {first:g} N (black: 0.45 fs, the microphone's top)")
     right.set_xticks(ticks, [f"{t / 1e3:g} k" for t in ticks])  # after the log scale, which resets them
     right.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
