@@ -41,19 +41,25 @@ def window_samples(fs: float) -> int:
     return max(64, int(2 ** round(np.log2(WINDOW_S * fs))))
 
 
+def bin_hz(sample_rate_hz: float) -> float:
+    """Width (Hz) of one bin of the tracker's zero-padded spectrum at ``sample_rate_hz`` (Hz): fs / (ZERO_PAD ·
+    window). 5.38 Hz at 44.1 kHz (window 4096), 5.86 Hz at 96 kHz (8192)."""
+    return sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
+
+
 def guard_hz(sample_rate_hz: float) -> float:
     """Least gap between two taxels' bands (Hz) for the loop (:mod:`matcad.loop.analyze`) to keep them apart: a
     tone at one band's edge spreads its Hann main lobe over ±EXCLUDE_BINS bins, and a ridge within EDGE_BINS bins
     of a band's edge is refused as hugging it; so the gap is (EXCLUDE_BINS + EDGE_BINS) bins of the tracker's
     zero-padded spectrum, fs / (ZERO_PAD · window). 43 Hz at 44.1 kHz (window 4096, 5.4 Hz bins)."""
-    return (EXCLUDE_BINS + EDGE_BINS) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
+    return (EXCLUDE_BINS + EDGE_BINS) * bin_hz(sample_rate_hz)
 
 
 def edge_zone_hz(sample_rate_hz: float) -> float:
     """Width (Hz) of the zone inside a band's edge where the board loop takes a ridge as the tone leaving the band
     (:func:`matcad.loop.board.off_edge`): EDGE_BINS + 1 bins of the tracker's spectrum. 16.2 Hz at 44.1 kHz, 17.6 Hz
     at 96 kHz."""
-    return (EDGE_BINS + 1) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
+    return (EDGE_BINS + 1) * bin_hz(sample_rate_hz)
 
 
 def loaded_listening_band(loaded_hz: tuple[float, float], sample_rate_hz: float) -> tuple[float, float]:
@@ -66,7 +72,7 @@ def loaded_listening_band(loaded_hz: tuple[float, float], sample_rate_hz: float)
     bins from its neighbour's listening band, at the first null of its Hann main lobe (±4 bins at 2× padding).
     (A band of exactly the loaded one left a rest pitch in its bottom 17.6 Hz unread at 96 kHz: the 16-taxel 1/8 in
     board's t2, 15 Hz above its band's edge, lost 107 of 139 frames.)"""
-    edge = edge_zone_hz(sample_rate_hz) * (EDGE_BINS + 2) / (EDGE_BINS + 1)
+    edge = edge_zone_hz(sample_rate_hz) + bin_hz(sample_rate_hz)
     return loaded_hz[0] - edge, loaded_hz[1] + edge
 
 
@@ -75,7 +81,7 @@ def trackable(band_hz: tuple[float, float], sample_rate_hz: float) -> tuple[floa
     at ``sample_rate_hz`` (Hz) when it is narrower (the extra bin: a band off the bin grid still holds
     BAND_BINS bins); else as it is. A board taxel's loaded band, anchored to a tight calibration under a light
     touch, can be narrower than the tracker needs (75 Hz at templates/mat-array-4.toml's 1 N; 81 Hz at 44.1 kHz)."""
-    width = (BAND_BINS + 1) * sample_rate_hz / (ZERO_PAD * window_samples(sample_rate_hz))
+    width = (BAND_BINS + 1) * bin_hz(sample_rate_hz)
     low, high = band_hz
     grow = max(0.0, width - (high - low)) / 2
     return low - grow, high + grow

@@ -92,3 +92,9 @@ def mat_strouhal_ratio(f_hz: float, neck_diameter_mm: float, flow_l_min: float, 
     """A MAT taxel's St over the paper's (:data:`PAPER_JET`): 1 at the paper's operating point; St ∝ f d D² / Q,
     so the ratio is free of the bore-or-outside question (:func:`needle_jet_speed_m_s`)."""
     return mat_strouhal(f_hz, neck_diameter_mm, flow_l_min, needle_diameter_mm) / mat_strouhal(**PAPER_JET)
+
+
+def matched_flow_l_min(f_hz: float, neck_diameter_mm: float, flow_l_min: float, needle_diameter_mm: float) -> float:
+    """The flow (L/min) that puts a MAT taxel's jet at the paper's operating point, from its flow now: St ∝ 1/Q, so
+    ``flow_l_min`` times :func:`mat_strouhal_ratio`."""
+    return flow_l_min * mat_strouhal_ratio(f_hz, neck_diameter_mm, flow_l_min, needle_diameter_mm)

@@ -185,15 +185,13 @@ def array_spec(base, points, solutions, name: str):
 
 
 def matched_flow_l_min(spec, f0_hz: float) -> float:
-    """The needle flow (L/min, to 0.01) that puts a solved single taxel's jet at the paper's operating point
-    (``jet.strouhal``, :func:`matcad.acoustics.edgetone.mat_strouhal_ratio`: St ∝ f d D² / Q) at its predicted
-    ``f0_hz`` (Hz); a board's taxels span several kHz, and one shared flow leaves the lowest and highest outside the
-    window."""
-    from matcad.acoustics.edgetone import mat_strouhal_ratio
+    """The needle flow (L/min, to 0.01) that puts a solved single taxel's jet at the paper's operating point at its
+    predicted ``f0_hz`` (Hz; ``jet.strouhal``, :func:`matcad.acoustics.edgetone.matched_flow_l_min`); a board's
+    taxels span several kHz, and one shared flow leaves the lowest and highest outside the window."""
+    from matcad.acoustics.edgetone import matched_flow_l_min as matched
 
     needle = spec.needle
-    ratio = mat_strouhal_ratio(f0_hz, spec.neck.diameter, needle.flow_l_min, needle.outer_diameter)
-    return round(needle.flow_l_min * ratio, 2)
+    return round(matched(f0_hz, spec.neck.diameter, needle.flow_l_min, needle.outer_diameter), 2)
 
 
 def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = None,
@@ -203,7 +201,7 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     ``progress(taxels placed, n)`` (:mod:`matcad.progress`) is told as each is placed. Raises
     :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
     from matcad.listening import guard_hz
-    from matcad.rules import check
+    from matcad.rules import check, errors
     from matcad.spec import MAX_TAXELS, taxel_spec, taxels
 
     start_time = time.perf_counter()
@@ -229,15 +227,15 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
     if any(f.id == "plate.bending" for f in findings) and not out.plate.support_posts:  # posts hold it flat
         posted = _with_posts(out)
         with_posts = check(posted)
-        pitch = None if _fits(with_posts) else post_pitch(single, n, vary, solutions, name)
+        pitch = post_pitch(single, n, vary, solutions, name) if errors(with_posts) else None
         if pitch is not None:  # no room for posts between the rows: the rows spread until there is, solved again
             spread, points = board_base(single, n, vary, pitch)
             spread_placed, spread_solutions = _place(spread, n, lo_hz, hi_hz, vary, guard, None)
             posted = _with_posts(array_spec(spread, points, spread_solutions, name))
             with_posts = check(posted)
-            if _fits(with_posts):
+            if not errors(with_posts):
                 placed, solutions = spread_placed, spread_solutions
-        if _fits(with_posts):  # posts that do not fit leave the board as it was
+        if not errors(with_posts):  # posts that do not fit leave the board as it was
             out, findings = posted, with_posts
     broken = [f for f in findings if f.level == "error" or f.id == "board.jet"]
     if broken:  # board.jet cannot fire on the stagger (stagger_pitch): checked on the solved necks all the same
@@ -312,11 +310,6 @@ def _place(base, n: int, lo_hz: float, hi_hz: float, vary, guard: float, progres
 def _with_posts(spec):
     """``spec`` with support posts under its plate (plate.support_posts)."""
     return dataclasses.replace(spec, plate=dataclasses.replace(spec.plate, support_posts=True))
-
-
-def _fits(findings) -> bool:
-    """No design-rule error among ``findings``."""
-    return not any(f.level == "error" for f in findings)
 
 
 def post_pitch(single, n: int, vary, solutions, name: str) -> tuple[float, float] | None:

@@ -28,13 +28,10 @@ def jet_strouhal(spec, p) -> list[Finding]:
     (too fast a jet for the pitch: it may overblow; too slow: it may not speak), and a warning when the jet that
     would match the paper's point passes Mach :data:`~matcad.acoustics.edgetone.MACH_LIMIT` (the limit of the
     picture, reached when f d > 0.3 c St_paper). Each names the flow that matches the paper's point."""
-    from matcad.acoustics.air import speed_of_sound_m_s
-
-    needle, d = spec.needle, spec.neck.diameter
-    c = spec.air.speed_of_sound or float(speed_of_sound_m_s(spec.air.temperature_c))
+    needle, d, c = spec.needle, spec.neck.diameter, p.speed_of_sound_m_s
     ratio, u_matched, fast_jet, outside = limits(p.f0_hz, d, needle.flow_l_min, needle.outer_diameter, c)
     u = edgetone.needle_jet_speed_m_s(needle.flow_l_min, needle.outer_diameter)
-    matched = needle.flow_l_min * ratio
+    matched = edgetone.matched_flow_l_min(p.f0_hz, d, needle.flow_l_min, needle.outer_diameter)
     lo, hi = edgetone.MAT_ST_SPAN
     where = (f"jet {u:.1f} m/s at {needle.flow_l_min:g} L/min through the {needle.outer_diameter:g} mm needle across "
              f"the {d:g} mm neck at {p.f0_hz:.0f} Hz: St {ratio:.2f} x the paper's operating point (4.0 kHz, "
