@@ -127,7 +127,7 @@ class Canvas:
         its PNG writer alone, where ``format="PNG"`` loads four other formats' plugins first (BMP, GIF, JPEG, PPM;
         ~10 ms)."""
         png = str(path).lower().endswith(".png")
-        self.image.save(path, format=None if png else "PNG", compress_level=3)  # 2x faster than 6, 7 % larger
+        self.image.save(path, format=None if png else "PNG", compress_level=1)  # 3x faster than 6, 10 % larger
 
 
 class Axes:

@@ -62,10 +62,10 @@ def _install_signal_handlers() -> dict:
 def _private_caches() -> None:
     """Libraries' caches (ezdxf's font cache, matplotlib's config and font list) default to folders under
     $HOME; unless the user chose them, point them at a private folder in the temporary directory."""
-    import tempfile
-
     if all(os.environ.get(v) for v in ("XDG_CACHE_HOME", "MPLCONFIGDIR")):
         return
+    import tempfile
+
     folder = Path(tempfile.gettempdir()) / f"matcad-cache-{os.getuid() if hasattr(os, 'getuid') else 0}"
     try:
         folder.mkdir(mode=0o700, exist_ok=True)

@@ -3,6 +3,8 @@ spectrogram drawn without matplotlib still shows the track where it is (pixels r
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -108,7 +110,8 @@ def test_analyze_loads_neither_matplotlib_nor_scipy_ndimage(tmp_path):
     """`analyze --band` in a fresh interpreter, twice into one folder: the spectrogram is written and neither the
     plotting stack nor scipy.ndimage (nor the spec package: --band needs no spec) is loaded, nor Pillow's other
     image formats (the PNG is saved by its name), nor subprocess (the second run swaps the folders through the C
-    library already loaded, not ctypes.util.find_library) (issue 25: analyze near its tracker)."""
+    library already loaded, not ctypes.util.find_library), nor numpy.ma (numpy's median and percentile load it:
+    matcad.loop.stats) (issue 25: analyze near its tracker)."""
     import subprocess
     import sys
     import wave
@@ -123,8 +126,8 @@ def test_analyze_loads_neither_matplotlib_nor_scipy_ndimage(tmp_path):
         w.writeframes(np.round(0.3 * np.sin(2 * np.pi * 4700 * t) * 30000).astype("<i2").tobytes())
     code = ("import sys; from matcad.cli import main; argv = ['analyze', %r, '--band', '3900', '5600', '--out', %r];"
             " assert main(argv) == 0 and main(argv) == 0; bad = [m for m in ('matplotlib', 'scipy.ndimage', "
-            "'matcad.spec', 'PIL.JpegImagePlugin', 'PIL.GifImagePlugin', 'subprocess') if m in sys.modules];"
-            " assert not bad, bad" % (str(rec), str(tmp_path / "a")))
+            "'matcad.spec', 'PIL.JpegImagePlugin', 'PIL.GifImagePlugin', 'subprocess', 'numpy.ma') if m in "
+            "sys.modules]; assert not bad, bad" % (str(rec), str(tmp_path / "a")))
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "a" / "spectrogram.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -155,3 +158,24 @@ def test_dxf_writer_writes_ezdxfs_bytes(template, tmp_path):
         assert (tmp_path / "fast.dxf").read_bytes() == (tmp_path / "ezdxf.dxf").read_bytes(), plan.flat.name
     with_hole = next(p for p in plans if p.circles)
     assert dxf_template(with_hole, tmp_path) == TEMPLATE.read_text(encoding="utf-8")
+
+
+def test_loop_median_and_percentile_are_numpys():
+    """matcad.loop.stats against numpy's median, percentile (its default, linear method) and nanmedian along rows on
+    random arrays of 1-80 values over seven decades, odd and even counts, NaN included (rows of NaN only too): the
+    same numbers, bit for bit."""
+    from matcad.loop.stats import median, nanmedian_rows, percentile
+
+    rng = np.random.default_rng(3)
+    for n in range(1, 81):
+        x = rng.standard_normal(n) * 10 ** rng.uniform(-3, 4)
+        if n % 7 == 0:
+            x[rng.integers(n)] = np.nan
+        assert np.array_equal(median(x), np.median(x), equal_nan=True)
+        for q in (0, 5, 37.3, 100, [10, 50, 90]):
+            assert np.array_equal(percentile(x, q), np.percentile(x, q), equal_nan=True)
+        rows = rng.standard_normal((5, n)) * 10 ** rng.uniform(-3, 4)
+        rows[rng.uniform(size=rows.shape) < n / 80] = np.nan
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # numpy's "All-NaN slice"
+            assert np.array_equal(nanmedian_rows(rows), np.nanmedian(rows, axis=1), equal_nan=True)

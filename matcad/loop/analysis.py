@@ -18,6 +18,7 @@ from matcad.errors import LoopError
 from matcad.loop import crossing
 from matcad.loop.segments import Segment
 from matcad.loop.spectrum import BandBins, levels
+from matcad.loop.stats import median
 from matcad.loop.voicing import (MIN_RUN, MIN_RUN_HARMONIC, STABLE_BINS, STRONG_DB, STRONG_RUN, WEAK_DB,
                                  longest_run)
 
@@ -213,9 +214,9 @@ def conclude(frames: Frames, bins: BandBins, duration_s: float, loudest: str = "
     unassigned = _unassigned(sources, other_excess[voiced], other_level[voiced])
     prom = np.where(np.isfinite(other_level[voiced]), -other_level[voiced], excess[voiced])
     plot_times, plot_db = plot
-    return Analysis(mean_hz=float(np.mean(track[voiced])), median_hz=float(np.median(track[voiced])),
-                    std_hz=float(np.std(track[voiced])), snr_db=float(np.median(excess[voiced])),
-                    prominence_db=float(np.median(prom)), tone_fraction=float(np.mean(voiced)),
+    return Analysis(mean_hz=float(np.mean(track[voiced])), median_hz=float(median(track[voiced])),
+                    std_hz=float(np.std(track[voiced])), snr_db=float(median(excess[voiced])),
+                    prominence_db=float(median(prom)), tone_fraction=float(np.mean(voiced)),
                     band_hz=(lo, hi), sample_rate_hz=bins.fs, duration_s=duration_s, times_s=times,
                     track_hz=track, frame_snr_db=excess, voiced=voiced, segments=tuple(segments),
                     sources=tuple(sources), plot_times_s=plot_times, plot_freqs_hz=band_freqs, plot_db=plot_db,
@@ -245,11 +246,11 @@ def second_sources(other_bin, other_excess, other_level, band_freqs) -> list[Sou
     if np.mean(present) < SECOND_SOURCE_FRACTION:
         return []
     bins = other_bin[present]
-    centre = np.median(bins)
+    centre = median(bins)
     close = np.abs(bins - centre) <= 3 * STABLE_BINS
     if np.sum(close) < SECOND_SOURCE_FRACTION * len(other_bin):
         return []
-    rel = float(np.median(other_level[present][close]))
+    rel = float(median(other_level[present][close]))
     return [Source(float(band_freqs[int(round(centre))]), rel, float(np.sum(close) / len(other_bin)))]
 
 

@@ -35,6 +35,7 @@ import numpy as np
 from matcad.errors import LoopError
 from matcad.listening import EDGE_BINS, HARMONICS, trackable
 from matcad.loop.segments import STEP_HZ
+from matcad.loop.stats import median
 from matcad.loop.voicing import MIN_RUN_HARMONIC, WEAK_DB
 from matcad.loop.analysis import Analysis
 from matcad.loop.analyze import run_trackers
@@ -172,7 +173,7 @@ def discount_harmonics(tracks, harmonics=HARMONICS) -> list[TaxelTrack]:
         warning = (f"{int(on.sum())} frames of {t.name} lie on {', '.join(which)}, predicted from that taxel's "
                    "tone: left out (a harmonic, or the taxel's own tone where the two coincide)")
         out.append(TaxelTrack(t.name, t.band_hz, replace(
-            a, mean_hz=float(np.mean(f)), median_hz=float(np.median(f)), std_hz=float(np.std(f)),
+            a, mean_hz=float(np.mean(f)), median_hz=float(median(f)), std_hz=float(np.std(f)),
             tone_fraction=float(np.mean(voiced)), voiced=voiced, segments=segments,
             warnings=(*a.warnings, warning))))
     return out
@@ -203,12 +204,12 @@ def off_edge(name: str, a: Analysis) -> Analysis:
     segments = tuple(replace(s, flag=s.flag or flag) if min(s.mean_hz - lo, hi - s.mean_hz) <= near else s
                      for s in a.segments)
     times = a.times_s[left]
-    side = "top" if np.median(a.track_hz[left]) > 0.5 * (lo + hi) else "bottom"
+    side = "top" if median(a.track_hz[left]) > 0.5 * (lo + hi) else "bottom"
     warning = (f"{name}'s tone reached its band's {side} edge ({hi if side == 'top' else lo:.0f} Hz) in "
                f"{int(left.sum())} frames between {times[0]:.2f} and {times[-1]:.2f} s: it left its band (pressed "
                "beyond the band's force range, or the band is wrong); those frames are left out")
     f = a.track_hz[voiced]
-    return replace(a, mean_hz=float(np.mean(f)), median_hz=float(np.median(f)), std_hz=float(np.std(f)),
+    return replace(a, mean_hz=float(np.mean(f)), median_hz=float(median(f)), std_hz=float(np.std(f)),
                    tone_fraction=float(np.mean(voiced)), voiced=voiced, segments=segments,
                    warnings=(*a.warnings, warning))
 
@@ -237,7 +238,7 @@ def room_tails(a: Analysis) -> Analysis:
     if not np.any(out) or not np.any(voiced):
         return a
     g = a.track_hz[voiced]
-    return replace(a, mean_hz=float(np.mean(g)), median_hz=float(np.median(g)), std_hz=float(np.std(g)),
+    return replace(a, mean_hz=float(np.mean(g)), median_hz=float(median(g)), std_hz=float(np.std(g)),
                    tone_fraction=float(np.mean(voiced)), voiced=voiced)
 
 
@@ -252,7 +253,7 @@ def tail_before(f, e, voiced, i: int, j: int, out) -> None:
     ref = lo + np.flatnonzero(voiced[lo:max(lo, i - TAIL_FRAMES + 1)])
     if len(ref) < 3:
         return
-    level = float(np.median(e[ref]))
+    level = float(median(e[ref]))
     for k in range(i, max(-1, i - TAIL_FRAMES), -1):
         if not voiced[k] or abs(f[k] - f[i]) > STEP_HZ or e[k] > level - TAIL_DB:
             break
@@ -324,7 +325,7 @@ def dropouts(name: str, a: Analysis) -> list[str]:
         if len(before) < MIN_RUN_HARMONIC or len(after) < MIN_RUN_HARMONIC or before[0] < i - 2 * MIN_RUN_HARMONIC \
                 or after[-1] > j + 2 * MIN_RUN_HARMONIC:
             continue
-        f0, f1 = np.median(a.track_hz[before]), np.median(a.track_hz[after])
+        f0, f1 = median(a.track_hz[before]), median(a.track_hz[after])
         steady = before[a.voiced[before]]  # a press ramps the voiced pitch; a blend frame on the line may not
         if abs(f1 - f0) <= STEP_HZ and len(steady) and np.ptp(a.track_hz[steady]) <= 2 * STEP_HZ:
             out.append(f"{name}'s tone stopped abruptly at {a.times_s[i]:.2f} s from a steady {f0:.0f} Hz and came "

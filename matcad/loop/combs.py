@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from matcad.loop.stats import nanmedian_rows
+
 COMB_SPACINGS_HZ = (50.0, 60.0, 100.0, 120.0)
 COMB_LEVEL_DB = 10.0
 COMB_GRID_FRACTION = 0.6
@@ -41,7 +43,7 @@ def mains_comb(lines: np.ndarray, freqs: np.ndarray, df: float) -> np.ndarray:
         comb = np.mean(ok, axis=1) >= COMB_GRID_FRACTION
         if not np.any(comb):
             continue
-        level = np.nanmedian(np.where(ok, hosted, np.nan)[comb], axis=1)
+        level = nanmedian_rows(np.where(ok, hosted, np.nan)[comb])
         on_grid = np.zeros(lines.shape[1], dtype=bool)
         on_grid[np.concatenate([grid - 1, grid, grid + 1])] = True
         members[comb] |= on_grid[None, :] & np.isfinite(lines[comb]) & (lines[comb] < level[:, None] + COMB_LEVEL_DB)

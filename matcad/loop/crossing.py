@@ -38,6 +38,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from matcad.loop.segments import Segment, steady_segments
+from matcad.loop.stats import median
 from matcad.loop.voicing import MIN_RUN, WEAK_DB
 
 COMPARABLE_DB = 10.0
@@ -113,7 +114,7 @@ def follow_taxel(times, track, state, other_bin, other_excess, other_level, exce
         before, after = before[tone[before]], after[tone[after]]
         meet = voiced[k0:k1 + 1]
         t_meet = float(times[meet[len(meet) // 2]])
-        f_meet = float(np.median(track[meet]))
+        f_meet = float(median(track[meet]))
         was_b = bool(on_b[meet[0] - 1])
         pick, why = _decide(times, line_a, line_b, level_ba, was_b, before, after)
         if pick is None:
@@ -251,8 +252,8 @@ def _decide(times, line_a, line_b, level_ba, was_b, before, after):
     if abs(to_a - to_b) >= SLOPE_CLEAR_HZ_S:
         motion = "kept moving" if abs(s_taxel) > abs(s_rest) else "stayed steady"
         return to_b < to_a, f"{motion} ({s_taxel:+.0f} Hz/s before the crossing)"
-    level_b = float(np.median(level_ba[before])) * (-1 if was_b else 1)  # the rest minus the taxel, before
-    level_a = float(np.median(level_ba[after]))  # B minus A, after
+    level_b = float(median(level_ba[before])) * (-1 if was_b else 1)  # the rest minus the taxel, before
+    level_a = float(median(level_ba[after]))  # B minus A, after
     if abs(level_b) >= LEVEL_CLEAR_DB and abs(level_a) >= LEVEL_CLEAR_DB:
         return (level_a < 0) == (level_b > 0), (f"was {abs(level_b):.1f} dB {'weaker' if level_b > 0 else 'louder'} "
                                                 "than the other")

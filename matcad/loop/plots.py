@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from matcad.loop.stats import median, percentile
+
 PLOT_COLUMNS = 1200
 SPECTROGRAM_PX = (800, 320)
 """Width of the spectrogram picture and height of each of its panels (px)."""
@@ -71,7 +73,7 @@ def plot(analysis, path, forces=None) -> None:
     db = analysis.plot_db
     freqs = analysis.plot_freqs_hz
     ax = canvas.axes((left, top, right, bottom), xlim, (float(freqs[0]), float(freqs[-1])))
-    ax.image(colour_map(db[::-1], float(np.percentile(db, 5)), float(db.max())),
+    ax.image(colour_map(db[::-1], float(percentile(db, 5)), float(db.max())),
              (float(t[0]), float(t[-1]), float(freqs[0]), float(freqs[-1])) if len(t) > 1 else None)
     ax.line(analysis.times_s, np.where(analysis.voiced, analysis.track_hz, np.nan), "cyan", 1)
     for s in analysis.segments:
@@ -114,7 +116,7 @@ def _windowed(times, values, edges):
     for k in range(len(edges) - 1):
         v = values[(which == k) & np.isfinite(values)]
         if len(v):
-            out[k] = np.percentile(v, [10, 50, 90])
+            out[k] = percentile(v, [10, 50, 90])
     return out
 
 
@@ -132,7 +134,7 @@ def overview(canvas, box, analysis, force=None):
     _interval(ax, mids, hz[:, 0], hz[:, 2], "#c5d7ec")
     ax.line(mids, hz[:, 1], "#1f4e8c", 1)
     means = np.array([s.mean_hz for s in analysis.segments])
-    summary = (f"{len(means)} segments, means {means.min():.0f}-{means.max():.0f} Hz (median {np.median(means):.0f})"
+    summary = (f"{len(means)} segments, means {means.min():.0f}-{means.max():.0f} Hz (median {median(means):.0f})"
                if len(means) else "no steady segment")
     legend = [("median voiced frequency (10-90 %)", "#1f4e8c", "line")]
     fx = None
@@ -149,7 +151,7 @@ def overview(canvas, box, analysis, force=None):
         finite = np.asarray(force, dtype=float)
         finite = finite[np.isfinite(finite)]
         if len(finite):
-            summary += f"; force {finite.min():.2f}-{finite.max():.2f} N (median {np.median(finite):.2f})"
+            summary += f"; force {finite.min():.2f}-{finite.max():.2f} N (median {median(finite):.2f})"
         legend.append(("median force [N], right axis", "#c0392b", "line"))
     title = f"overview of {times[-1]:.0f} s: {summary}"
     ax.frame(ylabel="frequency [Hz]", grid="y", size=10, title=title)
@@ -169,7 +171,7 @@ def plot_board(tracks, path, readings=None) -> None:
     box = (85, 35, width - 15, panel - 5)
     present = [t for t in tracks if t.analysis is not None]
     levels = np.concatenate([t.analysis.plot_db.ravel() for t in present]) if present else np.zeros(1)
-    vmin, vmax = float(np.percentile(levels, 5)), float(levels.max())
+    vmin, vmax = float(percentile(levels, 5)), float(levels.max())
     times = np.concatenate([t.analysis.plot_times_s for t in present]) if present else np.array([0.0, 1.0])
     xlim = (0.0, max(float(times.max()), 1e-3))  # the recording starts at 0 s
     lo, hi = min(t.band_hz[0] for t in tracks), max(t.band_hz[1] for t in tracks)

@@ -16,6 +16,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from matcad.loop.stats import median
+
 STEP_HZ = 12.0
 """Frame-to-frame change that ends a steady segment (a ±20 Hz wobble over 2.5 s moves ≤ 2.5 Hz per frame; a
 2→12 N press ramped in 0.2 s moves ~60 Hz per frame)."""
@@ -137,9 +139,9 @@ def _trimmed(track, piece) -> list[int]:
     if len(piece) < 2 * MIN_SEGMENT_FRAMES:
         return piece
     f = track[piece]
-    jitter = 1.4826 * float(np.median(np.abs(np.diff(f) - np.median(np.diff(f))))) / np.sqrt(2.0)
+    jitter = 1.4826 * float(median(np.abs(np.diff(f) - median(np.diff(f))))) / np.sqrt(2.0)
     tol = max(TRIM_SD * jitter, TRIM_MIN_HZ)
-    keep = np.flatnonzero(np.abs(f - np.median(f)) <= tol)
+    keep = np.flatnonzero(np.abs(f - median(f)) <= tol)
     return piece[keep[0]:keep[-1] + 1] if len(keep) else []
 
 
@@ -173,7 +175,7 @@ def steady_segments(times, track, state) -> list[Segment]:
         runs.append(cur)
     runs = [run for k, run in enumerate(runs) if not _passage(track, runs, k)]
     runs = [piece for run in runs for piece in _untrended(times, track, run)]
-    reference = float(np.median(track[state >= 1]))
+    reference = float(median(track[state >= 1]))
     out, last = [], None
     for run in runs:
         if len(run) < MIN_SEGMENT_FRAMES:
@@ -196,6 +198,6 @@ def steady_segments(times, track, state) -> list[Segment]:
         elif far and last is not None and last[2] and max(mean / last[0], last[0] / mean) <= MODE_JUMP_RATIO:
             flag = last[2]  # the same jumped mode, after a dropout
         last = (mean, run[-1], flag)
-        out.append(Segment(float(times[run[0]]), float(times[run[-1]]), len(run), mean, float(np.median(f)),
+        out.append(Segment(float(times[run[0]]), float(times[run[-1]]), len(run), mean, float(median(f)),
                            float(np.std(f)), flag))
     return out
