@@ -221,4 +221,56 @@ def _support_text(spec, pressed: str) -> str:
             f"{ACRYLIC_MODULUS_MPA:g} MPa; Roark Table 8.1 cases 1e and 1a")
 
 
+def deflection_under_taxel_mm(spec) -> float:
+    """What :func:`plate_bending` reads of a one-taxel spec beyond its acoustic design: the plate's deflection under
+    the taxel pressed with mechanics.max_force_n (mm; 0 without a force, where the rule reads nothing more). A
+    sweep memoises it (:mod:`matcad.sweep.memo`: once per combination of the plate's varied fields) and judges the
+    rest on arrays (:func:`bending_warnings`)."""
+    if spec.mechanics.max_force_n <= 0:
+        return 0.0
+    return float(deflections(spec)[1][0, 0])
+
+
+def bending_warnings(d, deflection_mm, force_n, sample_rate_hz, shift_hz) -> np.ndarray:
+    """:func:`plate_bending` on arrays of one-taxel variants (a sweep's): 1 where it warns, else 0. ``d``: the
+    variants' :class:`matcad.acoustics.design.Design` of arrays; ``deflection_mm``, ``force_n``, ``sample_rate_hz``:
+    per variant (:func:`deflection_under_taxel_mm`); ``shift_hz(rows)``: the pitch change of the variants at index
+    ``rows`` with the gap narrowed by their deflection (:func:`pitch_shift_hz`), asked only where
+    :func:`shift_bound_hz`'s bound passes the limit, as the rule does. The same tests, in the same arithmetic."""
+    from matcad.acoustics.models import mouth_end_correction_mm
+
+    gap, w = np.asarray(d.gap_mm, dtype=float), np.asarray(deflection_mm, dtype=float)
+    rates, which = np.unique(np.asarray(sample_rate_hz, dtype=float), return_inverse=True)
+    limit = np.array([BENDING_GUARD_SHARE * guard_hz(float(r)) for r in rates])[which.reshape(-1)]
+    open_ = w < gap
+    with np.errstate(invalid="ignore", divide="ignore"):  # a closed gap (not open_) has no bound: never read
+        built = mouth_end_correction_mm(d.mouth, d.neck_diameter / 2, gap, d.gap_radius_mm)
+        bent = mouth_end_correction_mm(d.mouth, d.neck_diameter / 2, np.where(open_, gap - w, gap), d.gap_radius_mm)
+        bound = sample_rate_hz * (bent - built) / (d.neck_length + built)
+    rows = np.flatnonzero(open_ & (bound > limit) & (np.asarray(force_n) > 0))
+    moved = np.zeros(len(gap), dtype=bool)
+    if rows.size:
+        moved[rows] = np.abs(shift_hz(rows)) > limit[rows]
+    return ((np.asarray(force_n) > 0) & (~open_ | moved)).astype(np.int64)
+
+
+def pitch_shift_hz(d, deflection_mm, wall_model: str):
+    """f0 with the mount gap narrowed by ``deflection_mm`` minus f0 as built (Hz), by the model `predict` chooses
+    for ``wall_model`` (:data:`matcad.acoustics.registry.CHOSEN`), on a Design of arrays of variants (each entry the
+    arithmetic of :func:`bendings` on that variant)."""
+    from matcad.acoustics import registry
+    from matcad.acoustics.resonator import resonator
+
+    model = registry.model(registry.CHOSEN[wall_model])
+
+    def f0(gap):
+        return np.asarray(model.f0_hz(resonator(d.replace(gap_mm=gap)), d.wall), dtype=float)
+
+    return f0(np.asarray(d.gap_mm, dtype=float) - deflection_mm) - f0(np.asarray(d.gap_mm, dtype=float))
+
+
 RULES = (plate_bending, support_posts)
+ARRAY_RULES = {plate_bending: deflection_under_taxel_mm}
+"""Of :data:`RULES`, those a sweep of one-taxel variants judges on arrays (:func:`bending_warnings`) rather than
+once per combination of the fields they read (plate.bending reads the whole acoustic design wherever the plate
+bends, so once per variant), each with the function of the spec the sweep memoises for it."""

@@ -3,7 +3,8 @@
 Adding a rule is one function in a module's ``RULES`` tuple; adding a rule module is that module and one entry
 here (docs/extending.md). A module of :data:`SPEC_MODULES` may also name, in ``TAXEL_RULES``, those of its
 ``RULES`` that read one taxel's own geometry: a board runs them on each taxel instead of on the whole spec; and in
-``INFO_RULES`` those that only inform (never an error or a warning), which a sweep's verdict columns skip.
+``INFO_RULES`` those that only inform (never an error or a warning), which a sweep's verdict columns skip; and in
+``ARRAY_RULES`` those a sweep judges on arrays of variants, each with the function of the spec it memoises for it.
 """
 
 from __future__ import annotations

@@ -9,7 +9,8 @@ slope, chunk by chunk of the grid. Every number is the one `matcad predict` / `m
   geometry fields.
 - Design rules of the spec (:data:`matcad.rules.registry.SPEC_MODULES`) run through :class:`matcad.sweep.memo.Memo`:
   once per combination of the varied fields each rule reads (exact: see memo.py). The sound rules
-  (:mod:`matcad.rules.acoustic`) are arithmetic on the predicted band and warnings, evaluated on the arrays.
+  (:mod:`matcad.rules.acoustic`, :mod:`matcad.rules.jet`) are arithmetic on the predicted band and warnings,
+  evaluated on the arrays; so is a module's ``ARRAY_RULES`` (plate.bending) from its memoised input.
 - A spec of several taxels, with a [reference], or a per-variant model (fem, relative) takes the per-variant path
   of :mod:`matcad.sweep.run`.
 """
@@ -110,27 +111,34 @@ def eligible(base, model: str) -> bool:
     return model in fast.VECTORISED and base.reference is None and not base.taxel and len(taxels(base)) == 1
 
 
-def _by_combination(chunk: GridChunk, axes: tuple[int, ...], positions, function) -> np.ndarray:
+def _by_combination(chunk: GridChunk, axes: tuple[int, ...], positions, function, seen: dict) -> np.ndarray:
     """``function(j)`` once per combination of the values on ``axes`` among ``positions`` (j: the first variant
-    with it), given to every variant with that combination: an object array."""
+    with it), given to every variant with that combination: an object array. ``seen`` keeps the results by
+    (axes, combination) across the grid's chunks (its codes are the whole grid's): a combination met in an earlier
+    chunk is not asked again."""
     positions = np.asarray(positions, dtype=np.int64)
     out = np.empty(len(positions), dtype=object)
     if not len(positions):
         return out
     uniq, first, inverse = np.unique(chunk.codes(axes, positions), return_index=True, return_inverse=True)
     results = np.empty(len(uniq), dtype=object)
-    results[:] = [function(int(positions[f])) for f in first]
+    for k, (code, f) in enumerate(zip(uniq.tolist(), first.tolist())):
+        if (axes, code) not in seen:
+            seen[axes, code] = function(int(positions[f]))
+        results[k] = seen[axes, code]
     out[:] = results[inverse.reshape(-1)]
     return out
 
 
-def validate(chunk: GridChunk, base) -> np.ndarray:
-    """Each variant's validation message ('' where it validates), exactly as :func:`matcad.spec.from_dict`."""
+def validate(chunk: GridChunk, base, seen: dict | None = None) -> np.ndarray:
+    """Each variant's validation message ('' where it validates), exactly as :func:`matcad.spec.from_dict`;
+    ``seen``: the messages of the grid's earlier chunks (:func:`_by_combination`), filled in."""
     from matcad.spec import SECTIONS, SpecError
     from matcad.spec.checks import geometry_invalid
     from matcad.spec.fields import read_section
 
     n = len(chunk)
+    seen = {} if seen is None else seen
     reason = np.full(n, "", dtype=object)
     everyone = np.arange(n)
     for section, cls in SECTIONS.items():  # the first failing table in from_dict's order names the error
@@ -145,7 +153,7 @@ def validate(chunk: GridChunk, base) -> np.ndarray:
                 return str(exc)
             return ""
 
-        found = _by_combination(chunk, axes, everyone, read)
+        found = _by_combination(chunk, axes, everyone, read, seen.setdefault(section, {}))
         reason = np.where(reason == "", found, reason)
     g = {key: chunk.field(base, key) for key in GEOMETRY}
     tolerances = {key: (_schema_range(key)) for key in chunk.follows_cavity}
@@ -164,7 +172,7 @@ def validate(chunk: GridChunk, base) -> np.ndarray:
                 return str(exc)
             return ""
 
-        reason[ask] = _by_combination(chunk, geometry, ask, whole)
+        reason[ask] = _by_combination(chunk, geometry, ask, whole, seen.setdefault("", {}))
     return reason
 
 
@@ -198,6 +206,32 @@ def spec_rules():
     return [rule for module in SPEC_MODULES for rule in module.RULES if rule not in getattr(module, "INFO_RULES", ())]
 
 
+def _array_rules() -> dict:
+    """The spec rules judged on arrays (each module's ``ARRAY_RULES``): {rule: the function of the spec memoised
+    for it}."""
+    from matcad.rules.registry import SPEC_MODULES
+
+    return {rule: given for module in SPEC_MODULES for rule, given in getattr(module, "ARRAY_RULES", {}).items()}
+
+
+def _bending_column(chunk: GridChunk, base, memo: Memo, v: fast.Variants) -> np.ndarray:
+    """plate.bending's verdict column (:func:`matcad.rules.plate.bending_warnings`: 1 where it warns), or -(k + 1)
+    where its memoised input failed with outcome k."""
+    from matcad.rules import plate
+
+    numbers = memo.apply(chunk)
+    outcomes = memo.outcomes
+    failed = np.array([isinstance(o, tuple) for o in outcomes], dtype=bool)[numbers]
+    w = np.array([np.nan if isinstance(o, tuple) else o for o in outcomes], dtype=float)[numbers]
+
+    def shift_hz(rows):
+        return plate.pitch_shift_hz(v.take(rows).design(), w[rows], base.wall.model)
+
+    column = plate.bending_warnings(v.design(), np.where(failed, 0.0, w), chunk.field(base, "mechanics.max_force_n"),
+                                    chunk.field(base, "microphone.sample_rate_hz"), shift_hz)
+    return np.where(failed, -(numbers + 1), column)
+
+
 def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, model: str, f0, low, high,
                  failed_checks) -> dict:
     """rule_errors, rule_warnings, failing_rules (and status/reason where a rule raised) of the chunk's valid
@@ -207,7 +241,9 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, mo
     from matcad.rules import acoustic, jet
 
     n = len(chunk)
-    numbers = [memo.apply(chunk) for memo in memos]
+    rules, on_arrays = spec_rules(), _array_rules()
+    numbers = [_bending_column(chunk, base, memo, v) if rule in on_arrays else memo.apply(chunk)
+               for rule, memo in zip(rules, memos)]
     d = v.design()
     sound = acoustic.array_counts(chunk.field(base, "microphone.sample_rate_hz"),
                                   chunk.field(base, "microphone.floor_hz"), low, high,
@@ -220,8 +256,11 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, mo
     errors, warnings, failing, failed = [], [], [], []
     for combo in uniq:
         items, broken = [], ""
-        for memo, number in zip(memos, combo[:len(memos)]):
-            outcome = memo.outcomes[number]
+        for rule, memo, number in zip(rules, memos, combo[:len(memos)]):
+            if rule in on_arrays and number >= 0:
+                items += [("plate.bending", "warning")] * int(number)
+                continue
+            outcome = memo.outcomes[-number - 1 if rule in on_arrays else number]
             if isinstance(outcome, tuple) and outcome[:1] == ("failed",):
                 broken = broken or outcome[1]
                 continue
@@ -241,8 +280,11 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, mo
 
 
 def rule_memos() -> list[Memo]:
-    """One :class:`Memo` per spec rule, keeping the summary of its findings (id, level) at error and warning."""
-    return [Memo(lambda spec, rule=rule: _summary(rule(spec))) for rule in spec_rules()]
+    """One :class:`Memo` per spec rule, keeping the summary of its findings (id, level) at error and warning; for a
+    rule judged on arrays, its input (:func:`_array_rules`)."""
+    on_arrays = _array_rules()
+    return [Memo(on_arrays[rule]) if rule in on_arrays else Memo(lambda spec, rule=rule: _summary(rule(spec)))
+            for rule in spec_rules()]
 
 
 def slope_memo() -> Memo:
@@ -256,11 +298,12 @@ def slope_memo() -> Memo:
     return Memo(slope)
 
 
-def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo) -> dict:
+def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo, seen: dict | None = None) -> dict:
     """Every column of the chunk's variants: status, reason, f0_hz, band_low_hz, band_high_hz, model_valid,
-    df0/dfield per axis (keyed by field), the load slope, and the rule columns when ``rules``; arrays."""
+    df0/dfield per axis (keyed by field), the load slope, and the rule columns when ``rules``; arrays. ``seen``:
+    the grid's validation messages so far (:func:`validate`)."""
     n = len(chunk)
-    reason = validate(chunk, base)
+    reason = validate(chunk, base, seen)
     ok = np.flatnonzero(reason == "")
     out = {"status": np.where(reason == "", "ok", "invalid").astype(object), "reason": reason,
            "f0_hz": np.full(n, np.nan), "band_low_hz": np.full(n, np.nan), "band_high_hz": np.full(n, np.nan),

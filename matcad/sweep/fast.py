@@ -52,6 +52,12 @@ class Variants:
         making = Making(m.neck_drilled[start:stop], m.sheet_measured[start:stop], m.printer[start:stop])
         return Variants({k: x[start:stop] for k, x in self.values.items()}, self.mouth, self.wall, making)
 
+    def take(self, rows) -> Variants:
+        """The variants at index ``rows``."""
+        m = self.making
+        making = Making(m.neck_drilled[rows], m.sheet_measured[rows], m.printer[rows])
+        return Variants({k: x[rows] for k, x in self.values.items()}, self.mouth, self.wall, making)
+
     def with_value(self, field: str, array) -> Variants:
         return Variants({**self.values, field: np.asarray(array, dtype=float)}, self.mouth, self.wall, self.making)
 

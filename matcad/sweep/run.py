@@ -228,7 +228,7 @@ def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, s
 
 
 _MEMOS: dict = {}
-"""This process's memos of the sweep it is working on: {sweep key: (rule memos, slope memo)}."""
+"""This process's memos of the sweep it is working on: {sweep key: (rule memos, slope memo, validation messages)}."""
 
 
 def array_chunks(tasks: list[dict]) -> list[dict]:
@@ -238,12 +238,12 @@ def array_chunks(tasks: list[dict]) -> list[dict]:
     for task in tasks:
         if task["key"] not in _MEMOS:
             _MEMOS.clear()
-            _MEMOS[task["key"]] = arrays.rule_memos(), arrays.slope_memo()
+            _MEMOS[task["key"]] = arrays.rule_memos(), arrays.slope_memo(), {}
         out.append(array_chunk(task, *_MEMOS[task["key"]]))
     return out
 
 
-def array_chunk(task: dict, rule_memos=None, slope_memo=None) -> dict:
+def array_chunk(task: dict, rule_memos=None, slope_memo=None, seen=None) -> dict:
     """The rows of variants ``start:stop`` of the grid by :func:`matcad.sweep.arrays.evaluate`."""
     from matcad.spec import from_dict
 
@@ -251,7 +251,7 @@ def array_chunk(task: dict, rule_memos=None, slope_memo=None) -> dict:
     data, axes, model = task["data"], task["axes"], task["model"]
     chunk = arrays.GridChunk(data, axes, np.arange(task["start"], task["stop"]))
     out = arrays.evaluate(chunk, from_dict(data), model, task["rules"], rule_memos or arrays.rule_memos(),
-                          slope_memo or arrays.slope_memo())
+                          slope_memo or arrays.slope_memo(), seen)
     columns = [(sensitivity_column(a), out[("slope", a.field)]) for a in axes if ("slope", a.field) in out]
     rows = []
     for j, i in enumerate(chunk.rows.tolist()):
