@@ -153,16 +153,54 @@ def test_elastic_wall_sweeps_on_arrays_equal_to_predict():
 
 def test_a_calibrated_spec_sweeps_by_its_calibration():
     """The paper template's calibration anchors every variant of its sweep (the calibrated f(0) times the physics
-    ratio to the calibrated drawing), row for row predict's."""
+    ratio to the calibrated drawing), row for row predict's, on arrays."""
     data = read_spec_data(PAPER)
     result = sweep(data, parse_axes(["cavity.length=4:5:3"]), rules=False)
-    assert result.model == "calibration" and not result.vectorised
+    assert result.model == "calibration" and result.vectorised
     base = from_dict(data)  # the calibrated taxel is the one drawn as loaded, whatever a variant changes
     for row, x in zip(result.rows, (4.0, 4.5, 5.0)):
         p = predict(dataclasses.replace(base, cavity=dataclasses.replace(base.cavity, length=x)), mechanics=False)
         assert p.model == "calibration" and row["f0_hz"] == p.f0_hz
         assert (row["band_low_hz"], row["band_high_hz"]) == p.band_hz
     assert result.rows[0]["f0_hz"] > result.rows[2]["f0_hz"]  # a longer cavity sings lower
+
+
+@pytest.mark.parametrize("vary", [["cavity.length=3.5,4.76,6", "neck.diameter=1.5,2.1,2.4"],
+                                  ["cavity.diameter=3,3.18,6", "spacer.height=0.5,1.5", "neck.length=3,6.35"],
+                                  ["end_cap.outer_diameter=10,12", "microphone.sample_rate_hz=9000,48000",
+                                   "mold.draft_deg=0,1"]])
+def test_calibrated_sweep_on_arrays_equals_the_per_variant_path(vary):
+    """The calibration anchor on arrays (matcad.sweep.calibrated) against `predict --model calibration` and `check`
+    variant by variant: status, f0, band, validity and every rule verdict equal, on grids that include the
+    calibrated drawing itself (ratio 1, no model-ratio line), vary fields the drawing does not fix (the mount gap:
+    the calibrated drawing's physics moves too), and break rules; the slope is the anchored f0's own derivative."""
+    from matcad.prediction.anchor import CalibrationAnchor
+    from matcad.spec.drawn import DRAWN, pinned
+    from matcad.sweep.grid import grid, variant_data
+    from matcad.sweep.tasks import run_variant
+
+    data = read_spec_data(PAPER)
+    axes = parse_axes(vary)
+    result = sweep(data, axes)
+    assert result.model == "calibration" and result.vectorised
+    pinned_data = pinned(data, from_dict(data))
+    f_cal = CalibrationAnchor(from_dict(data)).f_cal
+    for row, values in zip(result.rows, grid(axes)):
+        one = run_variant({"index": row["index"], "data": variant_data(pinned_data, axes, values),
+                           "model": "calibration", "predict": True, "rules": True})
+        for key in ("status", "reason", "f0_hz", "band_low_hz", "band_high_hz", "model_valid", "rule_errors",
+                    "rule_warnings", "failing_rules"):
+            assert row.get(key) == one.get(key), (key, values, row.get(key), one.get(key))
+    drawn = {f"{table}.{name}": getattr(from_dict(data).calibration, key) for key, (table, name) in DRAWN.items()}
+    for row in result.rows:  # the calibrated drawing sings at f(0) exactly (whatever else varies)
+        assert (row["f0_hz"] == f_cal) == all(row[a.field] == drawn.get(a.field, row[a.field]) for a in axes)
+    assert any(row["rule_errors"] for row in result.rows) or any(row["rule_warnings"] for row in result.rows)
+    col = sensitivity_column(axes[0])
+    row = result.rows[1]
+    x = row[axes[0].field]
+    f = [predict(from_dict(variant_data(pinned_data, axes, (x + s,) + tuple(row[a.field] for a in axes[1:]))),
+                 model="calibration", mechanics=False).f0_hz for s in (-1e-3, 1e-3)]
+    assert row[col] == pytest.approx((f[1] - f[0]) / 2e-3, rel=1e-4)
 
 
 def test_cavity_diameter_slope_moves_the_cap_that_follows_it():

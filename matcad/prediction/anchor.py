@@ -122,14 +122,21 @@ class CalibrationAnchor:
                         + ("" if self.same(spec) else f" x physics ratio {f0 / self.f_cal:.4f}"))
 
 
-def _ratio_line(spec, f0_hz: float) -> BudgetLine:
-    """The chosen model's error on a ratio between two designs (benchmarks/error_vs_runtime.py)."""
+def ratio_share(spec) -> float:
+    """The chosen model's largest relative error on a ratio between two designs (benchmarks/error_vs_runtime.py)."""
     from matcad.acoustics.registry import CHOSEN, model_errors
 
-    name = CHOSEN[spec.wall.model]
-    share = model_errors()[name].get("ratio_max_abs", model_errors()[name]["max_abs"])
-    return BudgetLine("model ratio", f"{name}: max |error| of new/calibrated {100 * share:.2f} %", -share * f0_hz,
-                      share * f0_hz)
+    error = model_errors()[CHOSEN[spec.wall.model]]
+    return error.get("ratio_max_abs", error["max_abs"])
+
+
+def _ratio_line(spec, f0_hz: float) -> BudgetLine:
+    """The chosen model's error on a ratio between two designs, as a budget line (Hz)."""
+    from matcad.acoustics.registry import CHOSEN
+
+    share = ratio_share(spec)
+    return BudgetLine("model ratio", f"{CHOSEN[spec.wall.model]}: max |error| of new/calibrated {100 * share:.2f} %",
+                      -share * f0_hz, share * f0_hz)
 
 
 class AsBuiltAnchor:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from matcad.sweep import fast
+from matcad.sweep import calibrated, fast
 from matcad.sweep.grid import variant_data
 from matcad.sweep.memo import Memo
 
@@ -104,11 +104,14 @@ class GridChunk:
         return np.full(len(self), fast.field_value(base, key), dtype=float)
 
 
-def eligible(base, model: str) -> bool:
-    """Whether a sweep of ``base`` by ``model`` runs on arrays: a closed-form model, one taxel, no [reference]."""
+def eligible(base, model: str, axes=()) -> bool:
+    """Whether a sweep of ``base`` by ``model`` over ``axes`` runs on arrays: one taxel, no [reference], and a
+    closed-form model or the calibration anchor (:func:`matcad.sweep.calibrated.eligible`)."""
     from matcad.spec import taxels
 
-    return model in fast.VECTORISED and base.reference is None and not base.taxel and len(taxels(base)) == 1
+    if base.reference is not None or base.taxel or len(taxels(base)) != 1:
+        return False
+    return calibrated.eligible(base, axes) if model == calibrated.MODEL else model in fast.VECTORISED
 
 
 def _by_combination(chunk: GridChunk, axes: tuple[int, ...], positions, function, seen: dict) -> np.ndarray:
@@ -232,12 +235,12 @@ def _bending_column(chunk: GridChunk, base, memo: Memo, v: fast.Variants) -> np.
     return np.where(failed, -(numbers + 1), column)
 
 
-def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, model: str, f0, low, high,
-                 failed_checks) -> dict:
+def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0, low, high,
+                 model_warnings) -> dict:
     """rule_errors, rule_warnings, failing_rules (and status/reason where a rule raised) of the chunk's valid
-    variants, as :func:`matcad.sweep.tasks.rule_verdicts` gives them one by one."""
+    variants, as :func:`matcad.sweep.tasks.rule_verdicts` gives them one by one (``model_warnings``: each variant's
+    count of its prediction's warnings from its own model)."""
     from matcad.acoustics.design import speed_of_sound
-    from matcad.acoustics.predict import warning_count
     from matcad.rules import acoustic, jet
 
     n = len(chunk)
@@ -247,7 +250,7 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, mo
     d = v.design()
     sound = acoustic.array_counts(chunk.field(base, "microphone.sample_rate_hz"),
                                   chunk.field(base, "microphone.floor_hz"), low, high,
-                                  warning_count(d, f0, failed_checks))
+                                  model_warnings)
     sound |= jet.array_counts(f0, chunk.field(base, "neck.diameter"), chunk.field(base, "needle.flow_l_min"),
                               chunk.field(base, "needle.outer_diameter"), speed_of_sound(d.air))
     matrix = np.stack(numbers + [np.asarray(c, dtype=np.int64) for c in sound.values()], axis=1) if n else \
@@ -312,22 +315,35 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
         return out
     good = chunk.subset(ok)
     v = variants(good, base)
-    f0 = fast.f0_hz(v, model)
-    failed = fast.failed_checks(v, model, f0)
-    valid = failed == 0
-    low, high = fast.band_hz(v, model, f0, valid)
+    if model == calibrated.MODEL:
+        anchor = calibrated.CalibratedSweep(good, base)
+        f0, low, high = anchor.columns(v)
+        valid, warned = np.ones(len(f0), dtype=bool), np.zeros(len(f0), dtype=np.int64)
+
+        def slope_of(field, follows):
+            return anchor.sensitivity(v, field, follows)
+    else:
+        from matcad.acoustics.predict import warning_count
+
+        f0 = fast.f0_hz(v, model)
+        failed = fast.failed_checks(v, model, f0)
+        valid, warned = failed == 0, warning_count(v.design(), f0, failed)
+        low, high = fast.band_hz(v, model, f0, valid)
+
+        def slope_of(field, follows):
+            return fast.sensitivity(v, model, field, follows)
     out["f0_hz"][ok], out["band_low_hz"][ok], out["band_high_hz"][ok] = f0, low, high
     out["model_valid"][ok] = valid
     for a in chunk.axes:
         follows = good.follows_cavity if a.field == "cavity.diameter" else None
         out[("slope", a.field)] = np.full(n, np.nan)
-        out[("slope", a.field)][ok] = fast.sensitivity(v, model, a.field, follows)
+        out[("slope", a.field)][ok] = slope_of(a.field, follows)
     numbers = slope.apply(good)
     outcomes = np.empty(len(slope.outcomes), dtype=object)
     outcomes[:] = slope.outcomes
     out["load_slope"][ok] = outcomes[numbers]
     if rules:
-        verdicts = rule_columns(good, base, memos, v, model, f0, low, high, failed)
+        verdicts = rule_columns(good, base, memos, v, f0, low, high, warned)
         out["rule_errors"] = np.full(n, -1, dtype=np.int64)
         out["rule_warnings"] = np.full(n, -1, dtype=np.int64)
         out["failing_rules"] = np.full(n, None, dtype=object)

@@ -156,11 +156,11 @@ def band_hz(v: Variants, model: str, f0, ok) -> tuple[np.ndarray, np.ndarray]:
     return _chunked(chunk, v, np.asarray(f0, dtype=float), np.asarray(ok))
 
 
-def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None) -> np.ndarray:
+def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None, f0=None) -> np.ndarray:
     """df0/dfield per variant (Hz per the field's unit: Hz/mm for lengths) by a central difference of the
     vectorised model, step :data:`RELATIVE_STEP` × the value; exactly 0 for a field the model does not read.
     ``follows`` ({field: factor}) moves the fields whose default follows this one with it (the cap's size follows
-    the cavity diameter)."""
+    the cavity diameter); ``f0`` (variants → Hz), when given, is differentiated instead of the model's f0."""
     if field not in v.values:
         return np.zeros(len(v))
     x = v.values[field]
@@ -172,4 +172,5 @@ def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None
             out = out.with_value(other, factor * value)
         return out
 
-    return (f0_hz(moved(x + h), model) - f0_hz(moved(x - h), model)) / (2 * h)
+    f = f0 or (lambda moved_v: f0_hz(moved_v, model))
+    return (f(moved(x + h)) - f(moved(x - h))) / (2 * h)

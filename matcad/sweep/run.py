@@ -145,7 +145,7 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     elif model not in allowed_models(base):
         raise ValueError(f"--model {model!r} invalid, must be one of {', '.join(allowed_models(base))}")
     size = math.prod(len(a.values) for a in axes)
-    if not cad and arrays.eligible(base, model):
+    if not cad and arrays.eligible(base, model, axes):
         keep = sink is None or len(axes) <= 2 or size <= MAX_VARIANTS
         rows, counted, worker_seconds = _array_rows(data, axes, model, rules, executor, sink, keep, progress)
         return SweepResult(base.name, model, tuple(axes), tuple(rows), True, executor.describe(), rules,
