@@ -101,6 +101,20 @@ def test_grid_model_and_rules_match_predict_per_variant():
         assert row["rule_warnings"] == sum(f.level == "warning" for f in findings)
 
 
+def _equal_per_variant(result, data, axes, model: str) -> None:
+    """Every row of an array sweep equals the per-variant path's (:func:`matcad.sweep.tasks.run_variant`:
+    from_dict, predict, check) on the same data: status, reason, f0, band, validity and every rule verdict."""
+    from matcad.sweep.grid import grid, variant_data
+    from matcad.sweep.tasks import run_variant
+
+    for row, values in zip(result.rows, grid(axes)):
+        one = run_variant({"index": row["index"], "data": variant_data(data, axes, values), "model": model,
+                           "predict": True, "rules": True})
+        for key in ("status", "reason", "f0_hz", "band_low_hz", "band_high_hz", "model_valid", "rule_errors",
+                    "rule_warnings", "failing_rules"):
+            assert row.get(key) == one.get(key), (key, values, row.get(key), one.get(key))
+
+
 @pytest.mark.parametrize("template,vary,bends", [
     (PAPER, ["cavity.diameter=1.5:9:4", "neck.diameter=1.2,2.1,3.3", "mold.draft_deg=0,8",
              "microphone.sample_rate_hz=9000,48000"], False),
@@ -116,20 +130,13 @@ def test_array_sweep_equals_the_per_variant_path(template, vary, bends):
     variants (fails if a memoised rule misses a field it reads, or the array checks miss a refusal). The last two
     grids bend the plate: plate.bending judged on arrays (matcad.rules.plate.bending_warnings) with pitch shifts of
     -1.0 to -4520 Hz either side of its limit, mouths closed by the plate, rigid and silicone walls."""
-    from matcad.sweep.grid import grid, variant_data
-    from matcad.sweep.tasks import run_variant
-
     data = read_spec_data(ROOT / template)
     axes = parse_axes(vary)
     result = sweep(data, axes, model="transmission_line")
     assert result.vectorised
+    _equal_per_variant(result, data, axes, "transmission_line")
     statuses = set()
-    for row, values in zip(result.rows, grid(axes)):
-        one = run_variant({"index": row["index"], "data": variant_data(data, axes, values),
-                           "model": "transmission_line", "predict": True, "rules": True})
-        for key in ("status", "reason", "f0_hz", "band_low_hz", "band_high_hz", "model_valid", "rule_errors",
-                    "rule_warnings", "failing_rules"):
-            assert row.get(key) == one.get(key), (key, values, row.get(key), one.get(key))
+    for row in result.rows:
         statuses.add((row["status"], bool(row.get("rule_errors"))) if not bends else
                      "plate.bending:warning" in (row.get("failing_rules") or ""))
     assert statuses == {True, False} if bends else {("invalid", False), ("ok", True), ("ok", False)} <= statuses
@@ -176,8 +183,7 @@ def test_calibrated_sweep_on_arrays_equals_the_per_variant_path(vary):
     the calibrated drawing's physics moves too), and break rules; the slope is the anchored f0's own derivative."""
     from matcad.prediction.anchor import CalibrationAnchor
     from matcad.spec.drawn import DRAWN, pinned
-    from matcad.sweep.grid import grid, variant_data
-    from matcad.sweep.tasks import run_variant
+    from matcad.sweep.grid import variant_data
 
     data = read_spec_data(PAPER)
     axes = parse_axes(vary)
@@ -185,12 +191,7 @@ def test_calibrated_sweep_on_arrays_equals_the_per_variant_path(vary):
     assert result.model == "calibration" and result.vectorised
     pinned_data = pinned(data, from_dict(data))
     f_cal = CalibrationAnchor(from_dict(data)).f_cal
-    for row, values in zip(result.rows, grid(axes)):
-        one = run_variant({"index": row["index"], "data": variant_data(pinned_data, axes, values),
-                           "model": "calibration", "predict": True, "rules": True})
-        for key in ("status", "reason", "f0_hz", "band_low_hz", "band_high_hz", "model_valid", "rule_errors",
-                    "rule_warnings", "failing_rules"):
-            assert row.get(key) == one.get(key), (key, values, row.get(key), one.get(key))
+    _equal_per_variant(result, pinned_data, axes, "calibration")
     drawn = {f"{table}.{name}": getattr(from_dict(data).calibration, key) for key, (table, name) in DRAWN.items()}
     for row in result.rows:  # the calibrated drawing sings at f(0) exactly (whatever else varies)
         assert (row["f0_hz"] == f_cal) == all(row[a.field] == drawn.get(a.field, row[a.field]) for a in axes)
