@@ -204,6 +204,31 @@ def test_calibrated_sweep_on_arrays_equals_the_per_variant_path(vary):
     assert row[col] == pytest.approx((f[1] - f[0]) / 2e-3, rel=1e-4)
 
 
+def test_a_calibration_remembers_the_mount_gap_it_was_measured_with():
+    """The calibrated taxel is its drawing as built (matcad.spec.drawn.DRAWN): a sweep of the mount gap on the paper
+    template moves the calibrated f0 by the physics ratio to the gap it was measured with (it kept f(0) on every
+    row while the drawing was its geometry alone), and the measured gap's own row is f(0)."""
+    from matcad.acoustics.registry import CHOSEN, model
+    from matcad.acoustics.design import design
+    from matcad.acoustics.resonator import resonator
+    from matcad.prediction.anchor import CalibrationAnchor
+
+    data = read_spec_data(PAPER)
+    base = from_dict(data)
+    result = sweep(data, parse_axes(["spacer.height=0.5,1.59,3.0"]), rules=False)
+    f0 = [row["f0_hz"] for row in result.rows]
+    f_cal = CalibrationAnchor(base).f_cal
+    physics = model(CHOSEN["silicone"])
+
+    def f_physics(height):
+        d = design(dataclasses.replace(base, spacer=dataclasses.replace(base.spacer, height=height)))
+        return physics.f0_hz(resonator(d), d.wall)
+
+    assert f0[1] == f_cal and f0[0] < f0[1] < f0[2]
+    assert f0[0] / f_cal == pytest.approx(f_physics(0.5) / f_physics(1.59), rel=1e-12)
+    assert f0[0] / f_cal < 0.93  # the 0.5 mm gap: 8.8 % lower
+
+
 def test_cavity_diameter_slope_moves_the_cap_that_follows_it():
     """Where the spec leaves the cap's size to its default (2.5 x and 0.6 x cavity.diameter), df0/d(cavity.diameter)
     moves the cap with the cavity, as a spec file with that diameter would (the physics: no calibration)."""

@@ -11,17 +11,21 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from matcad.spec.fields import length_mm
+from matcad.spec.fields import LENGTH_MAX_MM, length_mm, param
+
+AS_LOADED = "of the measured taxel's drawing; default this spec's as loaded"
 
 
 def _drawn(what: str):
     """One length of the measured taxel's drawing (mm; None: the spec's as loaded)."""
-    return length_mm(f"{what} of the measured taxel's drawing; default this spec's as loaded", None)
+    return length_mm(f"{what} {AS_LOADED}", None)
 
 
 @dataclass(frozen=True, kw_only=True)
 class Drawn:
-    """Geometry fields of a measured taxel's drawing (mm; None: this spec's as loaded)."""
+    """A measured taxel's drawing: its geometry and how it was built where that moves its pitch (the cap's draft,
+    the mount gap and the plate that bounds it, the clamp on the cap's flange) (mm, deg; None: this spec's as
+    loaded)."""
 
     cavity_diameter: float | None = _drawn("cavity diameter")
     cavity_length: float | None = _drawn("cavity length")
@@ -29,12 +33,25 @@ class Drawn:
     neck_length: float | None = _drawn("neck length (sheet)")
     cap_outer_diameter: float | None = _drawn("end-cap outer diameter")
     cap_top_thickness: float | None = _drawn("end-cap top thickness")
+    mold_draft_deg: float | None = param(f"core-pin draft {AS_LOADED}", "deg", None, lo=0.0, hi=10.0,
+                                         lo_open=False)
+    spacer_height: float | None = _drawn("mount gap (spacer height)")
+    plate_width: float | None = _drawn("neck plate width")
+    plate_depth: float | None = _drawn("neck plate depth")
+    guide_thickness: float | None = _drawn("guide sheet thickness (it clamps the cap's flange)")
+    flange_squeeze: float | None = param(f"end-cap flange squeeze {AS_LOADED}", "mm", None, lo=0.0, hi=LENGTH_MAX_MM,
+                                         lo_open=False)
 
 
 DRAWN = {"cavity_diameter": ("cavity", "diameter"), "cavity_length": ("cavity", "length"),
          "neck_diameter": ("neck", "diameter"), "neck_length": ("neck", "length"),
-         "cap_outer_diameter": ("end_cap", "outer_diameter"), "cap_top_thickness": ("end_cap", "top_thickness")}
-"""Each :class:`Drawn` field → the table and field of the spec it stands for."""
+         "cap_outer_diameter": ("end_cap", "outer_diameter"), "cap_top_thickness": ("end_cap", "top_thickness"),
+         "mold_draft_deg": ("mold", "draft_deg"), "spacer_height": ("spacer", "height"),
+         "plate_width": ("plate", "width"), "plate_depth": ("plate", "depth"),
+         "guide_thickness": ("guide", "thickness"), "flange_squeeze": ("end_cap", "flange_squeeze")}
+"""Each :class:`Drawn` field → the table and field of the spec it stands for: every field of one taxel that the
+closed-form models read (:data:`matcad.sweep.fast.FIELDS`) but the air and the silicone, which an anchor treats
+on its own (the air's temperature) or takes as the calibrated taxel's (the silicone)."""
 
 
 def filled(entry, spec):
