@@ -175,12 +175,13 @@ def test_a_calibrated_spec_sweeps_by_its_calibration():
 @pytest.mark.parametrize("vary", [["cavity.length=3.5,4.76,6", "neck.diameter=1.5,2.1,2.4"],
                                   ["cavity.diameter=3,3.18,6", "spacer.height=0.5,1.5", "neck.length=3,6.35"],
                                   ["end_cap.outer_diameter=10,12", "microphone.sample_rate_hz=9000,48000",
-                                   "mold.draft_deg=0,1"]])
+                                   "mold.draft_deg=0,1", "silicone.density_g_cm3=1.0,1.2"]])
 def test_calibrated_sweep_on_arrays_equals_the_per_variant_path(vary):
     """The calibration anchor on arrays (matcad.sweep.calibrated) against `predict --model calibration` and `check`
     variant by variant: status, f0, band, validity and every rule verdict equal, on grids that include the
-    calibrated drawing itself (ratio 1, no model-ratio line), vary fields the drawing does not fix (the mount gap:
-    the calibrated drawing's physics moves too), and break rules; the slope is the anchored f0's own derivative."""
+    calibrated drawing itself (ratio 1, no model-ratio line), vary how it is built (the mount gap, the draft) and a
+    field the drawing does not fix (the silicone's density: the calibrated drawing's physics moves too), and break
+    rules; the slope is the anchored f0's own derivative."""
     from matcad.prediction.anchor import CalibrationAnchor
     from matcad.spec.drawn import DRAWN, pinned
     from matcad.sweep.grid import variant_data
@@ -199,9 +200,10 @@ def test_calibrated_sweep_on_arrays_equals_the_per_variant_path(vary):
     col = sensitivity_column(axes[0])
     row = result.rows[1]
     x = row[axes[0].field]
+    h = 1e-6 * max(abs(x), 1.0)  # the array's step (matcad.sweep.fast.RELATIVE_STEP): predict's own difference
     f = [predict(from_dict(variant_data(pinned_data, axes, (x + s,) + tuple(row[a.field] for a in axes[1:]))),
-                 model="calibration", mechanics=False).f0_hz for s in (-1e-3, 1e-3)]
-    assert row[col] == pytest.approx((f[1] - f[0]) / 2e-3, rel=1e-4)
+                 model="calibration", mechanics=False).f0_hz for s in (-h, h)]
+    assert row[col] == pytest.approx((f[1] - f[0]) / (2 * h), rel=1e-6)
 
 
 def test_a_calibration_remembers_the_mount_gap_it_was_measured_with():

@@ -2,8 +2,9 @@
 (:class:`matcad.prediction.anchor.CalibrationAnchor`) — the calibrated taxel's Eq. 5 f(0) times each variant's
 physics ratio to the calibrated drawing — with its band, each entry the arithmetic `matcad predict` does on that
 variant (tested equal). The physics is the model `predict` chooses for the wall
-(:data:`matcad.acoustics.registry.CHOSEN`), run on the variants and on the calibrated drawing built with each
-variant's other fields (a varied mount gap moves both). Frequencies Hz, lengths mm.
+(:data:`matcad.acoustics.registry.CHOSEN`), run on the variants and on the calibrated drawing (its geometry and
+build, :data:`matcad.spec.drawn.DRAWN`) with each variant's other fields (the silicone's density moves both).
+Frequencies Hz, lengths mm.
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ class CalibratedSweep:
         self.base = base
 
     def drawn(self, v: fast.Variants) -> fast.Variants:
-        """The variants with the calibrated drawing's geometry (their other fields kept)."""
+        """The variants with the calibrated drawing's fields (:data:`matcad.spec.drawn.DRAWN`; their others kept)."""
         for key, value in self.drawing.items():
             v = v.with_value(key, np.full(len(v), value))
         return v
@@ -84,6 +85,6 @@ class CalibratedSweep:
         f_cal = self.anchor.f_cal
 
         def anchored(moved):
-            return f_cal * fast.f0_hz(moved, self.physics) / fast.f0_hz(self.drawn(moved), self.physics)
+            return f_cal * (fast.f0_hz(moved, self.physics) / fast.f0_hz(self.drawn(moved), self.physics))
 
         return fast.sensitivity(v, self.physics, field, follows, f0=anchored)
