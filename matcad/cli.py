@@ -47,16 +47,23 @@ def _unraisable(unraisable) -> None:
     sys.__unraisablehook__(unraisable)
 
 
-def _install_signal_handlers() -> dict:
-    """Route SIGINT and SIGTERM to :func:`_on_signal`; returns the handlers they replace."""
+def _install_signal_handlers(previous: dict) -> None:
+    """Route SIGINT and SIGTERM to :func:`_on_signal`, noting in ``previous`` the handlers they replace. Both
+    signals are held back while the handlers change (where the system can), so one that arrives meanwhile is
+    delivered after, as an interrupt the caller's ``try`` sees, and every replaced handler is noted."""
     _SIGNALLED.clear()  # a new run in the same interpreter (tests call main() repeatedly)
-    previous = {}
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        try:
-            previous[sig] = signal.signal(sig, _on_signal)
-        except ValueError:  # not the main thread: leave Python's default handling
-            pass
-    return previous
+    both = {signal.SIGINT, signal.SIGTERM}
+    hold = getattr(signal, "pthread_sigmask", None)
+    mask = hold(signal.SIG_BLOCK, both) if hold else None
+    try:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            try:
+                previous[sig] = signal.signal(sig, _on_signal)
+            except ValueError:  # not the main thread: leave Python's default handling
+                pass
+    finally:
+        if hold:
+            hold(signal.SIG_SETMASK, mask)
 
 
 def _private_caches() -> None:
@@ -178,11 +185,12 @@ class _Stdout:
 
 def main(argv: list[str] | None = None) -> int:
     """Run one command; every outcome maps to one row of :data:`EXIT_CODES`."""
-    previous = _install_signal_handlers()
-    sys.unraisablehook = _unraisable
-    _STDOUT.clear()
+    previous: dict = {}
     args = None
-    try:
+    try:  # from the first line: an interrupt right as the handlers are installed is an interrupt, not a traceback
+        _install_signal_handlers(previous)
+        sys.unraisablehook = _unraisable
+        _STDOUT.clear()
         _private_caches()
         from matcad.commands import parser
 

@@ -529,6 +529,47 @@ def test_fault_injection_long(tmp_path):
     _inject_faults(tmp_path, trials=40, seed=11)
 
 
+def test_an_interrupt_as_the_handlers_go_in_is_an_interrupt(monkeypatch):
+    """A SIGINT that lands the instant main() routes SIGINT to its handler (the long fault injection hit it: exit -2
+    and a KeyboardInterrupt traceback, 1 run in ~150 by hand) is held until the handlers are in, then ends the run
+    as any interrupt does: exit 130, no traceback."""
+    import signal
+
+    from matcad import cli
+
+    real = signal.signal
+
+    def signal_then_interrupt(sig, handler):
+        previous = real(sig, handler)
+        if sig == signal.SIGINT and handler is cli._on_signal:
+            os.kill(os.getpid(), signal.SIGINT)
+        return previous
+
+    before = signal.getsignal(signal.SIGINT)
+    monkeypatch.setattr(cli.signal, "signal", signal_then_interrupt)
+    try:
+        code = cli.main(["--version"])
+    except KeyboardInterrupt:
+        code = "a KeyboardInterrupt out of main()"
+    finally:
+        real(signal.SIGINT, before)
+    assert code == 130
+
+
+def test_an_interrupt_while_python_builds_the_signal_module_leaves_quietly():
+    """`python -m matcad` interrupted while its first line imports the signal module (Python's own handler still in
+    place: a KeyboardInterrupt traceback and exit -2 before): exit 130 and nothing on stderr."""
+    import subprocess
+    import sys
+
+    code = ("import builtins, runpy\nreal = builtins.__import__\n"
+            "def interrupted(name, *a, **k):\n    if name == 'signal':\n        raise KeyboardInterrupt\n"
+            "    return real(name, *a, **k)\nbuiltins.__import__ = interrupted\n"
+            "runpy.run_module('matcad', run_name='__main__', alter_sys=True)")
+    proc = subprocess.run([sys.executable, "-c", code, "--version"], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 130 and proc.stderr == "", (proc.returncode, proc.stderr)
+
+
 # ---- bounded tessellation and export failures ---------------------------------------------------------------------
 
 def test_chordal_tolerance_is_floored_by_part_size():
