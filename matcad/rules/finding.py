@@ -7,6 +7,7 @@ Levels: ``error`` (the part will not work or cannot be made: `build` refuses wit
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import Callable
 
 LEVELS = ("error", "warning", "info")
 """Every finding's level, most severe first: findings are listed in this order."""
@@ -25,6 +26,20 @@ class Finding:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+
+@dataclass(frozen=True)
+class ArrayRule:
+    """How a sweep judges one spec rule on arrays of one-taxel variants (a module's ``ARRAY_RULES``): the finding
+    it gives (``id``, ``level``), the function of the spec the sweep memoises for it (``inputs``: spec → a number)
+    and ``column(inputs, field, design, design_of, wall_model)``, the rule on the variants' arrays: how many such
+    findings each variant gets. ``field(dotted key)`` gives every variant's value, ``design`` their
+    :class:`matcad.acoustics.design.Design` of arrays, ``design_of(rows)`` that of the variants at ``rows``."""
+
+    id: str
+    level: str
+    inputs: Callable
+    column: Callable
 
 
 def fits_bed(size, bed) -> bool:

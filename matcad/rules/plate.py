@@ -11,7 +11,7 @@ import numpy as np
 from matcad.listening import EDGE_BINS, EXCLUDE_BINS, guard_hz
 from matcad.materials import ACRYLIC_MODULUS_MPA
 from matcad.parts.stack import plate_beam, plate_deflection_mm, post_bay_mm
-from matcad.rules.finding import Finding
+from matcad.rules.finding import ArrayRule, Finding
 
 BENDING_GUARD_SHARE = EDGE_BINS / (EXCLUDE_BINS + EDGE_BINS)
 """The share of the band guard (:func:`matcad.listening.guard_hz`) a pitch change from bending may take: its
@@ -254,6 +254,15 @@ def bending_warnings(d, deflection_mm, force_n, sample_rate_hz, shift_hz) -> np.
     return ((np.asarray(force_n) > 0) & (~open_ | moved)).astype(np.int64)
 
 
+def bending_column(deflection_mm, field, d, design_of, wall_model: str) -> np.ndarray:
+    """:func:`bending_warnings` as a sweep asks it (:class:`matcad.rules.finding.ArrayRule`'s ``column``)."""
+    def shift_hz(rows):
+        return pitch_shift_hz(design_of(rows), deflection_mm[rows], wall_model)
+
+    return bending_warnings(d, deflection_mm, field("mechanics.max_force_n"), field("microphone.sample_rate_hz"),
+                            shift_hz)
+
+
 def pitch_shift_hz(d, deflection_mm, wall_model: str):
     """f0 with the mount gap narrowed by ``deflection_mm`` minus f0 as built (Hz), by the model `predict` chooses
     for ``wall_model`` (:data:`matcad.acoustics.registry.CHOSEN`), on a Design of arrays of variants (each entry the
@@ -270,7 +279,6 @@ def pitch_shift_hz(d, deflection_mm, wall_model: str):
 
 
 RULES = (plate_bending, support_posts)
-ARRAY_RULES = {plate_bending: deflection_under_taxel_mm}
-"""Of :data:`RULES`, those a sweep of one-taxel variants judges on arrays (:func:`bending_warnings`) rather than
-once per combination of the fields they read (plate.bending reads the whole acoustic design wherever the plate
-bends, so once per variant), each with the function of the spec the sweep memoises for it."""
+ARRAY_RULES = {plate_bending: ArrayRule("plate.bending", "warning", deflection_under_taxel_mm, bending_column)}
+"""Of :data:`RULES`, those a sweep of one-taxel variants judges on arrays rather than once per combination of the
+fields they read (plate.bending reads the whole acoustic design wherever the plate bends, so once per variant)."""

@@ -210,28 +210,22 @@ def spec_rules():
 
 
 def _array_rules() -> dict:
-    """The spec rules judged on arrays (each module's ``ARRAY_RULES``): {rule: the function of the spec memoised
-    for it}."""
+    """The spec rules judged on arrays (each module's ``ARRAY_RULES``): {rule: its
+    :class:`matcad.rules.finding.ArrayRule`}."""
     from matcad.rules.registry import SPEC_MODULES
 
-    return {rule: given for module in SPEC_MODULES for rule, given in getattr(module, "ARRAY_RULES", {}).items()}
+    return {rule: entry for module in SPEC_MODULES for rule, entry in getattr(module, "ARRAY_RULES", {}).items()}
 
 
-def _bending_column(chunk: GridChunk, base, memo: Memo, v: fast.Variants) -> np.ndarray:
-    """plate.bending's verdict column (:func:`matcad.rules.plate.bending_warnings`: 1 where it warns), or -(k + 1)
-    where its memoised input failed with outcome k."""
-    from matcad.rules import plate
-
+def _array_column(chunk: GridChunk, base, memo: Memo, v: fast.Variants, entry) -> np.ndarray:
+    """An array rule's count of findings per variant (``entry``: its ArrayRule, ``memo``: its memoised inputs), or
+    -(k + 1) where its input failed with the memo's outcome k."""
     numbers = memo.apply(chunk)
     outcomes = memo.outcomes
     failed = np.array([isinstance(o, tuple) for o in outcomes], dtype=bool)[numbers]
-    w = np.array([np.nan if isinstance(o, tuple) else o for o in outcomes], dtype=float)[numbers]
-
-    def shift_hz(rows):
-        return plate.pitch_shift_hz(v.take(rows).design(), w[rows], base.wall.model)
-
-    column = plate.bending_warnings(v.design(), np.where(failed, 0.0, w), chunk.field(base, "mechanics.max_force_n"),
-                                    chunk.field(base, "microphone.sample_rate_hz"), shift_hz)
+    inputs = np.array([0.0 if isinstance(o, tuple) else o for o in outcomes], dtype=float)[numbers]
+    column = entry.column(inputs, lambda key: chunk.field(base, key), v.design(), lambda rows: v.take(rows).design(),
+                          base.wall.model)
     return np.where(failed, -(numbers + 1), column)
 
 
@@ -245,7 +239,7 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0
 
     n = len(chunk)
     rules, on_arrays = spec_rules(), _array_rules()
-    numbers = [_bending_column(chunk, base, memo, v) if rule in on_arrays else memo.apply(chunk)
+    numbers = [_array_column(chunk, base, memo, v, on_arrays[rule]) if rule in on_arrays else memo.apply(chunk)
                for rule, memo in zip(rules, memos)]
     d = v.design()
     sound = acoustic.array_counts(chunk.field(base, "microphone.sample_rate_hz"),
@@ -261,7 +255,7 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0
         items, broken = [], ""
         for rule, memo, number in zip(rules, memos, combo[:len(memos)]):
             if rule in on_arrays and number >= 0:
-                items += [("plate.bending", "warning")] * int(number)
+                items += [(on_arrays[rule].id, on_arrays[rule].level)] * int(number)
                 continue
             outcome = memo.outcomes[-number - 1 if rule in on_arrays else number]
             if isinstance(outcome, tuple) and outcome[:1] == ("failed",):
@@ -284,9 +278,9 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0
 
 def rule_memos() -> list[Memo]:
     """One :class:`Memo` per spec rule, keeping the summary of its findings (id, level) at error and warning; for a
-    rule judged on arrays, its input (:func:`_array_rules`)."""
+    rule judged on arrays, its inputs (:func:`_array_rules`)."""
     on_arrays = _array_rules()
-    return [Memo(on_arrays[rule]) if rule in on_arrays else Memo(lambda spec, rule=rule: _summary(rule(spec)))
+    return [Memo(on_arrays[rule].inputs) if rule in on_arrays else Memo(lambda spec, rule=rule: _summary(rule(spec)))
             for rule in spec_rules()]
 
 
