@@ -63,22 +63,16 @@ def bendings(spec) -> list[Bending]:
     built. The gap is taken as uniform at its value under the taxel (the 'mount' mouth's model,
     :func:`matcad.acoustics.models.mount_end_correction_mm`): the real gap opens again toward the supports, so the
     change is an upper bound there. A mouth other than 'mount' sees no gap: its pitch does not move."""
-    from matcad.acoustics import registry
     from matcad.acoustics.design import design
-    from matcad.acoustics.resonator import resonator
 
     board, w = deflections(spec)
     gap = spec.spacer.height
-    model = registry.model(registry.CHOSEN[spec.wall.model])
     out = []
     for j, heard in enumerate(board):
-        d = design(spec, heard)
         open_ = w[:, j] < gap
-        variants = np.append(np.where(open_, gap - w[:, j], gap), gap)  # every pressed taxel's gap, then as built
-        many = d.replace(gap_mm=variants, cavity_diameter=np.full(len(variants), d.cavity_diameter))
-        f = np.broadcast_to(np.asarray(model.f0_hz(resonator(many), d.wall), dtype=float), variants.shape)
+        shift = pitch_shift_hz(design(spec, heard), np.where(open_, w[:, j], 0.0), spec.wall.model)
         out += [Bending(t.name, heard.name, spec.mechanics.max_force_n, float(w[i, j]), gap,
-                        float(f[i] - f[-1]) if open_[i] else None) for i, t in enumerate(board)]
+                        float(shift[i]) if open_[i] else None) for i, t in enumerate(board)]
     return out
 
 
@@ -90,17 +84,30 @@ def shift_bound_hz(spec, board, w) -> float:
     ≤ δ / (l + δ), times Δδ / δ: |Δf| / f ≤ Δδ / (2 (l + δ)). Taken twice over (a neck whose air does not move as
     one), at f = the sample rate (the microphone hears nothing above half of it)."""
     from matcad.acoustics.design import gap_radius_mm
-    from matcad.acoustics.models import mouth_end_correction_mm
 
-    gap = spec.spacer.height
     radius = float(gap_radius_mm(spec.plate.width, spec.plate.depth))
     worst = 0.0
     for j, heard in enumerate(board):
-        a = heard.neck.diameter / 2
-        built = float(mouth_end_correction_mm(spec.neck.mouth, a, gap, radius))
-        bent = float(mouth_end_correction_mm(spec.neck.mouth, a, gap - w[:, j].max(), radius))
-        worst = max(worst, spec.microphone.sample_rate_hz * (bent - built) / (spec.neck.length + built))
+        worst = max(worst, float(bound_hz(spec.neck.mouth, heard.neck.diameter / 2, spec.spacer.height,
+                                          w[:, j].max(), radius, spec.neck.length, spec.microphone.sample_rate_hz)))
     return worst
+
+
+def bound_hz(mouth: str, neck_radius_mm, gap_mm, deflection_mm, gap_radius_mm, neck_length_mm, sample_rate_hz):
+    """:func:`shift_bound_hz`'s bound (Hz) for one heard taxel, floats or arrays: the sample rate times the rise of
+    the outer end correction when the gap narrows by ``deflection_mm``, over the neck's length plus that
+    correction (mm)."""
+    from matcad.acoustics.models import mouth_end_correction_mm
+
+    built = mouth_end_correction_mm(mouth, neck_radius_mm, gap_mm, gap_radius_mm)
+    bent = mouth_end_correction_mm(mouth, neck_radius_mm, gap_mm - deflection_mm, gap_radius_mm)
+    return sample_rate_hz * (bent - built) / (neck_length_mm + built)
+
+
+def bending_limit_hz(sample_rate_hz: float) -> float:
+    """The largest pitch change from bending :func:`plate_bending` lets pass (Hz): :data:`BENDING_GUARD_SHARE` of
+    the band guard at ``sample_rate_hz``."""
+    return BENDING_GUARD_SHARE * guard_hz(sample_rate_hz)
 
 
 def post_clearances_mm(spec) -> list[dict]:
@@ -180,7 +187,7 @@ def plate_bending(spec) -> list[Finding]:
     if spec.mechanics.max_force_n <= 0:
         return []
     guard = guard_hz(spec.microphone.sample_rate_hz)
-    limit = BENDING_GUARD_SHARE * guard
+    limit = bending_limit_hz(spec.microphone.sample_rate_hz)
     board, w = deflections(spec)
     if w.max() < spec.spacer.height and shift_bound_hz(spec, board, w) <= limit:
         return []
@@ -237,16 +244,13 @@ def bending_warnings(d, deflection_mm, force_n, sample_rate_hz, shift_hz) -> np.
     per variant (:func:`deflection_under_taxel_mm`); ``shift_hz(rows)``: the pitch change of the variants at index
     ``rows`` with the gap narrowed by their deflection (:func:`pitch_shift_hz`), asked only where
     :func:`shift_bound_hz`'s bound passes the limit, as the rule does. The same tests, in the same arithmetic."""
-    from matcad.acoustics.models import mouth_end_correction_mm
-
     gap, w = np.asarray(d.gap_mm, dtype=float), np.asarray(deflection_mm, dtype=float)
     rates, which = np.unique(np.asarray(sample_rate_hz, dtype=float), return_inverse=True)
-    limit = np.array([BENDING_GUARD_SHARE * guard_hz(float(r)) for r in rates])[which.reshape(-1)]
+    limit = np.array([bending_limit_hz(float(r)) for r in rates])[which.reshape(-1)]
     open_ = w < gap
     with np.errstate(invalid="ignore", divide="ignore"):  # a closed gap (not open_) has no bound: never read
-        built = mouth_end_correction_mm(d.mouth, d.neck_diameter / 2, gap, d.gap_radius_mm)
-        bent = mouth_end_correction_mm(d.mouth, d.neck_diameter / 2, np.where(open_, gap - w, gap), d.gap_radius_mm)
-        bound = sample_rate_hz * (bent - built) / (d.neck_length + built)
+        bound = bound_hz(d.mouth, d.neck_diameter / 2, gap, np.where(open_, w, 0.0), d.gap_radius_mm, d.neck_length,
+                         sample_rate_hz)
     rows = np.flatnonzero(open_ & (bound > limit) & (np.asarray(force_n) > 0))
     moved = np.zeros(len(gap), dtype=bool)
     if rows.size:
@@ -265,17 +269,21 @@ def bending_column(deflection_mm, field, d, design_of, wall_model: str) -> np.nd
 
 def pitch_shift_hz(d, deflection_mm, wall_model: str):
     """f0 with the mount gap narrowed by ``deflection_mm`` minus f0 as built (Hz), by the model `predict` chooses
-    for ``wall_model`` (:data:`matcad.acoustics.registry.CHOSEN`), on a Design of arrays of variants (each entry the
-    arithmetic of :func:`bendings` on that variant)."""
+    for ``wall_model`` (:data:`matcad.acoustics.registry.CHOSEN`): a Design of arrays of variants, or one design under
+    an array of deflections (:func:`bendings`); each entry the arithmetic of that one design."""
     from matcad.acoustics import registry
     from matcad.acoustics.resonator import resonator
 
     model = registry.model(registry.CHOSEN[wall_model])
+    built = np.asarray(d.gap_mm, dtype=float)
+    shape = np.broadcast_shapes(built.shape, np.shape(deflection_mm), np.shape(d.cavity_diameter))
+    cavity = np.broadcast_to(d.cavity_diameter, shape)
 
     def f0(gap):
-        return np.asarray(model.f0_hz(resonator(d.replace(gap_mm=gap)), d.wall), dtype=float)
+        many = d.replace(gap_mm=np.broadcast_to(gap, shape), cavity_diameter=cavity)
+        return np.broadcast_to(np.asarray(model.f0_hz(resonator(many), d.wall), dtype=float), shape)
 
-    return f0(np.asarray(d.gap_mm, dtype=float) - deflection_mm) - f0(np.asarray(d.gap_mm, dtype=float))
+    return f0(built - deflection_mm) - f0(built)
 
 
 RULES = (plate_bending, support_posts)

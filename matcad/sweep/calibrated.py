@@ -48,11 +48,13 @@ class CalibratedSweep:
             v = v.with_value(key, np.full(len(v), value))
         return v
 
+    def anchored_hz(self, v: fast.Variants) -> np.ndarray:
+        """f(0) x physics(variant) / physics(calibrated drawing) (Hz)."""
+        return self.anchor.f_cal * (fast.f0_hz(v, self.physics) / fast.f0_hz(self.drawn(v), self.physics))
+
     def f0_hz(self, v: fast.Variants) -> np.ndarray:
-        """The anchored f0 (Hz): f(0) x physics(variant) / physics(calibrated drawing); f(0) where ``same``."""
-        f_cal = self.anchor.f_cal
-        ratio = fast.f0_hz(v, self.physics) / fast.f0_hz(self.drawn(v), self.physics)
-        return np.where(self.same, f_cal * 1.0, f_cal * ratio)
+        """The anchored f0 (Hz): :meth:`anchored_hz`, and f(0) itself where ``same``."""
+        return np.where(self.same, self.anchor.f_cal * 1.0, self.anchored_hz(v))
 
     def columns(self, v: fast.Variants) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(f0, band low, band high) of the variants (Hz): :meth:`CalibrationAnchor.anchored`'s lines (the
@@ -82,9 +84,4 @@ class CalibratedSweep:
         """df0/dfield of the anchored f0 (Hz per the field's unit) by :func:`matcad.sweep.fast.sensitivity`'s
         central difference: the ratio's own derivative (a drawn field moves the variant only; any other field
         moves the calibrated drawing too)."""
-        f_cal = self.anchor.f_cal
-
-        def anchored(moved):
-            return f_cal * (fast.f0_hz(moved, self.physics) / fast.f0_hz(self.drawn(moved), self.physics))
-
-        return fast.sensitivity(v, self.physics, field, follows, f0=anchored)
+        return fast.sensitivity(v, self.physics, field, follows, f0=self.anchored_hz)
