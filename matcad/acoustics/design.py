@@ -59,19 +59,23 @@ class WallMaterial:
 class Making:
     """How the taxel is made, which sets the fabrication tolerances of the budget: the neck drilled to size from a
     pilot (else laser cut), the neck sheet calipered (else nominal cast sheet), the printer of the core pin ('fdm'
-    or 'sla'). An array design may make each variant its own way (arrays of those values)."""
+    or 'sla'), and the riser sheet the neck runs on through (its thickness in mm, 0 for none; calipered or not).
+    An array design may make each variant its own way (arrays of those values)."""
 
     neck_drilled: bool
     sheet_measured: bool
     printer: str
+    riser_mm: float = 0.0
+    riser_measured: bool = False
 
 
 @dataclass(frozen=True)
 class Design:
     """One taxel as built, for the acoustics (mm): the cavity (diameter D at the plate, length L, core-pin draft in
-    degrees), the neck (diameter d, length l = the plate's sheet) and its outer end (``mouth``: 'baffled',
-    'unflanged' or 'mount', with the mount's gap height and vent radius), the silicone cap around the cavity (outer
-    diameter, top thickness, height clamped by the guide), the air, the wall material and how it is made.
+    degrees), the neck (diameter d, length l = the plate's sheet, and a riser's where it runs on through one) and
+    its outer end (``mouth``: 'baffled', 'unflanged' or 'mount', with the mount's gap height and vent radius), the
+    silicone cap around the cavity (outer diameter, top thickness, height clamped by the guide and, for a cap in a
+    riser's pocket, the riser), the air, the wall material and how it is made.
 
     As-built deviations the drawing does not show (docs/inference.md): ``neck_taper_mm``, the neck's diameter at
     the mouth minus at the cavity (a laser's taper; ``neck_diameter`` is their mean), and ``side_volume_mm3``, air
@@ -106,21 +110,25 @@ class Design:
 def design(spec, taxel=None) -> Design:
     """The :class:`Design` of ``spec``'s taxel ``taxel`` (a :class:`matcad.spec.board.Taxel`; default: the spec's
     own tables, i.e. a single-taxel spec). The mouth's gap is the spacer height and its vent radius half the plate's
-    smaller side; the cap is clamped over the flange's thickness (guide sheet + squeeze)."""
-    from matcad.spec import cap_flange_thickness_mm
+    smaller side; the cap is clamped over the flange's thickness (guide sheet + squeeze, + the riser's for a cap in
+    a riser's pocket); the neck runs through the plate's sheet, and the riser's where it runs on through one."""
+    from matcad.spec import cap_flange_thickness_mm, neck_length_mm
 
     cavity, neck, cap = (spec.cavity, spec.neck, spec.end_cap) if taxel is None else \
         (taxel.cavity, taxel.neck, taxel.end_cap)
     wall = spec.wall
+    length = neck_length_mm(spec, taxel)
+    riser = spec.riser if length != neck.length else None
     return Design(
         cavity_diameter=cavity.diameter, cavity_length=cavity.length, draft_deg=spec.mold.draft_deg,
-        neck_diameter=neck.diameter, neck_length=neck.length, mouth=neck.mouth, gap_mm=spec.spacer.height,
+        neck_diameter=neck.diameter, neck_length=length, mouth=neck.mouth, gap_mm=spec.spacer.height,
         gap_radius_mm=float(gap_radius_mm(spec.plate.width, spec.plate.depth)), cap_outer_diameter=cap.outer_diameter,
-        cap_top_thickness=cap.top_thickness, cap_clamp_height=cap_flange_thickness_mm(spec),
+        cap_top_thickness=cap.top_thickness, cap_clamp_height=cap_flange_thickness_mm(spec, taxel),
         air=Air(spec.air.temperature_c, spec.air.speed_of_sound),
         wall=WallMaterial(wall.model, wall.shear_modulus_mpa, wall.khz_modulus_factor, wall.loss_factor,
                           spec.silicone.density_g_cm3 * 1000.0),
-        making=Making(spec.plate.neck_pilot, spec.plate.thickness_measured, spec.machine.printer))
+        making=Making(spec.plate.neck_pilot, spec.plate.thickness_measured, spec.machine.printer,
+                      riser.thickness if riser else 0.0, bool(riser and riser.thickness_measured)))
 
 
 @dataclass(frozen=True)

@@ -59,10 +59,14 @@ def sheet_tolerance_mm(thickness_mm, measured: bool):
 
 def fabrication_tolerances(making, neck_length_mm) -> tuple:
     """(neck diameter, sheet thickness, cavity diameter) tolerances (± mm) of how a taxel is made
-    (:class:`~matcad.acoustics.design.Making`; its fields may be arrays of variants, each its own)."""
+    (:class:`~matcad.acoustics.design.Making`; its fields may be arrays of variants, each its own). A neck through
+    the plate and a riser (``making.riser_mm`` of it) has both sheets' tolerances added: sheets of one batch may err
+    the same way."""
     if np.ndim(making.neck_drilled) == 0:
+        riser = sheet_tolerance_mm(making.riser_mm, making.riser_measured) if making.riser_mm else 0.0
         return (NECK_DIAMETER_TOL_MM["drilled" if making.neck_drilled else "laser"],
-                sheet_tolerance_mm(neck_length_mm, making.sheet_measured), CAVITY_DIAMETER_TOL_MM[making.printer])
+                sheet_tolerance_mm(neck_length_mm - making.riser_mm, making.sheet_measured) + riser,
+                CAVITY_DIAMETER_TOL_MM[making.printer])
     return (np.where(making.neck_drilled, NECK_DIAMETER_TOL_MM["drilled"], NECK_DIAMETER_TOL_MM["laser"]),
             np.where(making.sheet_measured, MEASURED_SHEET_TOL_MM, sheet_tolerance_mm(neck_length_mm, False)),
             np.array([CAVITY_DIAMETER_TOL_MM[p] for p in making.printer]))
@@ -168,6 +172,9 @@ def budget(d, res, model: str, f0_hz, valid=True, reference=None) -> list[Budget
         return shifts(moved_f0[field])
 
     what = "" if array else "measured" if making.sheet_measured else "ISO 7823-1 cast sheet"
+    if not array and making.riser_mm:
+        riser = "measured" if making.riser_measured else "ISO 7823-1 cast sheet"
+        what = f"plate {what} + {making.riser_mm:g} mm riser {riser}"
     lines += [BudgetLine("neck diameter", words(lambda: f"+-{d_tol:g} mm ({'drilled' if drilled else 'laser cut'})"),
                          *moved("neck.diameter")),
               BudgetLine("neck length (sheet)", words(lambda: f"+-{sheet_tol:.3g} mm ({what})"), *moved("neck.length")),

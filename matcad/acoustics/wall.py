@@ -37,7 +37,7 @@ TABLE_AXES = {
     "outer": (1.3, 1.6, 2.0, 2.52, 3.2, 4.0),
     "top": (0.4, 0.8, 1.26, 2.0, 3.0),
     "length": (1.0, 2.0, 3.0, 4.5, 7.0),
-    "clamp_fraction": (0.0, 0.17, 0.34, 0.6),
+    "clamp_fraction": (0.0, 0.17, 0.34, 0.6, 0.8, 1.0),
 }
 """Cap shapes in cavity radii (outer radius, top thickness, cavity length) and the clamped fraction of the cavity
 height; the paper template (b/a 2.52, T/a 1.26, L/a 3.0, clamp 0.34) lies on the grid."""

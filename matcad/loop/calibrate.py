@@ -83,8 +83,9 @@ def fit_from_spec(forces_n, frequencies_hz, spec, k_free: bool = False, cycles=N
     from matcad.acoustics.eq5fit import fit
     from matcad.acoustics.resonator import resonator
 
-    res = resonator(design(spec))
-    k = float(frequency_constant_mm3_hz2(res.c_m_s, spec.neck.diameter, spec.neck.length))
+    d = design(spec)
+    res = resonator(d)
+    k = float(frequency_constant_mm3_hz2(res.c_m_s, d.neck_diameter, d.neck_length))
     temp = spec.air.temperature_c if temperature_c is None else temperature_c
     return fit(forces_n, frequencies_hz, k, res.volume if k_free else None, cycles, temp, cycle_std_n)
 

@@ -74,9 +74,11 @@ def _cavity_volume(spec) -> float:
 
 
 def _sheet_sd(spec) -> float:
-    from matcad.acoustics.uncertainty import sheet_tolerance_mm
+    from matcad.acoustics.design import design
+    from matcad.acoustics.uncertainty import fabrication_tolerances
 
-    return sheet_tolerance_mm(spec.neck.length, spec.plate.thickness_measured) / 2
+    d = design(spec)
+    return fabrication_tolerances(d.making, d.neck_length)[1] / 2
 
 
 PARAMETERS = (

@@ -84,12 +84,14 @@ def shift_bound_hz(spec, board, w) -> float:
     ≤ δ / (l + δ), times Δδ / δ: |Δf| / f ≤ Δδ / (2 (l + δ)). Taken twice over (a neck whose air does not move as
     one), at f = the sample rate (the microphone hears nothing above half of it)."""
     from matcad.acoustics.design import gap_radius_mm
+    from matcad.spec import neck_length_mm
 
     radius = float(gap_radius_mm(spec.plate.width, spec.plate.depth))
     worst = 0.0
     for j, heard in enumerate(board):
         worst = max(worst, float(bound_hz(spec.neck.mouth, heard.neck.diameter / 2, spec.spacer.height,
-                                          w[:, j].max(), radius, spec.neck.length, spec.microphone.sample_rate_hz)))
+                                          w[:, j].max(), radius, neck_length_mm(spec, heard),
+                                          spec.microphone.sample_rate_hz)))
     return worst
 
 

@@ -23,7 +23,8 @@ This module is the face of the package; each name lives in one module of it:
 
 from matcad.spec.board import Taxel, field_path, is_array, taxel_spec, taxels
 from matcad.spec.calibration import Calibration
-from matcad.spec.cap import cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm
+from matcad.spec.cap import (cap_flange_diameter_mm, cap_flange_thickness_mm, cap_height_mm, in_pocket,
+                             neck_length_mm)
 from matcad.spec.derive import calibrated_spec, reference_spec, variant
 from matcad.spec.fields import Section, SpecError
 from matcad.spec.io import apply_sets, load, load_calibration, load_spec, read_spec_data
@@ -31,13 +32,13 @@ from matcad.spec.model import SECTIONS, Spec, from_dict, to_dict
 from matcad.spec.notes import frequency_notes, spec_notes
 from matcad.spec.schema import schema, schema_text
 from matcad.spec.sections import (MAX_TAXELS, Air, Array, Cavity, EndCap, Fasteners, Guide, Machine, Mechanics,
-                                  Microphone, Mold, Mount, Neck, Needle, Outputs, Plate, Reference, Silicone,
-                                  Spacer, TaxelEntry, Wall)
+                                  Microphone, Mold, Mount, Neck, Needle, Outputs, Plate, Reference, Riser,
+                                  Silicone, Spacer, TaxelEntry, Wall)
 
 __all__ = [
     "MAX_TAXELS", "SECTIONS", "Air", "Array", "Calibration", "Cavity", "EndCap", "Fasteners", "Guide", "Machine",
-    "Mechanics", "Microphone", "Mold", "Mount", "Neck", "Needle", "Outputs", "Plate", "Reference", "Section",
+    "Mechanics", "Microphone", "Mold", "Mount", "Neck", "Needle", "Outputs", "Plate", "Reference", "Riser", "Section",
     "Silicone", "Spacer", "Spec", "SpecError", "Taxel", "TaxelEntry", "Wall", "apply_sets", "calibrated_spec",
-    "cap_flange_diameter_mm", "cap_flange_thickness_mm", "cap_height_mm", "field_path",
-    "frequency_notes", "from_dict", "is_array", "load", "load_calibration", "load_spec", "read_spec_data",
+    "cap_flange_diameter_mm", "cap_flange_thickness_mm", "cap_height_mm", "field_path", "frequency_notes",
+    "from_dict", "in_pocket", "is_array", "load", "load_calibration", "load_spec", "neck_length_mm", "read_spec_data",
     "reference_spec", "schema", "schema_text", "spec_notes", "taxel_spec", "taxels", "to_dict", "variant"]

@@ -20,6 +20,7 @@ from matcad.spec.sections import Cavity, EndCap, Neck, Needle, TaxelEntry
 
 ENTRY_FIELDS = {
     "cavity.diameter": "cavity_diameter", "cavity.length": "cavity_length", "neck.diameter": "neck_diameter",
+    "neck.riser": "neck_riser",
     "end_cap.outer_diameter": "cap_outer_diameter", "end_cap.top_thickness": "cap_top_thickness",
     "needle.theta_deg": "needle_theta_deg", "needle.y": "needle_y", "needle.flow_l_min": "needle_flow_l_min"}
 """Shared-table field → the [[taxel]] key that overrides it for one taxel."""
@@ -28,7 +29,8 @@ ENTRY_FIELDS = {
 @dataclass(frozen=True)
 class Taxel:
     """One resonator of a board: its name, where its neck axis is on the neck plate (x, y in mm, plate centre =
-    origin) and its own validated geometry. ``neck.length`` is the plate's sheet, the same for every taxel.
+    origin) and its own validated geometry. ``neck.length`` is the plate's sheet, the same for every taxel;
+    ``neck.riser`` whether its neck runs on through the spec's [riser] (:func:`matcad.spec.cap.neck_length_mm`).
     ``calibration``: its own Eq. 5 calibration ([taxel.calibration]), None when the spec gives it none."""
 
     name: str
@@ -90,8 +92,9 @@ def field_path(spec, index: int, key: str) -> str:
 
 def taxel_spec(spec, taxel: Taxel):
     """A single-taxel spec with ``taxel``'s geometry (its position dropped) and its own calibration when it has
-    one (else the spec's [calibration]; a taxel's own calibration was measured on this taxel as drawn): how per-taxel physics (predict, wall modes, cap mechanics) is applied to
-    one taxel of a board."""
+    one (else the spec's [calibration]; a taxel's own calibration was measured on this taxel as drawn): how per-taxel
+    physics (predict, wall modes, cap mechanics) is applied to one taxel of a board. The [riser] stays, so the
+    taxel's neck runs through it or its cap sits in a pocket of it as on the board."""
     own = dataclasses.replace(spec, cavity=taxel.cavity, neck=taxel.neck, end_cap=taxel.end_cap,
                               needle=taxel.needle, array=None, taxel=())
     if taxel.calibration is None:

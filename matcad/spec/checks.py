@@ -41,8 +41,19 @@ def cross_checks(spec) -> None:
             measured_spec(spec, entry)
         except SpecError as err:
             raise SpecError(f"measured[{i}] ({err.field})", err.value, err.allowed) from None
-    for index, t in enumerate(taxels(spec)):
+    board = taxels(spec)
+    for index, t in enumerate(board):
         _geometry_checks(t, lambda key, i=index: field_path(spec, i, key), spec.mold.draft_deg)
+    _riser_checks(spec, board)
+
+
+def _riser_checks(spec, board) -> None:
+    """A neck that runs on through a riser needs a [riser] (a riser no neck runs through is possible, if idle: the
+    ``riser.idle`` rule says so)."""
+    through = [i for i, t in enumerate(board) if t.neck.riser]
+    if spec.riser is None and through:
+        raise SpecError(field_path(spec, through[0], "neck.riser"), True,
+                        "needs a [riser] table (the sheet the neck runs on through: its thickness)")
 
 
 def geometry_invalid(cavity_diameter, cavity_length, neck_diameter, draft_deg, cap_outer_diameter=None):

@@ -20,7 +20,7 @@ from matcad.spec.measured import Measured
 from matcad.spec.tube import KINDS, TUBE_TABLES, Tube
 from matcad.spec.sections import (CAP_OUTER_PER_D, CAP_TOP_PER_D, MAX_TAXELS, Air, Array, Cavity, EndCap,
                                   Fasteners, Guide, Machine, Mechanics, Microphone, Mold, Mount, Neck, Needle,
-                                  Outputs, Plate, Reference, Silicone, Spacer, TaxelEntry, Wall)
+                                  Outputs, Plate, Reference, Riser, Silicone, Spacer, TaxelEntry, Wall)
 
 
 @dataclass(frozen=True)
@@ -31,6 +31,7 @@ class Spec:
     cavity: Cavity = field(default=None)  # type: ignore[assignment]
     neck: Neck = field(default=None)  # type: ignore[assignment]
     plate: Plate = field(default_factory=Plate)
+    riser: Riser | None = None
     guide: Guide = field(default_factory=Guide)
     spacer: Spacer = field(default_factory=Spacer)
     end_cap: EndCap = field(default_factory=EndCap)
@@ -72,7 +73,7 @@ class Spec:
 
 
 SECTIONS: dict[str, type] = {
-    "cavity": Cavity, "neck": Neck, "plate": Plate, "guide": Guide, "spacer": Spacer, "end_cap": EndCap,
+    "cavity": Cavity, "neck": Neck, "plate": Plate, "riser": Riser, "guide": Guide, "spacer": Spacer, "end_cap": EndCap,
     "fasteners": Fasteners, "needle": Needle, "mount": Mount, "mold": Mold, "machine": Machine,
     "outputs": Outputs, "air": Air, "wall": Wall, "microphone": Microphone, "silicone": Silicone,
     "calibration": Calibration, "mechanics": Mechanics, "reference": Reference, "array": Array, "tube": Tube}

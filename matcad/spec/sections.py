@@ -56,6 +56,25 @@ class Neck(Section):
                        "(thin tube end), or 'mount' (flange with the air-supply mount a spacer height "
                        "below, as in the paper)", default="mount", kind="choice",
                        choices=("baffled", "unflanged", "mount"))
+    riser: bool = param("the neck runs on through the [riser] sheet stacked on the plate: it is neck.length + "
+                        "riser.thickness long and the cap sits on the riser; false: where there is a [riser] the cap "
+                        "sits on the plate in a pocket cut through the riser, its flange riser.thickness thicker",
+                        default=False, kind="bool")
+
+
+@dataclass(frozen=True)
+class Riser(Section):
+    """A second laser-cut sheet stacked on the neck plate, under the caps, that gives a board two neck lengths
+    (docs/arrays.md): a taxel whose neck runs on through it (``neck.riser``, ``[[taxel]] neck_riser``) has a neck
+    neck.length + riser.thickness long and its cap on the riser; every other cap sits on the plate in a pocket cut
+    through the riser, its flange riser.thickness thicker, so every flange meets the clamp at one height."""
+
+    table: ClassVar[str] = "riser"
+
+    thickness: float = length_mm("riser sheet thickness (a stock acrylic sheet)")
+    thickness_measured: bool = param("true if riser.thickness is a measured value", default=False, kind="bool")
+    thickness_example: bool = _example_sheet("riser.thickness")
+    laser_kerf: float | None = _sheet_kerf("riser")
 
 
 @dataclass(frozen=True)
@@ -385,7 +404,7 @@ def _position(doc: str) -> Any:
 class TaxelEntry(Section):
     """One [[taxel]] of an array spec: where its neck is on the plate and how its geometry differs from the shared
     [cavity], [neck], [end_cap] and [needle] tables (a field left out is the shared value). The neck length is the
-    plate's sheet and the mouth is the plate's, so neither is per taxel."""
+    plate's sheet, and the riser's with it where the neck runs on through a [riser]; the mouth is the plate's."""
 
     table: ClassVar[str] = "taxel"
 
@@ -396,6 +415,8 @@ class TaxelEntry(Section):
     cavity_diameter: float | None = length_mm("this taxel's cavity diameter D; default [cavity]", None)
     cavity_length: float | None = length_mm("this taxel's cavity length L; default [cavity]", None)
     neck_diameter: float | None = length_mm("this taxel's neck diameter d; default [neck]", None)
+    neck_riser: bool | None = param("this taxel's neck runs on through the [riser] sheet (see neck.riser); default "
+                                    "[neck]", default=None, kind="bool")
     cap_outer_diameter: float | None = length_mm(
         f"this taxel's end-cap outer diameter; default [end_cap] if given there, else {CAP_OUTER_PER_D} x its D",
         None)

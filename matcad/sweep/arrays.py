@@ -105,11 +105,12 @@ class GridChunk:
 
 
 def eligible(base, model: str, axes=()) -> bool:
-    """Whether a sweep of ``base`` by ``model`` over ``axes`` runs on arrays: one taxel, no [reference], and a
-    closed-form model or the calibration anchor (:func:`matcad.sweep.calibrated.eligible`)."""
+    """Whether a sweep of ``base`` by ``model`` over ``axes`` runs on arrays: one taxel, no [reference] and no
+    [riser] (whose two sheets the arrays do not carry), and a closed-form model or the calibration anchor
+    (:func:`matcad.sweep.calibrated.eligible`)."""
     from matcad.spec import taxels
 
-    if base.reference is not None or base.taxel or len(taxels(base)) != 1:
+    if base.reference is not None or base.riser is not None or base.taxel or len(taxels(base)) != 1:
         return False
     return calibrated.eligible(base, axes) if model == calibrated.MODEL else model in fast.VECTORISED
 
