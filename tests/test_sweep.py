@@ -115,6 +115,27 @@ def _equal_per_variant(result, data, axes, model: str) -> None:
             assert row.get(key) == one.get(key), (key, values, row.get(key), one.get(key))
 
 
+@pytest.mark.parametrize("riser,wall,vary", [
+    ({"thickness": 1.5}, "rigid", ["riser.thickness=1.5,3", "cavity.length=3:5:3"]),  # necks through it
+    (None, "silicone", ["riser.thickness=1.5,3", "neck.diameter=1.5,2.1"]),  # an axis adds one: caps in pockets
+])
+def test_a_sweep_with_a_riser_runs_each_variant_as_predict_does(riser, wall, vary):
+    """A riser's sheet is in no array of matcad.sweep.fast: such a grid runs variant by variant, each row what
+    `predict` + `check` give (the arrays would keep the plate's one neck length and clamp: fails if the grid
+    goes to them). Through the riser the neck grows; in its pockets the silicone wall is clamped higher."""
+    data = {**read_spec_data(ROOT / "templates/mat-laser-only.toml"), "wall": {"model": wall}}
+    if riser is not None:
+        data = {**data, "riser": riser, "neck": {**data["neck"], "riser": True}}
+    model = {"rigid": "transmission_line", "silicone": "elastic_wall"}[wall]
+    axes = parse_axes(vary)
+    result = sweep(data, axes, model=model)
+    assert not result.vectorised
+    _equal_per_variant(result, data, axes, model)
+    half = len(result.rows) // 2  # the riser's thickness (the first axis) moves every pitch
+    for one, other in zip(result.rows[:half], result.rows[half:]):
+        assert one["riser.thickness"] != other["riser.thickness"] and one["f0_hz"] != other["f0_hz"]
+
+
 @pytest.mark.parametrize("template,vary,bends", [
     (PAPER, ["cavity.diameter=1.5:9:4", "neck.diameter=1.2,2.1,3.3", "mold.draft_deg=0,8",
              "microphone.sample_rate_hz=9000,48000"], False),

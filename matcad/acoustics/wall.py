@@ -37,10 +37,12 @@ TABLE_AXES = {
     "outer": (1.3, 1.6, 2.0, 2.52, 3.2, 4.0),
     "top": (0.4, 0.8, 1.26, 2.0, 3.0),
     "length": (1.0, 2.0, 3.0, 4.5, 7.0),
-    "clamp_fraction": (0.0, 0.17, 0.34, 0.6, 0.8, 1.0),
+    "clamp_fraction": (0.0, 0.17, 0.34, 0.6, 0.7, 0.8, 0.9, 1.0),
 }
 """Cap shapes in cavity radii (outer radius, top thickness, cavity length) and the clamped fraction of the cavity
-height; the paper template (b/a 2.52, T/a 1.26, L/a 3.0, clamp 0.34) lies on the grid."""
+height; the paper template (b/a 2.52, T/a 1.26, L/a 3.0, clamp 0.34) lies on the grid. The clamp runs to a wall held
+over its whole height: a cap in a riser's pocket is clamped over the riser too (0.65-0.97 of the paper's cavity on
+a 1.5-3 mm riser; every 0.1 from 0.6, where the modes move fastest)."""
 QUASI_STATIC_RATIO = 3.0
 """The quasi-static wall holds where every wall mode with volume coupling lies ≥ 3× f (docs/physics.md)."""
 SIGNIFICANT_MODE = 0.02

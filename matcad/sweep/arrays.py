@@ -110,9 +110,16 @@ def eligible(base, model: str, axes=()) -> bool:
     (:func:`matcad.sweep.calibrated.eligible`)."""
     from matcad.spec import taxels
 
-    if base.reference is not None or base.riser is not None or base.taxel or len(taxels(base)) != 1:
+    if base.reference is not None or not one_sheet(base, axes) or base.taxel or len(taxels(base)) != 1:
         return False
     return calibrated.eligible(base, axes) if model == calibrated.MODEL else model in fast.VECTORISED
+
+
+def one_sheet(base, axes=()) -> bool:
+    """Whether every variant of ``base`` over ``axes`` has its neck in the plate's one sheet and its cap on it: no
+    [riser] in ``base`` and no axis in one (the arrays of :mod:`matcad.sweep.fast` carry neither the riser's length
+    of a neck nor its height of a pocketed cap's clamp)."""
+    return base.riser is None and not any(a.section == "riser" for a in axes)
 
 
 def _by_combination(chunk: GridChunk, axes: tuple[int, ...], positions, function, seen: dict) -> np.ndarray:

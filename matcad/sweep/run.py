@@ -166,7 +166,7 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
         except SpecError as exc:
             rows[i].update(status="invalid", reason=str(exc))
     ok = sorted(specs)
-    vectorised = model in fast.VECTORISED
+    vectorised = model in fast.VECTORISED and arrays.one_sheet(base, axes)  # a riser: each variant on its own
     if vectorised and ok:
         v = fast.from_specs([specs[i] for i in ok])
         f0 = fast.f0_hz(v, model)
