@@ -244,14 +244,17 @@ def board_bands(spec, predictions=None) -> dict:
 
 
 def board_report(spec, board, predictions) -> list[dict]:
-    """Per taxel of a board: name, position (mm), its own geometry and prediction, and where its needle is."""
+    """Per taxel of a board: name, position (mm), its own geometry and prediction, and where its needle is; with a
+    [riser], its neck's length, its cap's seat and flange (:func:`matcad.report.data.taxel_stack`)."""
     from dataclasses import asdict
 
     from matcad.parts.features import needle_tip_mm
+    from matcad.report.data import taxel_stack
 
     return [{"name": t.name, "x_mm": t.x, "y_mm": t.y, "cavity": asdict(t.cavity), "neck": asdict(t.neck),
-             "end_cap": asdict(t.end_cap), "needle": asdict(t.needle), "needle_tip_mm": list(needle_tip_mm(t)),
-             "prediction": p.to_dict()} for t, p in zip(board, predictions)]
+             "end_cap": asdict(t.end_cap), "needle": asdict(t.needle), "needle_tip_mm": list(needle_tip_mm(t))}
+            | (taxel_stack(spec, t) if spec.riser is not None else {}) | {"prediction": p.to_dict()}
+            for t, p in zip(board, predictions)]
 
 
 BUILD_STAGES = 8

@@ -80,7 +80,11 @@ def test_every_outputs_flag_has_a_part_and_every_part_a_flag():
 
 
 def test_registered_parts_are_unique_ordered_and_name_their_files():
+    from matcad.spec import Riser
+
     spec = load_spec(PAPER)
+    spec = dataclasses.replace(spec, riser=Riser(thickness=1.5))  # a condition of every part holds: each is made
+    assert all(p.when is None or p.when(spec) for p in registry.parts())
     names = [p.name for p in registry.parts()]
     assert len(names) == len(set(names))
     kinds = [p.kind for p in registry.parts()]
@@ -175,7 +179,8 @@ def test_every_registered_part_of_the_paper_template_renders_and_reads_back(pape
     out = result.out_dir
     assert_build_folder(spec, out)
     wanted = registry.wanted(spec)
-    assert {p.name for p in wanted} == {p.name for p in registry.parts()} - (
+    assert spec.riser is None  # a riser is cut for a [riser] only: tests/test_riser.py builds one
+    assert {p.name for p in wanted} == {p.name for p in registry.parts()} - {"riser"} - (
         set() if spec.spacer.style == "laser" else {"spacer"})
     for p in wanted:
         assert f"preview_{p.name}.png" in result.files

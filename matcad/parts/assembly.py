@@ -1,10 +1,11 @@
 """Every part in its assembled place (assembly frame: plate underside z = 0, neck axis = z), for assembly.step and
 the section (:func:`matcad.render.section.write_section_svg`).
 
-Stack, bottom to top: needle mount, spacers (gap = spacer.height), neck plate (0..l), locator guide around
-the cap's flange, the cap on the plate, the clamp guide resting on the flange (unclamped: the flange's
-squeeze shows as a gap that the bolts close; heights from :mod:`matcad.parts.stack`). build123d is imported
-inside the functions, as in every part module.
+Stack, bottom to top: needle mount, spacers (gap = spacer.height), neck plate (0..l), the riser bonded on it
+when the spec has one (l..l + r), locator guide around the caps' flanges, each cap on its seat (the riser where
+its neck runs on through it, else the plate, in a pocket of the riser), the clamp guide resting on the flanges
+(unclamped: the flange's squeeze shows as a gap that the bolts close; heights from :mod:`matcad.parts.stack`).
+build123d is imported inside the functions, as in every part module.
 """
 
 from __future__ import annotations
@@ -18,15 +19,16 @@ from matcad.parts.neck_plate import neck_plate
 from matcad.parts.needle_mount import needle, needle_mount, taxel_needle
 from matcad.parts.solid import flat_solid
 from matcad.parts.spacer import spacer
-from matcad.parts.stack import clamp_seat_z_mm
+from matcad.parts.riser import riser
+from matcad.parts.stack import cap_seat_z_mm, clamp_seat_z_mm, locator_z_mm
 
 if TYPE_CHECKING:
     from build123d import Compound
 
 
 def drilled(plate, neck_diameters: tuple[float, ...]):
-    """The neck plate as assembled: the pilot-cut necks (in board order) drilled to their finished diameters
-    (mm)."""
+    """The neck plate (or the riser) as assembled: the pilot-cut necks (in board order) drilled to their finished
+    diameters (mm)."""
     import dataclasses
 
     finished = iter(neck_diameters)
@@ -58,22 +60,25 @@ def assembled_parts(spec, made: dict | None = None, memo=_build) -> dict[str, ob
     def reuse(name, build, cap=None):
         return Pos(0, 0, 0) * made[name] if name in made else memo(name, cap, build)
 
-    plate_t = spec.neck.length
     parts = {
         "neck_plate": memo("neck_plate", None, lambda: flat_solid(drilled(neck_plate(spec),
                                                                           tuple(t.neck.diameter for t in board)))),
-        "guide_locator": memo("guide_locator", None, lambda: flat_solid(guide(spec, "locator"), plate_t)),
+    }
+    if spec.riser is not None:
+        through = tuple(t.neck.diameter for t in board if t.neck.riser)
+        parts["riser"] = memo("riser", None, lambda: flat_solid(drilled(riser(spec), through), spec.neck.length))
+    parts |= {
+        "guide_locator": memo("guide_locator", None, lambda: flat_solid(guide(spec, "locator"), locator_z_mm(spec))),
         "guide_clamp": memo("guide_clamp", None, lambda: flat_solid(guide(spec, "clamp"), clamp_seat_z_mm(spec))),
     }
     if len(board) == 1:
-        parts |= {"end_cap": Pos(0, 0, plate_t) * reuse("end_cap", lambda: end_cap(spec), cap=spec),
+        parts |= {"end_cap": Pos(0, 0, cap_seat_z_mm(spec)) * reuse("end_cap", lambda: end_cap(spec), cap=spec),
                   "needle_mount": reuse("needle_mount", lambda: needle_mount(spec)),
                   "needle": memo("needle", None, lambda: needle(spec))}
     else:
         caps = {t.name: taxel_spec(spec, t) for t in board}
-        parts |= {f"end_cap_{t.name}": Pos(t.x, t.y, plate_t) * memo(f"end_cap_{t.name}", caps[t.name],
-                                                                     lambda c=caps[t.name]: end_cap(c))
-                  for t in board}
+        parts |= {f"end_cap_{t.name}": Pos(t.x, t.y, cap_seat_z_mm(spec, t))
+                  * memo(f"end_cap_{t.name}", caps[t.name], lambda c=caps[t.name]: end_cap(c)) for t in board}
         parts["needle_mount"] = reuse("needle_mount", lambda: needle_mount(spec))
         parts |= {f"needle_{t.name}": memo(f"needle_{t.name}", None, lambda t=t: taxel_needle(t)) for t in board}
     if spec.spacer.style == "laser":

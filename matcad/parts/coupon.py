@@ -1,7 +1,7 @@
 """Test coupons that sweep the sizes that matter, so users can measure their own laser and printer.
 
-Laser coupons, one per sheet, each cut with that sheet's kerf: the neck plate's sheet sweeps neck holes
-d − 0.2 … d + 0.2 mm and dowel holes, the guide sheet dowel and bolt holes, the spacer sheet bolt holes; every
+Laser coupons, one per sheet, each cut with that sheet's kerf: the neck plate's sheet (and a riser's) sweeps neck
+holes d − 0.2 … d + 0.2 mm and dowel holes, the guide sheet dowel and bolt holes, the spacer sheet bolt holes; every
 hole engraved with its finished size. Printed coupon (mount process): needle bores at the needle's real angle θ
 and vertical dowel holes swept around their fit, ascending left to right. Pick the size that fits and feed the
 difference back (<sheet>.laser_kerf, fasteners fits).
@@ -37,7 +37,7 @@ LABEL_GAP_MM = 1.0
 BOLT_SWEEP_MM = (-0.2, -0.1, 0.0, 0.1, 0.2)
 PRINTED_COUPON_POSE = PrintPose(0.0, "flat underside")
 """How coupon_printed.stl is exported."""
-SHEET_ROWS = {"plate": ("neck", "dowel"), "guide": ("dowel", "bolt"), "spacer": ("bolt",)}
+SHEET_ROWS = {"plate": ("neck", "dowel"), "riser": ("neck", "dowel"), "guide": ("dowel", "bolt"), "spacer": ("bolt",)}
 """Which fits each sheet's coupon sweeps: the holes that sheet really carries."""
 
 

@@ -30,9 +30,16 @@ STOCK_ACRYLIC_MM = (1.0, 1.5, 1.59, 2.0, 2.5, 3.0, 3.18, 4.0, 4.76, 5.0, 6.0, 6.
 """Common cast/extruded acrylic sheet thicknesses: metric and 1/16-inch steps (mm)."""
 
 
-SHEETS = {"plate": "neck plate (thickness neck.length)", "guide": "guides (guide.thickness)",
-          "spacer": "spacers (spacer.height)"}
+SHEETS = {"plate": "neck plate (thickness neck.length)", "riser": "riser (riser.thickness)",
+          "guide": "guides (guide.thickness)", "spacer": "spacers (spacer.height)"}
 """Spec sections that are each one acrylic sheet, with its own kerf (``<section>.laser_kerf``)."""
+
+
+def sheet_row_key(flat) -> tuple[float, bool]:
+    """Under which row a laser part ``flat`` (:class:`matcad.parts.flat.Flat`) is listed where each sheet is named
+    once (what to caliper, ``laser.stock``): its thickness, parts of one thickness sharing a sheet; the riser's row
+    apart, its thickness being a neck's length and a flange's of its own (mm)."""
+    return flat.thickness, flat.sheet == "riser"
 
 
 def sheet_kerf_mm(spec, sheet: str) -> float:
@@ -45,6 +52,8 @@ def sheet_kerf_mm(spec, sheet: str) -> float:
 
 def sheet_thickness_mm(spec, sheet: str) -> tuple[float, bool]:
     """(thickness mm, measured) of ``sheet``: an example value counts as measured (:func:`sheet_status`)."""
+    if sheet == "riser":  # only a spec with a [riser] cuts one
+        return spec.riser.thickness, spec.riser.thickness_measured
     return {"plate": (spec.neck.length, spec.plate.thickness_measured),
             "guide": (spec.guide.thickness, spec.guide.thickness_measured),
             "spacer": (spec.spacer.height, spec.spacer.thickness_measured)}[sheet]
@@ -110,7 +119,7 @@ def is_stock_sheet(thickness_mm: float, tol_mm: float = 0.005) -> bool:
 
 
 def laser_stack_holes(spec) -> tuple:
-    """Dowel and bolt holes shared by every laser-cut layer of the stack (plate, guides)."""
+    """Dowel and bolt holes shared by every laser-cut layer of the stack (plate, riser, guides)."""
     from matcad.parts.flat import Hole
 
     fit = spec.fasteners.dowel_fit_laser

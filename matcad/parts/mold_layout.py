@@ -215,11 +215,18 @@ def _plan(cavity_d: float, outer_d: float, flange_d: float, tip_r: float, fill_p
     return best
 
 
+def cap_key(t) -> tuple:
+    """What makes the cap of the taxel ``t`` the cap it is: its cavity, its end cap, and whether its neck runs on
+    through a [riser] (else, where there is a riser, its cap sits in a pocket of it with a thicker flange:
+    :func:`matcad.spec.cap_flange_thickness_mm`; without a riser no neck runs through one, and a tube has no neck)."""
+    return t.cavity, t.end_cap, t.neck is not None and t.neck.riser
+
+
 def cap_groups(board) -> list[list]:
-    """The taxels of ``board`` grouped by identical cap (cavity and end cap), in order of first appearance."""
+    """The taxels of ``board`` grouped by identical cap (:func:`cap_key`), in order of first appearance."""
     groups: dict[tuple, list] = {}
     for t in board:
-        groups.setdefault((t.cavity, t.end_cap), []).append(t)
+        groups.setdefault(cap_key(t), []).append(t)
     return list(groups.values())
 
 
@@ -241,7 +248,7 @@ def pours_per_board(board, count: int) -> dict:
     slots = mold_slots(board, count)
     rows = []
     for g in cap_groups(board):
-        have = sum(1 for s in slots if (s.cavity, s.end_cap) == (g[0].cavity, g[0].end_cap))
+        have = sum(1 for s in slots if cap_key(s) == cap_key(g[0]))
         rows.append({"taxels": [t.name for t in g], "slots_per_mold": have,
                      "pours": -(-len(g) // have) if have else None})
     pours = [r["pours"] for r in rows]

@@ -2,10 +2,12 @@
 neck plate toward the mount: arithmetic of the spec (mm).
 
 Assembly frame: plate underside z = 0, neck axis = z. Bottom to top: the needle mount (its top face at
-z = −spacer.height, ``mount.thickness`` thick), the spacers, the neck plate (0 … l), the locator guide around the
-cap's flange, and the clamp guide resting on the flange (:func:`matcad.spec.cap_flange_thickness_mm`:
-guide thickness + squeeze) until the bolts press it down onto the locator. The parts, the design rules, the bill
-of materials and the fabrication plan all read these heights from here.
+z = −spacer.height, ``mount.thickness`` thick), the spacers, the neck plate (0 … l), the [riser] bonded on it when
+there is one (l … l + r), the locator guide around the caps' flanges, and the clamp guide resting on the flanges
+(:func:`matcad.spec.cap_flange_thickness_mm`: guide thickness + squeeze) until the bolts press it down onto the
+locator. A cap whose neck runs on through the riser sits on the riser; every other cap sits on the plate in a
+pocket of the riser, its flange r thicker, so every flange's top meets the clamp at one height. The parts, the
+design rules, the bill of materials and the fabrication plan all read these heights from here.
 """
 
 from __future__ import annotations
@@ -16,17 +18,36 @@ from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.materials import ACRYLIC_MODULUS_MPA
 from matcad.mechanics.plate import cantilever_deflection_mm, deflection_mm
 from matcad.parts.features import plate_bolt_positions_mm, plate_post_positions_mm
-from matcad.spec import cap_flange_diameter_mm, cap_flange_thickness_mm
+from matcad.spec import cap_flange_diameter_mm, cap_flange_thickness_mm, in_pocket, neck_length_mm
+
+
+def riser_thickness_mm(spec) -> float:
+    """Thickness r of the [riser] bonded on the plate; 0 without one (mm)."""
+    return spec.riser.thickness if spec.riser is not None else 0.0
+
+
+def locator_z_mm(spec) -> float:
+    """Height of the locator guide's underside: on the plate, or on the riser bonded on it: l + r (mm)."""
+    return spec.neck.length + riser_thickness_mm(spec)
+
+
+def cap_seat_z_mm(spec, t=None) -> float:
+    """Height of the face the cap of ``t`` (a :class:`matcad.spec.Taxel`; default ``spec``'s own) sits on: the
+    riser's top where its neck runs on through the riser, else the plate's top (in a pocket of a riser, or with no
+    riser) — the top of its neck either way (:func:`matcad.spec.neck_length_mm`; mm)."""
+    return neck_length_mm(spec, t)
 
 
 def clamp_seat_z_mm(spec) -> float:
-    """Height of the clamp guide's underside, resting on the unclamped flange: l + flange thickness (mm)."""
-    return spec.neck.length + cap_flange_thickness_mm(spec)
+    """Height of the clamp guide's underside, resting on the unclamped flanges: the cap's seat + its flange
+    thickness, l + r + guide + squeeze, the same for every cap of a board (mm)."""
+    return cap_seat_z_mm(spec) + cap_flange_thickness_mm(spec)
 
 
 def bolt_span_mm(spec) -> float:
     """Stack the bolts and dowels must span, from the mount's top face to the clamp guide's top face, the flange
-    unclamped: l + flange thickness + guide thickness + spacer height (mm)."""
+    unclamped: the clamp's seat (l + r + guide + squeeze, :func:`clamp_seat_z_mm`) + guide thickness + spacer
+    height (mm)."""
     return clamp_seat_z_mm(spec) + spec.guide.thickness + spec.spacer.height
 
 
@@ -36,13 +57,19 @@ def mount_depth_mm(spec) -> float:
 
 
 def squeeze_range_mm(spec, nominal: bool = False) -> tuple[float, float, float]:
-    """Flange squeeze the clamp can produce over the guide sheet's tolerance: (low, high, tolerance) in mm.
+    """Flange squeeze the clamp can produce over the sheets' tolerance: (low, high, tolerance) in mm, for the cap of
+    ``spec`` (a single-taxel spec: :func:`matcad.spec.taxel_spec` for a board's taxel).
 
     The flange is cast guide.thickness + squeeze thick; the clamp bottoms out on the locator, cut from the same
     sheet, so the real squeeze is the flange minus the real sheet (nominal ±
-    :func:`matcad.acoustics.uncertainty.sheet_tolerance_mm`). A measured sheet (or a template's example of one)
+    :func:`matcad.acoustics.uncertainty.sheet_tolerance_mm`). A cap in a pocket of a [riser]
+    (:func:`matcad.spec.in_pocket`) sits on the plate under the riser and the locator: its flange is cast
+    riser.thickness thicker, and the real squeeze is that flange minus both real sheets, so the tolerance is both
+    sheets' added (sheets of one batch may err the same way). A measured sheet (or a template's example of one)
     takes the calipering tolerance unless ``nominal``: what the sheet on the bench may really be until calipered."""
     tol = sheet_tolerance_mm(spec.guide.thickness, spec.guide.thickness_measured and not nominal)
+    if in_pocket(spec):
+        tol += sheet_tolerance_mm(spec.riser.thickness, spec.riser.thickness_measured and not nominal)
     s = spec.end_cap.flange_squeeze
     return s - tol, s + tol, tol
 

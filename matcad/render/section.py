@@ -80,11 +80,11 @@ class _Drawing:
 
 def _dimensions(spec, draw: _Drawing) -> None:
     from matcad.parts.features import needle_axis_mm
-    from matcad.spec import cap_height_mm
+    from matcad.spec import cap_height_mm, neck_length_mm
     from matcad.parts.stack import mount_depth_mm
 
     D, L = spec.cavity.diameter, spec.cavity.length
-    d, l = spec.neck.diameter, spec.neck.length
+    d, l = spec.neck.diameter, neck_length_mm(spec)  # the cap sits on its neck's top: plate, or riser run through
     od, top, gap = spec.end_cap.outer_diameter, spec.end_cap.top_thickness, spec.spacer.height
     f = draw.font
     z_top = l + cap_height_mm(spec)
@@ -125,15 +125,17 @@ def _label_points(spec) -> dict[str, tuple[float, float]]:
     """A point inside each part of the section to start its leader from (assembly frame x, z; mm)."""
     from matcad.parts.features import needle_tip_mm
     from matcad.spec import cap_height_mm
-    from matcad.parts.stack import clamp_seat_z_mm
+    from matcad.parts.stack import cap_seat_z_mm, clamp_seat_z_mm, locator_z_mm
 
     w, l, g, gap = spec.plate.width, spec.neck.length, spec.guide.thickness, spec.spacer.height
     tip_x, _, tip_z = needle_tip_mm(spec)
     t = math.radians(spec.needle.theta_deg)
     return {
-        "neck_plate": (-w / 2 + 1.0, l / 2), "guide_locator": (-w / 2 + 1.0, l + g / 2),
+        "neck_plate": (-w / 2 + 1.0, l / 2), "riser": (-w / 2 + 1.0, (l + locator_z_mm(spec)) / 2),
+        "guide_locator": (-w / 2 + 1.0, locator_z_mm(spec) + g / 2),
         "guide_clamp": (-w / 2 + 1.0, clamp_seat_z_mm(spec) + g / 2),
-        "end_cap": (-spec.end_cap.outer_diameter / 4, l + cap_height_mm(spec) - spec.end_cap.top_thickness / 2),
+        "end_cap": (-spec.end_cap.outer_diameter / 4,
+                    cap_seat_z_mm(spec) + cap_height_mm(spec) - spec.end_cap.top_thickness / 2),
         "needle_mount": (-w / 2 + 1.0, -gap - spec.mount.thickness / 2),
         "needle": (tip_x - 6.0 * math.cos(t), tip_z - 6.0 * math.sin(t)), "spacer": (w / 2 - 1.0, -gap / 2),
     }

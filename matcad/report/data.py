@@ -15,12 +15,12 @@ from typing import TYPE_CHECKING
 from matcad import __version__
 from matcad.acoustics.geometry import drafted_cavity_volume_mm3, drafted_tip_diameter_mm
 from matcad.parts.features import (SHEET_STATUSES, bolt_nominal_mm, cap_volume_mm3, plate_bolt_positions_mm,
-                                   plate_dowel_positions_mm, sheet_kerf_mm)
+                                   plate_dowel_positions_mm, sheet_kerf_mm, sheet_status)
 from matcad.parts.print_profile import PRINT_FILE
 from matcad.parts.stack import bolt_span_mm
 from matcad.report.fabrication import fabrication
 from matcad.report.files import manifest
-from matcad.spec import to_dict
+from matcad.spec import cap_flange_thickness_mm, neck_length_mm, to_dict
 
 if TYPE_CHECKING:
     from matcad.parts.flat import Flat
@@ -33,9 +33,11 @@ THREAD_ENGAGEMENT_PER_D = 2.0
 
 
 def as_built(spec) -> dict:
-    """Geometry as it will be made: drafted cavity, neck as cut and as finished (mm, mm³)."""
+    """Geometry as it will be made: drafted cavity, neck as cut and as finished, its length through the plate (and
+    the riser it runs on through), and the [riser] when there is one (:func:`riser_sheet`) (mm, mm³)."""
     cav = spec.cavity
     pilot = spec.plate.neck_pilot
+    riser = {"riser": riser_sheet(spec)} if spec.riser is not None else {}
     return {
         "cavity_diameter_mm": cav.diameter, "cavity_length_mm": cav.length, "draft_deg": spec.mold.draft_deg,
         "cavity_tip_diameter_mm": float(drafted_tip_diameter_mm(cav.diameter, cav.length, spec.mold.draft_deg)),
@@ -45,10 +47,30 @@ def as_built(spec) -> dict:
         "neck_diameter_as_cut_mm": spec.neck.diameter - spec.plate.pilot_undersize if pilot else spec.neck.diameter,
         "neck_diameter_finished_mm": spec.neck.diameter,
         "neck_finish": "drill pilot to size" if pilot else "as cut (kerf compensated)",
-        "neck_length_mm": spec.neck.length, "neck_length_measured": spec.plate.thickness_measured,
+        "neck_length_mm": neck_length_mm(spec), "neck_length_measured": spec.plate.thickness_measured,
         "laser_kerf_mm": sheet_kerf_mm(spec, "plate"),
         "cap_volume_mm3": cap_volume_mm3(spec),
-    }
+    } | riser
+
+
+def taxel_stack(spec, t) -> dict:
+    """Where the taxel ``t`` (a :class:`matcad.spec.Taxel`) sits in a stack with a [riser]: its neck's length (the
+    plate's sheet, and the riser's where it runs on through it), the face its cap sits on ('riser' or 'plate', in a
+    pocket of the riser) and its cap's flange thickness (mm)."""
+    return {"neck_length_mm": neck_length_mm(spec, t), "cap_seat": "riser" if t.neck.riser else "plate",
+            "cap_flange_thickness_mm": cap_flange_thickness_mm(spec, t)}
+
+
+def riser_sheet(spec) -> dict:
+    """The [riser] sheet as built (mm): its thickness and status, its kerf, the taxels whose necks run on through it,
+    those whose caps sit in its pockets, and every taxel's place in the stack (:func:`taxel_stack`)."""
+    from matcad.spec import taxels
+
+    board = taxels(spec)
+    return {"thickness_mm": spec.riser.thickness, "status": sheet_status(spec, "riser"),
+            "laser_kerf_mm": sheet_kerf_mm(spec, "riser"), "through": [t.name for t in board if t.neck.riser],
+            "pocketed": [t.name for t in board if not t.neck.riser],
+            "taxels": [{"name": t.name} | taxel_stack(spec, t) for t in board]}
 
 
 def bill_of_materials(spec, flats: list[Flat], mold: MoldLayout | None) -> dict:

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
-from matcad.parts.features import sheet_status
+from matcad.parts.features import sheet_row_key, sheet_status
 from matcad.parts.print_profile import PRINT_FILE
 from matcad.parts.registry import Kind, wanted
 from matcad.parts.stack import squeeze_range_mm
@@ -23,6 +23,8 @@ WHY_CALIPER = {
     "neck_plate": "its thickness is the neck length l, which sets f",
     "guide_locator": "the cap's flange is cast to this thickness + the squeeze: measure BEFORE printing the mold",
     "guide_clamp": "same sheet as the locator",
+    "riser": "it lengthens the necks run through it and thickens the pocketed caps' flanges: measure BEFORE printing "
+             "the mold",
     "spacer": "sets the gap under the neck mouth (the jet path)",
 }
 
@@ -32,28 +34,50 @@ def sheets_to_caliper(flats: list[Flat]) -> list[dict]:
     why it matters."""
     rows, seen = [], set()
     for flat in flats:
-        if flat.thickness in seen:  # parts listed plate, guides, spacer: a shared sheet keeps its first use
+        if sheet_row_key(flat) in seen:  # parts listed plate, guides, spacer: a shared sheet keeps its first use
             continue
-        seen.add(flat.thickness)
+        seen.add(sheet_row_key(flat))
         status = flat.thickness_status
         rows.append({"sheet_mm": flat.thickness, "part": flat.name, "sheet": flat.sheet, "status": status,
                      "measured": status == "measured",
                      "tolerance_mm": sheet_tolerance_mm(flat.thickness, status == "measured"),
-                     "before_mold": flat.name.startswith("guide"), "why": WHY_CALIPER.get(flat.name, "")})
+                     "before_mold": flat.sheet in ("guide", "riser"), "why": WHY_CALIPER.get(flat.name, "")})
     return rows
 
 
 def seal(spec: Spec) -> dict:
     """Flange squeeze over the guide sheet's tolerance (mm), as the rule ``seal.squeeze`` judges it; for a
-    template's example sheet also the range until the user calipers theirs (over the nominal tolerance)."""
-    lo, hi, tol = squeeze_range_mm(spec)
-    n_lo, n_hi, n_tol = squeeze_range_mm(spec, nominal=True)
-    status = sheet_status(spec, "guide")
-    return {"flange_squeeze_mm": spec.end_cap.flange_squeeze, "guide_sheet_mm": spec.guide.thickness,
+    template's example sheet also the range until the user calipers theirs (over the nominal tolerance). With a
+    [riser], ``caps`` gives it per seat ('riser': caps whose necks run on through it; 'plate': caps in its
+    pockets, over both sheets' tolerance), with the taxels and the flange thickness cast."""
+    out = _squeeze(spec)
+    if spec.riser is None:
+        return out
+    from matcad.spec import cap_flange_thickness_mm, taxel_spec, taxels
+
+    seats: dict[str, list] = {}
+    for t in taxels(spec):
+        seats.setdefault("riser" if t.neck.riser else "plate", []).append(t)
+    return out | {"caps": [{"seat": seat, "taxels": [t.name for t in group],
+                            "flange_mm": cap_flange_thickness_mm(spec, group[0]),
+                            "riser_sheet_mm": spec.riser.thickness} | _squeeze(taxel_spec(spec, group[0]))
+                           for seat, group in seats.items()]}
+
+
+def _squeeze(one: Spec) -> dict:
+    """:func:`seal` of the cap of the single-taxel spec ``one`` (mm): unverified while a sheet its squeeze hangs on
+    (the guide's; a pocketed cap's riser too) is a template's example."""
+    from matcad.spec import in_pocket
+
+    lo, hi, tol = squeeze_range_mm(one)
+    n_lo, n_hi, n_tol = squeeze_range_mm(one, nominal=True)
+    status = sheet_status(one, "guide")
+    unverified = status == "example" or (in_pocket(one) and sheet_status(one, "riser") == "example")
+    return {"flange_squeeze_mm": one.end_cap.flange_squeeze, "guide_sheet_mm": one.guide.thickness,
             "guide_measured": status == "measured", "guide_status": status, "sheet_tolerance_mm": tol,
             "squeeze_low_mm": lo, "squeeze_high_mm": hi,
-            "unverified_low_mm": n_lo if status == "example" else None,
-            "unverified_high_mm": n_hi if status == "example" else None,
+            "unverified_low_mm": n_lo if unverified else None,
+            "unverified_high_mm": n_hi if unverified else None,
             "nominal_tolerance_mm": n_tol}
 
 
@@ -115,13 +139,15 @@ def steps(spec: Spec, caliper: list[dict], print_files: list[str] = ()) -> list[
 
     o, out = spec.outputs, []
     board = len(taxels(spec)) > 1
+    riser = _riser_words(spec) if spec.riser is not None and o.neck_plate else None
 
     def step(where: str, files: list[str], do: str) -> None:
         out.append({"where": where, "files": files, "do": do})
 
     unmeasured = [c for c in caliper if c["status"] != "measured"]
     step("calipers", [], "Caliper every sheet (table above) in several places; enter the values (neck.length, "
-         "guide.thickness, spacer.height), set *_measured = true (and *_example = false) and rebuild"
+         + ("riser.thickness, " if spec.riser is not None else "")
+         + "guide.thickness, spacer.height), set *_measured = true (and *_example = false) and rebuild"
          + (" — still to caliper: " + ", ".join(f"{c['sheet_mm']:g} mm ({c['status']})" for c in unmeasured)
             if unmeasured else ""))
     step("laser + printer", ["matcad coupon"], "Cut one coupon per sheet (coupon_<sheet>.dxf) and print "
@@ -137,17 +163,20 @@ def steps(spec: Spec, caliper: list[dict], print_files: list[str] = ()) -> list[
              f"the {SHEETS[sheet]} from the {t:g} mm sheet, all nested in {SHEET_FILE.format(sheet=sheet)}, kerf "
              f"{sheet_kerf_mm(spec, sheet):g} mm (already compensated in the file: cut on the line; engrave first, "
              "then the inner cuts, the outlines last)")
+    if riser:
+        step("bench", ["neck_plate.dxf", "riser.dxf"], riser["bond"])
     drills = drill_plan(spec)
     if drills:
-        step("drill", ["neck_plate.dxf"], _drill_text(drills) + " (drill press, plate clamped flat, backed with "
-             "scrap)")
+        step("drill", ["neck_plate.dxf", *(["riser.dxf"] if riser else [])], _drill_text(drills)
+             + (riser["drill"] if riser else "") + " (drill press, plate clamped flat, backed with scrap)")
     printed = [part for part in wanted(spec, Kind.PRINTED)]
     if printed:
         jobs = list(print_files) or [PRINT_FILE.format(printer=spec.machine.printer)]
         step(f"printer ({spec.machine.printer})", [*jobs, *(f"{part.name}.stl" for part in printed)],
              _print_text(spec, [part.name for part in printed], jobs))
     if o.end_cap_mold:
-        step("bench", ["end_cap_mold_base.stl", "end_cap_mold_lid.stl"], "Cast the caps: follow the casting guide")
+        step("bench", ["end_cap_mold_base.stl", "end_cap_mold_lid.stl"], "Cast the caps: follow the casting guide"
+             + (riser["cast"] if riser else ""))
     if o.needle_mount:
         step("bench", ["needle_mount.stl"], "Fix the mount by its ears (4 x M3) to the bench or robot; press the "
              "dowels into it; slide " + ("each needle up the bore labelled with its taxel on the mount's top face "
@@ -156,13 +185,53 @@ def steps(spec: Spec, caliper: list[dict], print_files: list[str] = ()) -> list[
     stack = "spacers (spacer.dxf) over the bolt holes, " if spec.spacer.style == "laser" else ""
     seat = ("seat each cap in the locator hole engraved with its taxel, base face down on the plate"
             if board else "seat the cap in the locator, base face down on the plate")
-    step("bench", ["neck_plate.dxf", "guide_locator.dxf", "guide_clamp.dxf"], f"Stack on the mount: {stack}"
-         f"the neck plate, the locator guide; {seat}; lay the clamp guide over the flange"
+    plate = "the neck plate"
+    if riser:
+        plate, seat = "the neck plate with the riser bonded on it", riser["seat"]
+    step("bench", ["neck_plate.dxf", *(["riser.dxf"] if riser else []), "guide_locator.dxf", "guide_clamp.dxf"],
+         f"Stack on the mount: {stack}{plate}, the locator guide; {seat}; lay the clamp guide over the flange"
          f"{'s' if board else ''}; {spec.fasteners.bolt} bolts through all layers into the mount, tightened "
          "evenly until the clamp sits on the locator (that closes the flange squeeze)")
     step("bench", ["report.md"], "Blow air through the needle and record: the tone should sit in the predicted "
          "band; calibrate with `matcad calibrate`")
     return out
+
+
+def _riser_words(spec: Spec) -> dict[str, str]:
+    """What the [riser] adds to the steps (mm): ``bond`` (a step of its own: the riser solvent-bonded on the plate
+    on the dowels, before any neck is drilled), ``drill`` (each neck that runs on through it drilled through both
+    sheets in one pass), ``cast`` (the pocketed caps' thicker flanges) and ``seat`` (where each cap sits)."""
+    from matcad.spec import cap_flange_thickness_mm, taxels
+
+    board = taxels(spec)
+    through = [t for t in board if t.neck.riser]
+    pocketed = [t for t in board if not t.neck.riser]
+
+    def names(group) -> str:
+        return ", ".join(t.name for t in group)
+
+    cut = ("holes are undersize pilots in both sheets, drilled through both after bonding" if spec.plate.neck_pilot
+           else "holes are cut to size in both sheets: before the cement sets, push a pin or drill shank of each "
+           "neck's size through riser and plate together to check they line up")
+    bond = (f"Bond the {spec.riser.thickness:g} mm riser (riser.dxf) on the neck plate before any neck is drilled: "
+            "both on the two dowels through their dowel holes (they go together one way only), engraving up, "
+            "pressed flat; run acrylic solvent cement (water-thin, e.g. Weld-On 4) into the joint along the outline "
+            "with a needle applicator and let it wick between the sheets, keeping it out of the pockets' and necks' "
+            f"edges (it crazes a cut edge); pull the dowels once it grips, let it cure 24 h. The through-neck "
+            f"{cut}" + (f" ({names(through)})" if through else " (none: no neck runs through this riser)"))
+    drill = (f"; {names(through)}: {'their necks run' if len(through) > 1 else 'its neck runs'} on through the "
+             "bonded riser: drill through riser and plate in one pass from the riser's side, so the two holes "
+             "cannot be offset" if through else "")
+    drill += (f"; {names(pocketed)}: down through the plate at the bottom of {'their' if len(pocketed) > 1 else 'its'}"
+              " riser pocket" if pocketed else "")
+    cast = "".join(f"; {names(g)}: flange{'s' if len(g) > 1 else ''} cast {cap_flange_thickness_mm(spec, g[0]):g} "
+                   f"mm thick ({what})" for g, what in ((pocketed, f"in the riser's pockets: {spec.riser.thickness:g}"
+                                                         " mm thicker, down to the plate"), (through, "on the riser"))
+                   if g)
+    seat = ("seat each cap in the locator hole engraved with its taxel, base face down"
+            + (f"; {names(pocketed)} down through the riser's pockets onto the plate" if pocketed else "")
+            + (f"; {names(through)} on the riser" if through else ""))
+    return {"bond": bond, "drill": drill, "cast": cast, "seat": seat}
 
 
 def _print_text(spec: Spec, names: list[str], jobs: list[str]) -> str:

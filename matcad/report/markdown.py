@@ -45,12 +45,8 @@ def _fabrication_markdown(f: dict | None) -> list[str]:
     status = {"measured": "yes", "example": "**no** (example value)", "nominal": "**no**"}
     lines += [f"| {c['sheet_mm']:g} | {c['part']} | ±{c['tolerance_mm']:.2f} | {status[c['status']]} | "
               f"{cell(c['why'])} |" for c in f["caliper"]]
-    lines += ["", f"Seal: the flange is cast {s['guide_sheet_mm']:g} + {s['flange_squeeze_mm']:g} mm thick; over the "
-              f"guide sheet's ±{s['sheet_tolerance_mm']:.2f} mm the clamp squeezes it {s['squeeze_low_mm']:+.2f} … "
-              f"{s['squeeze_high_mm']:+.2f} mm ({s['guide_status']} sheet)"
-              + (f"; **unverified**: until you caliper your own sheet it may be {s['unverified_low_mm']:+.2f} … "
-                 f"{s['unverified_high_mm']:+.2f} mm (nominal ±{s['nominal_tolerance_mm']:.2f} mm)."
-                 if s["guide_status"] == "example" else ".")]
+    for c in s.get("caps", [s]):
+        lines += ["", _seal_markdown(c)]
     lines += ["", "Steps, in order:", ""]
     lines += [f"{i}. **{cell(s['where'])}** — {cell(s['do'])}" + (f" (`{'`, `'.join(s['files'])}`)" if s["files"] else "")
               for i, s in enumerate(f["steps"], 1)]
@@ -59,6 +55,21 @@ def _fabrication_markdown(f: dict | None) -> list[str]:
         lines += [f"| {cell(x['fit'])} | {x['hole_mm']:.3f} | {x['pin_mm']:.3f} | {x['clearance_mm']:+.3f} |"
                   for x in f["fits"]]
     return lines
+
+
+def _seal_markdown(s: dict) -> str:
+    """The seal of one cap (:func:`matcad.report.fabrication.seal`), or of a [riser]'s caps on one seat."""
+    pocket = s.get("seat") == "plate"
+    where = "in the riser's pockets" if pocket else "on the riser"
+    who = f" of {', '.join(s['taxels'])} ({where})" if "seat" in s else ""
+    cast = f" + {s['riser_sheet_mm']:g}" if pocket else ""
+    sheets = "guide and riser sheets'" if pocket else "guide sheet's"
+    return (f"Seal{who}: the flange is cast {s['guide_sheet_mm']:g} + {s['flange_squeeze_mm']:g}{cast} mm thick; over "
+            f"the {sheets} ±{s['sheet_tolerance_mm']:.2f} mm the clamp squeezes it {s['squeeze_low_mm']:+.2f} … "
+            f"{s['squeeze_high_mm']:+.2f} mm ({s['guide_status']} {'guide ' if pocket else ''}sheet)"
+            + (f"; **unverified**: until you caliper your own sheet it may be {s['unverified_low_mm']:+.2f} … "
+               f"{s['unverified_high_mm']:+.2f} mm (nominal ±{s['nominal_tolerance_mm']:.2f} mm)."
+               if s["unverified_low_mm"] is not None else "."))
 
 
 def _casting_markdown(c: dict | None) -> list[str]:
@@ -123,6 +134,17 @@ def _files_to_make_markdown(sheets: list[dict] | None, job: dict | None) -> list
     return lines
 
 
+def _riser_markdown(riser: dict | None) -> list[str]:
+    """The [riser] sheet's line of As built: its sheet, and each taxel's neck length, cap seat and flange (mm)."""
+    if not riser:
+        return []
+    seat = {"riser": "cap on the riser", "plate": "cap on the plate in a pocket of the riser"}
+    return [f"- riser: {riser['thickness_mm']:g} mm sheet ({riser['status']}, kerf {riser['laser_kerf_mm']:g} mm) "
+            f"bonded on the plate; necks through it: {', '.join(riser['through']) or 'none'}; "
+            + "; ".join(f"{t['name']} neck l {t['neck_length_mm']:g} mm, {seat[t['cap_seat']]}, flange "
+                        f"{t['cap_flange_thickness_mm']:g} mm" for t in riser["taxels"])]
+
+
 def _taxels_markdown(board: list[dict] | None) -> list[str]:
     """A board's taxels: position, geometry, needle and unloaded prediction, one row each (mm, deg, Hz)."""
     if not board:
@@ -166,6 +188,7 @@ def sections(r: dict) -> str:
              f"- neck: {ab['neck_diameter_finished_mm']:g} mm finished ({ab['neck_finish']}; cut at "
              f"{ab['neck_diameter_as_cut_mm']:g} mm, kerf {ab['laser_kerf_mm']:g} mm), length "
              f"{ab['neck_length_mm']:g} mm ({'measured' if ab['neck_length_measured'] else 'nominal'})",
+             *_riser_markdown(ab.get("riser")),
              f"- neck area {p['neck_area_mm2']:.4f} mm², A·l/V {p['neck_air_ratio']:.3f}, c "
              f"{p['speed_of_sound_m_s']:.2f} m/s", "",
              f"## Prediction{scope}", "", "| model | f0 [Hz] | valid | failed checks |", "|---|---:|---|---|"]

@@ -152,20 +152,42 @@ def jet_interference(spec) -> list[Finding]:
 def plate_ligaments(spec) -> list[Finding]:
     """Acrylic between two neck holes, and between a neck and a bolt or dowel hole, at least
     :data:`LIGAMENT_PER_SHEET` plate sheets (neck.length): a warning per pair, with the ligament and the limit.
-    The plate's bending under mechanics.max_force_n is not checked: the plate rests on four corner spacers with
-    the caps pressed between them and holes in it; no closed form for that case is carried here."""
+    The same in a [riser] (:func:`riser_ligaments`). The plate's bending under mechanics.max_force_n is
+    :mod:`matcad.rules.plate`'s."""
+    return _ligaments(spec, "neck plate", spec.neck.length, lambda t: ("neck", t.neck.diameter), lambda t: t.name)
+
+
+def riser_ligaments(spec) -> list[Finding]:
+    """:func:`plate_ligaments` in the [riser]: between its taxel holes (a neck run on through it, else the pocket of
+    a cap's flange, :func:`matcad.parts.riser.riser_holes`) and to its bolt and dowel holes, at least
+    :data:`LIGAMENT_PER_SHEET` riser sheets (riser.thickness); nothing without a riser."""
+    if spec.riser is None:
+        return []
+    from matcad.parts.riser import riser_holes
+
+    def hole(t):
+        h = riser_holes(spec, (t,))[0]
+        return ("neck" if t.neck.riser else "pocket"), h.finished_mm
+
+    return _ligaments(spec, "riser", spec.riser.thickness, hole, lambda t: f"{t.name}'s {hole(t)[0]}")
+
+
+def _ligaments(spec, sheet: str, thickness: float, hole, other) -> list[Finding]:
+    """Webs of a sheet ``thickness`` thick (mm) between every two taxels' holes and from each to the stack's bolt and
+    dowel holes, each below :data:`LIGAMENT_PER_SHEET` sheets a warning: ``hole(taxel)`` is (what, finished diameter
+    mm) of a taxel's hole in ``sheet``, ``other(taxel)`` how a message names it as the second of a pair."""
     out = []
     board = _board(spec)
-    limit = LIGAMENT_PER_SHEET * spec.neck.length
-    pairs = [(a.name, b.name, math.hypot(a.x - b.x, a.y - b.y) - (a.neck.diameter + b.neck.diameter) / 2)
+    limit = LIGAMENT_PER_SHEET * thickness
+    pairs = [(a, other(b), math.hypot(a.x - b.x, a.y - b.y) - (hole(a)[1] + hole(b)[1]) / 2)
              for i, a in enumerate(board) for b in board[i + 1:]]
-    pairs += [(t.name, f"{what} hole at ({x:.2f}, {y:.2f})", math.hypot(t.x - x, t.y - y) - (t.neck.diameter + size) / 2)
+    pairs += [(t, f"{what} hole at ({x:.2f}, {y:.2f})", math.hypot(t.x - x, t.y - y) - (hole(t)[1] + size) / 2)
               for t in board for what, x, y, size in _stack_holes(spec)]
     for a, b, web in pairs:
         if web < limit:
             out.append(Finding("board.ligament", "warning", round(web, 4), round(limit, 4),
-                               f"neck plate: {web:.2f} mm of acrylic between {a}'s neck and {b} (< {limit:g} mm, "
-                               f"{LIGAMENT_PER_SHEET:g} x the {spec.neck.length:g} mm sheet)",
+                               f"{sheet}: {web:.2f} mm of acrylic between {a.name}'s {hole(a)[0]} and {b} "
+                               f"(< {limit:g} mm, {LIGAMENT_PER_SHEET:g} x the {thickness:g} mm sheet)",
                                f"move the taxels apart ({_position_fields(spec)}) or enlarge plate.width / "
                                "plate.depth"))
     return out
@@ -221,4 +243,4 @@ def bore_crossings(spec) -> list[Finding]:
     return out
 
 
-RULES = (plate_fit, spacing, jet_interference, plate_ligaments, mold_slots, bore_crossings)
+RULES = (plate_fit, spacing, jet_interference, plate_ligaments, riser_ligaments, mold_slots, bore_crossings)

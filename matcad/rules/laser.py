@@ -7,7 +7,7 @@ import math
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
 from matcad.export.sheets import BED_MARGIN_MM, kit_sheets, usable_bed_mm
 from matcad.parts.catalogue import laser_parts
-from matcad.parts.features import is_stock_sheet
+from matcad.parts.features import is_stock_sheet, sheet_row_key
 from matcad.parts.flat import DrawnSizeError, Flat, drawn_holes
 from matcad.rules.finding import Finding, fits_bed
 
@@ -40,7 +40,8 @@ def feature_and_web(spec) -> list[Finding]:
     return out
 
 
-SHEET_THICKNESS_FIELDS = {"plate": "neck.length", "guide": "guide.thickness", "spacer": "spacer.height"}
+SHEET_THICKNESS_FIELDS = {"plate": "neck.length", "riser": "riser.thickness", "guide": "guide.thickness",
+                          "spacer": "spacer.height"}
 """The spec field that holds each sheet's thickness."""
 HOLE_FIELDS = {"neck": "neck.diameter", "neck_pilot": "plate.pilot_undersize", "dowel": "fasteners.dowel_diameter",
                "bolt": "fasteners.bolt", "cap": "end_cap.outer_diameter"}
@@ -96,9 +97,9 @@ def stock_thickness(spec) -> list[Finding]:
     out = []
     seen = set()
     for flat in laser_parts(spec):
-        if flat.thickness in seen:
+        if sheet_row_key(flat) in seen:
             continue
-        seen.add(flat.thickness)
+        seen.add(sheet_row_key(flat))
         if flat.thickness_status == "example":
             tol = sheet_tolerance_mm(flat.thickness, False)
             field = SHEET_THICKNESS_FIELDS[flat.sheet]
@@ -116,8 +117,9 @@ def stock_thickness(spec) -> list[Finding]:
                                "use a stock sheet, or measure yours and mark it *_measured = true"))
         else:
             tol = sheet_tolerance_mm(flat.thickness, False)
-            # the plate's thickness is the neck length l, which sets f: nominal is not good enough there
-            level = "warning" if flat.name == "neck_plate" else "info"
+            # the plate's thickness is the neck length l, which sets f: nominal is not good enough there (nor in the
+            # riser: the necks run on through it)
+            level = "warning" if flat.sheet in ("plate", "riser") else "info"
             out.append(Finding("laser.stock", level, flat.thickness, round(tol, 3),
                                f"{flat.name}: nominal {flat.thickness:g} mm cast acrylic may be off by "
                                f"+-{tol:.2f} mm (ISO 7823-1); measure it and mark it measured",

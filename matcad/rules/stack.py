@@ -1,11 +1,12 @@
-"""Rules for the assembled stack: needle clearance and placement, fasteners in printed parts."""
+"""Rules for the assembled stack: needle clearance and placement, the flanges' seal, the riser, fasteners in printed
+parts."""
 
 from __future__ import annotations
 
 from matcad.parts.features import needle_tip_mm
 from matcad.parts.stack import mount_depth_mm, squeeze_range_mm
 from matcad.rules.finding import Finding
-from matcad.spec import cap_flange_thickness_mm
+from matcad.spec import cap_flange_thickness_mm, in_pocket
 
 PAPER_THETA_DEG = (30.0, 75.0)
 PAPER_Y_MM = (0.0, 3.47)
@@ -72,20 +73,36 @@ def needle_window(spec) -> list[Finding]:
 
 CALIPER_GUIDE = ("caliper the guide sheet BEFORE printing the mold, enter guide.thickness and set "
                  "guide.thickness_measured = true")
+CALIPER_RISER = ("caliper the riser sheet BEFORE printing the mold, enter riser.thickness and set "
+                 "riser.thickness_measured = true")
+
+
+def _sheet_words(section) -> str:
+    """How a sheet's thickness is known, in words: measured, a template's example value, or nominal."""
+    if not section.thickness_measured:
+        return "nominal, ISO 7823-1 cast sheet"
+    return "an example value" if section.thickness_example else "measured"
 
 
 def seal_squeeze(spec) -> list[Finding]:
-    """The cap's flange must stay squeezed whatever the guide sheet really is, and not be crushed. A template's
-    example value (``guide.thickness_example``) is judged as the calipered sheet it stands for, and is reported
-    unverified: the squeeze over the nominal sheet's tolerance, as a warning, until the user enters their own."""
+    """The cap's flange must stay squeezed whatever the guide sheet really is, and not be crushed. A cap in a pocket
+    of a [riser] (:func:`matcad.spec.in_pocket`) is squeezed over both the guide's and the riser's tolerance
+    (:func:`matcad.parts.stack.squeeze_range_mm`). A template's example value (``guide.thickness_example``,
+    ``riser.thickness_example``) is judged as the calipered sheet it stands for, and is reported unverified: the
+    squeeze over the nominal sheets' tolerance, as a warning, until the user enters their own."""
     lo, hi, tol = squeeze_range_mm(spec)
     g = spec.guide
     flange = cap_flange_thickness_mm(spec)
-    example = g.thickness_measured and g.thickness_example
-    what = ("an example value" if example else "measured") if g.thickness_measured else "nominal, ISO 7823-1 cast sheet"
-    span = f"{lo:+.2f} … {hi:+.2f} mm over the guide sheet's ±{tol:.2f} mm ({g.thickness:g} mm {what})"
+    pocket = [spec.riser] if in_pocket(spec) else []
+    example = any(s.thickness_measured and s.thickness_example for s in (g, *pocket))
+    span = f"{lo:+.2f} … {hi:+.2f} mm over the guide sheet's ±{tol:.2f} mm ({g.thickness:g} mm {_sheet_words(g)})"
+    if pocket:
+        span = (f"{lo:+.2f} … {hi:+.2f} mm over the guide and riser sheets' ±{tol:.2f} mm ({g.thickness:g} mm "
+                f"{_sheet_words(g)} + {spec.riser.thickness:g} mm {_sheet_words(spec.riser)}: the cap sits in a "
+                "pocket of the riser)")
     if lo <= 0:
         fix = (CALIPER_GUIDE if not g.thickness_measured else
+               CALIPER_RISER if pocket and not spec.riser.thickness_measured else
                f"raise end_cap.flange_squeeze above the {tol:g} mm measuring tolerance")
         return [Finding("seal.squeeze", "error" if spec.outputs.end_cap_mold else "warning", round(lo, 4), "> 0",
                         f"the {spec.end_cap.flange_squeeze:g} mm flange squeeze can be swallowed: squeeze {span}; "
@@ -94,18 +111,41 @@ def seal_squeeze(spec) -> list[Finding]:
     if strain > MAX_FLANGE_STRAIN:
         return [Finding("seal.squeeze", "warning", round(strain, 3), MAX_FLANGE_STRAIN,
                         f"the flange may be crushed by {100 * strain:.0f} % (squeeze {span})",
-                        "reduce end_cap.flange_squeeze, or caliper the guide sheet")]
+                        "reduce end_cap.flange_squeeze, or caliper the guide " + ("and riser sheets" if pocket
+                                                                                  else "sheet"))]
     if example:
         n_lo, n_hi, n_tol = squeeze_range_mm(spec, nominal=True)
+        named = [(name, s) for name, s in [("guide", g)] + [("riser", r) for r in pocket]
+                 if s.thickness_measured and s.thickness_example]
+        one = len(named) == 1
+        nominal = "a nominal sheet's" if one else "nominal sheets'"
         return [Finding("seal.squeeze", "warning", [round(n_lo, 4), round(n_hi, 4)], "> 0",
-                        f"unverified: guide.thickness = {g.thickness:g} mm is the template's example of a calipered "
-                        f"sheet, not yours; until you caliper it the flange squeeze is {n_lo:+.2f} … {n_hi:+.2f} mm "
-                        f"over a nominal sheet's ±{n_tol:.2f} mm (ISO 7823-1): the clamp may never touch the "
-                        f"flange (calipered, {lo:+.2f} … {hi:+.2f} mm)",
-                        CALIPER_GUIDE + " and guide.thickness_example = false")]
+                        "unverified: " + " and ".join(f"{n}.thickness = {s.thickness:g} mm" for n, s in named)
+                        + (" is the template's example of a calipered sheet" if one else
+                           " are the template's examples of calipered sheets")
+                        + f", not yours; until you caliper {'it' if one else 'them'} the flange squeeze is "
+                        f"{n_lo:+.2f} … {n_hi:+.2f} mm over {nominal} ±{n_tol:.2f} mm (ISO 7823-1): the clamp may "
+                        f"never touch the flange (calipered, {lo:+.2f} … {hi:+.2f} mm)",
+                        "; ".join({"guide": CALIPER_GUIDE, "riser": CALIPER_RISER}[n]
+                                  + f" and {n}.thickness_example = false" for n, _ in named))]
     return [Finding("seal.squeeze", "info", [round(lo, 4), round(hi, 4)], "> 0",
                     f"flange squeeze {span}: {100 * lo / flange:.1f}-{100 * strain:.1f} % of the "
                     f"{flange:g} mm flange", "")]
+
+
+def riser_idle(spec) -> list[Finding]:
+    """A [riser] no taxel's neck runs on through (no ``neck.riser``) lengthens no neck: it only puts every cap in a
+    pocket and thickens every flange by its thickness, a sheet to cut and bond for nothing (a warning)."""
+    from matcad.spec import taxels
+
+    if spec.riser is None or any(t.neck.riser for t in taxels(spec)):
+        return []
+    return [Finding("riser.idle", "warning", 0, ">= 1 neck through it",
+                    f"riser: no taxel's neck runs on through the {spec.riser.thickness:g} mm riser, so it lengthens "
+                    "none and only sets every cap in a pocket of it, its flange "
+                    f"{spec.riser.thickness:g} mm thicker",
+                    "set neck_riser = true on the taxels that need the longer neck ([[taxel]], or neck.riser), or "
+                    "remove the [riser] table")]
 
 
 def printed_fits(spec) -> list[Finding]:
@@ -115,6 +155,6 @@ def printed_fits(spec) -> list[Finding]:
     return []
 
 
-RULES = (needle_clearance, needle_bore, needle_window, seal_squeeze, printed_fits)
+RULES = (needle_clearance, needle_bore, needle_window, seal_squeeze, riser_idle, printed_fits)
 TAXEL_RULES = (needle_clearance, needle_window, seal_squeeze)
 """The rules that read one taxel's own geometry: a board runs them on each taxel (:func:`matcad.rules.check`)."""

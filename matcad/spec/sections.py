@@ -243,7 +243,8 @@ class Outputs(Section):
     table: ClassVar[str] = "outputs"
 
     end_cap_mold: bool = param("STL + STEP mold base and lid", default=True, kind="bool")
-    neck_plate: bool = param("DXF + SVG neck plate", default=True, kind="bool")
+    neck_plate: bool = param("DXF + SVG neck plate, and the [riser] bonded on it when there is one", default=True,
+                             kind="bool")
     guides: bool = param("DXF + SVG locator and clamp guides", default=True, kind="bool")
     spacers: bool = param("DXF + SVG spacers (when spacer.style = 'laser')", default=True, kind="bool")
     needle_mount: bool = param("STL + STEP needle mount", default=True, kind="bool")
