@@ -13,8 +13,9 @@ Brent's method (scipy.optimize.brentq). ``neck.length`` is a sheet: it is chosen
 until one passes the rules. ``neck.riser`` (a spec with a [riser]) is the taxel's own choice between its two neck
 lengths: on each sheet the continuous fields are solved with the neck through the riser and with the cap in a
 pocket of it, and the way whose passing root lies nearest the start (least |t|: the least change of the continuous
-fields) is kept. Without continuous fields the discrete choice whose f0 is nearest the target is kept. Frequencies
-Hz, lengths mm.
+fields) is kept; a way whose cap the cap mechanics cannot press as [mechanics] asks (:func:`unpressable`: a pocket
+of a thick riser leaves little cap above the clamp) is passed over when the spec's loaded band needs them. Without
+continuous fields the discrete choice whose f0 is nearest the target is kept. Frequencies Hz, lengths mm.
 """
 
 from __future__ import annotations
@@ -259,6 +260,23 @@ def discrete_choices(spec, vary) -> list[list[dict]]:
     return [[{SHEET: sheet, RISER: way} for way in ways] for sheet in sheets]
 
 
+def unpressable(spec) -> str | None:
+    """Why the cap mechanics cannot press ``spec``'s cap over its [mechanics] travel (mm), when its loaded band needs
+    them (no [calibration]): a cap in a thick riser's pocket has that much less of it above the clamp
+    (:func:`matcad.mechanics.case.cap_case`). None when it can, or when a calibration gives the rise."""
+    from matcad.acoustics.design import calibration
+    from matcad.mechanics.case import cap_case
+    from matcad.spec import SpecError
+
+    if calibration(spec) is not None:
+        return None
+    try:
+        cap_case(spec)
+    except SpecError as exc:
+        return str(exc)
+    return None
+
+
 def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -> Solution:
     """Solve ``spec``'s f0 = ``target_hz`` (Hz) varying the fields of ``vary`` ({field: (lo, hi) mm or None for
     :func:`default_range`}); see the module docstring. Raises :class:`Unreachable` (no geometry in range reaches
@@ -276,7 +294,7 @@ def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -
                          "board)")
     model, base = chosen_model(spec)
     continuous = {p: (r or default_range(spec, p)) for p, r in vary.items() if p not in DISCRETE}
-    candidates, reached, evaluations, failed = [], [], 0, None
+    candidates, reached, evaluations, failed, unpressed = [], [], 0, None, None
     for group in discrete_choices(spec, vary):
         for choice in group:
             changed = {k: v for k, v in choice.items() if v != get_field(spec, k)}
@@ -300,6 +318,10 @@ def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -
                 if errors(findings):
                     failed = failed or (candidate, findings)
                     continue
+                why = unpressable(candidate) if RISER in vary else None
+                if why:
+                    unpressed = unpressed or why
+                    continue
                 candidates.append((distance, candidate, findings))
                 break
         if candidates and continuous:
@@ -308,6 +330,8 @@ def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -
         if failed:
             bad = "; ".join(f"{f.id}: {f.message}" for f in errors(failed[1]))
             raise RulesFailed(f"every solution for {target_hz:g} Hz breaks a design rule (first: {bad})", failed[1])
+        if unpressed:
+            raise Unreachable(f"--target-hz {target_hz:g}: every solution's cap is too short for its press: {unpressed}")
         raise Unreachable(_unreachable_text(spec, target_hz, vary, continuous, reached, model))
     # the least change of the continuous fields (|t|), or, discrete fields alone, the f0 nearest the target (ln)
     _, best, findings = min(candidates, key=lambda c: c[0])
