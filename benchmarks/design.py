@@ -116,7 +116,7 @@ rows are 96 kHz boards whose plate stays flat on its posts (docs/arrays.md); the
 wall (the three-field one lets the cavity reach 12 mm in a 7.95 mm cap)."""
 
 
-def _most_that_fit(s, n, band, vary):
+def most_that_fit(s, n, band, vary):
     """(allocation of the most taxels <= n that fit, the message when n did not)."""
     import re
 
@@ -155,7 +155,7 @@ def capacity(forces=(5.0,), seeds=5, mic_distance_m=None):
         for force in forces:
             s = spec_mod.from_dict(tomllib.loads(BOARD_BASE.format(sheet=sheet, force=force, rate=rate)))
             t0 = time.perf_counter()
-            a, why = _most_that_fit(s, n, band, parse_vary(s, vary))
+            a, why = most_that_fit(s, n, band, parse_vary(s, vary))
             took = time.perf_counter() - t0
             if a is None:
                 print(f"| {rate / 1e3:g} | {force:g} | {sheet:g} | {' '.join(vary)} | {n} | 0 | - | - | {took:.0f} "
@@ -272,7 +272,7 @@ def capacity_sweep(forces, path):
             for force in forces:
                 s = spec_mod.from_dict(tomllib.loads(BOARD_BASE.format(sheet=sheet, force=force, rate=rate)))
                 t0 = time.perf_counter()
-                a, _ = _most_that_fit(s, ask, band, parse_vary(s, list(vary)))
+                a, _ = most_that_fit(s, ask, band, parse_vary(s, list(vary)))
                 bands = () if a is None else tuple(b.loaded_hz for b in a.bands)
                 flat = a is not None and not any(f.id == "plate.bending" for f in a.findings)
                 results.append((rate, sheet, vary, force, bands, flat))

@@ -17,7 +17,9 @@ def arguments(cmd) -> None:
     cmd.add_argument("--target-hz", type=float, metavar="F", help="target unloaded f0 (Hz) of one taxel")
     cmd.add_argument("--vary", nargs="+", metavar="FIELD[=LO:HI]",
                      help="fields the solver may change: neck.diameter, cavity.diameter, cavity.length (optional "
-                          "range in mm) and neck.length (a stock sheet); with --taxels default neck.diameter")
+                          "range in mm), neck.length (the plate's stock sheet) and, with a [riser], neck.riser (each "
+                          "taxel's neck through the riser or its cap in a pocket of it: the way needing the least "
+                          "change of the others); with --taxels default neck.diameter")
     cmd.add_argument("--taxels", type=int, metavar="N", help="design an array of N taxels with disjoint bands")
     cmd.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"),
                      help="with --taxels: the band (Hz) they share")

@@ -26,7 +26,7 @@ import time
 from dataclasses import dataclass
 
 from matcad.design import RulesFailed, Unreachable
-from matcad.design.solve import CONTINUOUS, SHEET, solve
+from matcad.design.solve import CONTINUOUS, RISER, SHEET, field_text, solve
 
 TARGET_MARGIN = 1e-3
 """Relative precision of each taxel's f0 target (the bisection stops there: 5 Hz at 5 kHz)."""
@@ -35,9 +35,10 @@ STEP_UP = 0.03
 LAYOUT_STEPS_PER_MM = 10
 """The layout's pitches are whole tenths of a millimetre: necks at multiples of 0.05 mm, readable in the spec."""
 PER_TAXEL = {"neck.diameter": "neck_diameter", "cavity.diameter": "cavity_diameter",
-             "cavity.length": "cavity_length"}
+             "cavity.length": "cavity_length", RISER: "neck_riser"}
 """Fields a [[taxel]] entry may set for itself that `design --taxels` varies (the neck length is the plate's sheet,
-shared); each entry also gets the needle flow that matches its pitch (:func:`matched_flow_l_min`)."""
+shared; ``neck.riser`` picks the taxel's one of the board's two neck lengths when there is a [riser]); each entry
+also gets the needle flow that matches its pitch (:func:`matched_flow_l_min`)."""
 
 
 @dataclass(frozen=True)
@@ -69,7 +70,8 @@ class Allocation:
         lines = [f"{self.spec.name}: {len(self.bands)} taxels in {self.band_hz[0]:g}-{self.band_hz[1]:g} Hz, "
                  f"guard {self.guard_hz:.0f} Hz, {self.seconds:.1f} s"]
         for b, s in zip(self.bands, self.solutions):
-            fields = ", ".join(f"{k} {v[1]:.4g} mm" for k, v in s.fields.items())
+            fields = ", ".join(f"{k + ' ' if k != RISER else ''}{field_text(k, v[1], s.spec)}"
+                               for k, v in s.fields.items())
             lines.append(f"  {b.name} at ({b.x_mm:g}, {b.y_mm:g}) mm: f0 {b.f0_hz:.0f} Hz, unloaded "
                          f"{b.unloaded_hz[0]:.0f}-{b.unloaded_hz[1]:.0f} Hz, loaded {b.loaded_hz[0]:.0f}-"
                          f"{b.loaded_hz[1]:.0f} Hz; {fields}")
@@ -197,7 +199,8 @@ def matched_flow_l_min(spec, f0_hz: float) -> float:
 def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = None,
              progress=None) -> Allocation:
     """Allocate ``n`` disjoint bands in [``lo_hz``, ``hi_hz``] and solve one taxel for each (see the module
-    docstring); ``vary`` as for :func:`matcad.design.solve.solve`, continuous per-taxel fields only;
+    docstring); ``vary`` as for :func:`matcad.design.solve.solve`: per-taxel fields (at least one continuous; and
+    ``neck.riser``, each taxel's way through the [riser]), and ``neck.length``, the plate's sheet;
     ``progress(taxels placed, n)`` (:mod:`matcad.progress`) is told as each is placed. Raises
     :class:`Unreachable` when the bands do not fit, :class:`RulesFailed` when the array breaks a design rule."""
     from matcad.listening import guard_hz
@@ -209,11 +212,12 @@ def allocate(spec, n: int, lo_hz: float, hi_hz: float, vary, name: str | None = 
         raise ValueError(f"--taxels {n} invalid, must be 2-{MAX_TAXELS} (a board of one is --target-hz)")
     if not (math.isfinite(lo_hz) and math.isfinite(hi_hz) and 0 < lo_hz < hi_hz):
         raise ValueError(f"--band {lo_hz:g} {hi_hz:g} invalid, must be 0 < LO < HI (Hz)")
-    bad = [k for k in vary if k not in (*CONTINUOUS, SHEET)]
-    if bad or set(vary) == {SHEET}:
-        raise ValueError(f"--vary {(bad or [SHEET])[0]}: with --taxels the per-taxel fields vary "
-                         f"({', '.join(CONTINUOUS)}; at least one), and {SHEET}, the plate's sheet shared by every "
-                         "taxel, among the stock sheets")
+    bad = [k for k in vary if k not in (*CONTINUOUS, SHEET, RISER)]
+    if bad or not set(vary) & set(CONTINUOUS):
+        raise ValueError(f"--vary {(bad or list(vary))[0]}: with --taxels the per-taxel fields vary "
+                         f"({', '.join(CONTINUOUS)}; at least one, each taxel's f0 is bisected onto its band; and "
+                         f"{RISER}, each taxel's neck through the [riser] or not), and {SHEET}, the plate's sheet "
+                         "shared by every taxel, among the stock sheets")
     if SHEET in vary:
         return _over_sheets(spec, n, lo_hz, hi_hz, {k: r for k, r in vary.items() if k != SHEET}, name, progress,
                             start_time)

@@ -10,7 +10,12 @@ route in log space, x_i(t) = x_i0 · exp(t · g_i) with g_i = ∂ln f/∂ln x_i 
 to first order), restricted to every field's range, scans f along it and refines the root nearest the start with
 Brent's method (scipy.optimize.brentq). ``neck.length`` is a sheet: it is chosen among the stock thicknesses
 (:data:`matcad.parts.features.STOCK_ACRYLIC_MM`) nearest the start first, and the continuous fields solved for each
-until one passes the rules. Frequencies Hz, lengths mm.
+until one passes the rules. ``neck.riser`` (a spec with a [riser]) is the taxel's own choice between its two neck
+lengths: on each sheet the continuous fields are solved with the neck through the riser and with the cap in a
+pocket of it, and the way whose passing root lies nearest the start (least |t|: the least change of the continuous
+fields) is kept; a way whose cap the cap mechanics cannot press as [mechanics] asks (:func:`unpressable`: a pocket
+of a thick riser leaves little cap above the clamp) is passed over when the spec's loaded band needs them. Without
+continuous fields the discrete choice whose f0 is nearest the target is kept. Frequencies Hz, lengths mm.
 """
 
 from __future__ import annotations
@@ -27,7 +32,10 @@ from matcad.prediction.anchor import ANCHORS, anchor, available
 
 CONTINUOUS = ("neck.diameter", "cavity.diameter", "cavity.length")
 SHEET = "neck.length"
-FIELDS = CONTINUOUS + (SHEET,)
+RISER = "neck.riser"
+"""The taxel's neck through the spec's [riser] (neck.length + riser.thickness long) or its cap in a pocket of it."""
+DISCRETE = (SHEET, RISER)
+FIELDS = CONTINUOUS + DISCRETE
 SCAN_POINTS = 33
 """Points scanned along the route for sign changes of f − target (f may not be monotonic near a wall mode)."""
 XTOL = 1e-10
@@ -64,11 +72,23 @@ class Solution:
     def to_text(self) -> str:
         """What `matcad design --target-hz` prints: f0 by predict against the target (Hz), the error, each varied
         field's start and solution (mm), the run time and the notes."""
-        fields = ", ".join(f"{k} {a:g} -> {b:.4g} mm" for k, (a, b) in self.fields.items())
+        fields = ", ".join(f"{k} {field_text(k, a) if k == RISER else format(a, 'g')} -> "
+                           f"{field_text(k, b, self.spec)}" for k, (a, b) in self.fields.items())
         lines = [f"{self.spec.name}: f0 = {self.f0_hz:.1f} Hz by predict ({self.model}) for target "
                  f"{self.target_hz:g} Hz, error {100 * self.error:+.3f} %; {fields}; {self.seconds:.2f} s, "
                  f"{self.evaluations} model evaluations"]
         return "\n".join(lines + [f"  note: {n}" for n in self.notes])
+
+
+def field_text(path: str, value, spec=None) -> str:
+    """One varied field's value as `design` prints it: a length (mm), or for :data:`RISER` the taxel's way, with
+    its neck's length when the solved ``spec`` is given (its plate sheet, plus its [riser] through it; mm)."""
+    if path != RISER:
+        return f"{value:.4g} mm"
+    from matcad.spec import neck_length_mm
+
+    way = "neck through the riser" if value else "cap in a riser pocket"
+    return way if spec is None else f"{way}, neck {neck_length_mm(spec):.4g} mm"
 
 
 def get_field(spec, path: str) -> float:
@@ -77,11 +97,12 @@ def get_field(spec, path: str) -> float:
 
 
 def with_fields(spec, values: dict):
-    """``spec`` with dotted fields set, validated (SpecError on an impossible geometry, e.g. neck > cavity)."""
+    """``spec`` with dotted fields set (lengths mm, :data:`RISER` a bool), validated (SpecError on an impossible
+    geometry, e.g. neck > cavity)."""
     sections: dict[str, dict] = {}
     for path, value in values.items():
         section, name = path.split(".")
-        sections.setdefault(section, {})[name] = float(value)
+        sections.setdefault(section, {})[name] = value if isinstance(value, bool) else float(value)
     return dataclasses.replace(spec, **{s: dataclasses.replace(getattr(spec, s), **v) for s, v in sections.items()})
 
 
@@ -114,12 +135,17 @@ def parse_vary(spec, items, allowed=FIELDS) -> dict[str, tuple[float, float] | N
             raise ValueError(f"--vary {item}: field must be one of {', '.join(allowed)}{why}")
         if path in out:
             raise ValueError(f"--vary {path} given twice")
+        if path == RISER and spec.riser is None:
+            raise ValueError(f"--vary {item}: {RISER} chooses whether a taxel's neck runs on through a riser sheet, "
+                             "and this spec has none; add a [riser] table: [riser] thickness = T (mm, a stock acrylic "
+                             "sheet stacked on the plate under the caps)")
         if not rng:
             out[path] = None
             continue
-        if path == SHEET:
-            raise ValueError(f"--vary {item}: {SHEET} is a sheet, chosen among the stock thicknesses; give it "
-                             "without a range")
+        if path in DISCRETE:
+            what = ("a sheet, chosen among the stock thicknesses" if path == SHEET
+                    else "a choice, the neck through the riser or the cap in a pocket of it")
+            raise ValueError(f"--vary {item}: {path} is {what}; give it without a range")
         try:
             lo, hi = (float(v) for v in rng.split(":"))
         except ValueError:
@@ -225,6 +251,32 @@ def stock_order(spec) -> list[float]:
     return sorted(STOCK_ACRYLIC_MM, key=lambda t: (abs(math.log(t / spec.neck.length)), t))
 
 
+def discrete_choices(spec, vary) -> list[list[dict]]:
+    """The discrete fields' values :func:`solve` tries, one group per plate sheet (:func:`stock_order` when
+    ``vary`` has :data:`SHEET`, else the spec's; mm), each group the taxel's ways through the [riser] (both, the
+    start's first, when ``vary`` has :data:`RISER`; else the start's) — as {field: value} to set on the spec."""
+    sheets = stock_order(spec) if SHEET in vary else [spec.neck.length]
+    ways = [spec.neck.riser, not spec.neck.riser] if RISER in vary else [spec.neck.riser]
+    return [[{SHEET: sheet, RISER: way} for way in ways] for sheet in sheets]
+
+
+def unpressable(spec) -> str | None:
+    """Why the cap mechanics cannot press ``spec``'s cap over its [mechanics] travel (mm), when its loaded band needs
+    them (no [calibration]): a cap in a thick riser's pocket has that much less of it above the clamp
+    (:func:`matcad.mechanics.case.cap_case`). None when it can, or when a calibration gives the rise."""
+    from matcad.acoustics.design import calibration
+    from matcad.mechanics.case import cap_case
+    from matcad.spec import SpecError
+
+    if calibration(spec) is not None:
+        return None
+    try:
+        cap_case(spec)
+    except SpecError as exc:
+        return str(exc)
+    return None
+
+
 def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -> Solution:
     """Solve ``spec``'s f0 = ``target_hz`` (Hz) varying the fields of ``vary`` ({field: (lo, hi) mm or None for
     :func:`default_range`}); see the module docstring. Raises :class:`Unreachable` (no geometry in range reaches
@@ -241,45 +293,55 @@ def solve(spec, target_hz: float, vary: dict[str, tuple[float, float] | None]) -
         raise ValueError("--target-hz solves one taxel: give a single-taxel spec (--taxels N --band LO HI designs a "
                          "board)")
     model, base = chosen_model(spec)
-    sheets = stock_order(spec) if SHEET in vary else [spec.neck.length]
-    continuous = {p: (r or default_range(spec, p)) for p, r in vary.items() if p != SHEET}
-    candidates, reached, evaluations, failed = [], [], 0, None
-    for sheet in sheets:
-        try:
-            s = with_fields(spec, {SHEET: sheet}) if sheet != spec.neck.length else spec
-        except ValueError:
-            continue
-        if continuous:
-            route = _Route(s, continuous, model, base)
-            roots, seen = _roots(route, target_hz)
-            evaluations += route.evaluations
-            reached.append((sheet, seen))
-            solved = [route.at(t)[0] for t in roots]
-        else:
-            solved = [s]
-            evaluations += 1
-            reached.append((sheet, (model_f0(s, model, base),) * 2))
-        for candidate in solved:
-            findings = check(candidate)
-            if errors(findings):
-                failed = failed or (candidate, findings)
+    continuous = {p: (r or default_range(spec, p)) for p, r in vary.items() if p not in DISCRETE}
+    candidates, reached, evaluations, failed, unpressed = [], [], 0, None, None
+    for group in discrete_choices(spec, vary):
+        for choice in group:
+            changed = {k: v for k, v in choice.items() if v != get_field(spec, k)}
+            try:
+                s = with_fields(spec, changed) if changed else spec
+            except ValueError:
                 continue
-            candidates.append((candidate, findings))
-            break
+            if continuous:  # (|t|, spec) of each root along the route, nearest the start first
+                route = _Route(s, continuous, model, base)
+                roots, seen = _roots(route, target_hz)
+                evaluations += route.evaluations
+                reached.append((choice, seen))
+                solved = [(abs(t), route.at(t)[0]) for t in roots]
+            else:
+                f0 = model_f0(s, model, base)
+                evaluations += 1
+                reached.append((choice, (f0, f0)))
+                solved = [(abs(math.log(f0 / target_hz)), s)]
+            for distance, candidate in solved:
+                findings = check(candidate)
+                if errors(findings):
+                    failed = failed or (candidate, findings)
+                    continue
+                why = unpressable(candidate) if RISER in vary else None
+                if why:
+                    unpressed = unpressed or why
+                    continue
+                candidates.append((distance, candidate, findings))
+                break
         if candidates and continuous:
             break  # the stock sheet nearest the start that works
     if not candidates:
         if failed:
             bad = "; ".join(f"{f.id}: {f.message}" for f in errors(failed[1]))
             raise RulesFailed(f"every solution for {target_hz:g} Hz breaks a design rule (first: {bad})", failed[1])
+        if unpressed:
+            raise Unreachable(f"--target-hz {target_hz:g}: every solution's cap is too short for its press: {unpressed}")
         raise Unreachable(_unreachable_text(spec, target_hz, vary, continuous, reached, model))
-    # sheet alone: the stock sheet whose f0 is nearest the target
-    best, findings = min(candidates, key=lambda c: abs(math.log(model_f0(c[0], model, base) / target_hz))) \
-        if not continuous else candidates[0]
+    # the least change of the continuous fields (|t|), or, discrete fields alone, the f0 nearest the target (ln)
+    _, best, findings = min(candidates, key=lambda c: c[0])
     p = predict(best, mechanics=False)
     fields = {k: (get_field(spec, k), get_field(best, k)) for k in vary}
-    notes = () if continuous else (f"{SHEET} alone takes stock values only: the nearest gives {p.f0_hz:.0f} Hz; add "
-                                   "a continuous field to --vary to hit the target",)
+    takes = {SHEET: "stock values", RISER: "the neck's two lengths (through the riser or not)"}
+    alone = [k for k in DISCRETE if k in vary]
+    notes = () if continuous else (f"{' and '.join(alone)} alone take{'s' * (len(alone) == 1)} "
+                                   f"{' and '.join(takes[k] for k in alone)} only: the nearest gives {p.f0_hz:.0f} "
+                                   "Hz; add a continuous field to --vary to hit the target",)
     return Solution(best, target_hz, p.f0_hz, p.model, fields, time.perf_counter() - start, evaluations,
                     tuple(findings), notes)
 
@@ -289,5 +351,9 @@ def _unreachable_text(spec, target_hz, vary, continuous, reached, model) -> str:
     span = (f"{min(r[0] for r in finite):.0f}-{max(r[1] for r in finite):.0f} Hz" if finite else "no valid geometry")
     ranges = ", ".join(f"{p} {a:g}-{b:g} mm" for p, (a, b) in continuous.items())
     sheets = f"{SHEET} among the stock sheets" if SHEET in vary else f"{SHEET} = {spec.neck.length:g} mm"
+    if RISER in vary:
+        sheets += f", the neck through the {spec.riser.thickness:g} mm riser or the cap in a pocket of it"
+    elif spec.riser is not None and spec.neck.riser:
+        sheets += f" + the {spec.riser.thickness:g} mm riser the neck runs through"
     return (f"--target-hz {target_hz:g} unreachable: varying {ranges or ''}{', ' if ranges else ''}{sheets} "
             f"({model}) reaches {span}; widen a range (--vary FIELD=LO:HI) or vary another field")
