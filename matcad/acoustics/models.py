@@ -51,6 +51,20 @@ def mount_end_correction_mm(neck_radius_mm, gap_mm, gap_radius_mm):
     return baffled_end_correction_mm(a) + radial
 
 
+def radiating_gap_end_correction_mm(neck_radius_mm, gap_mm, wavenumber_per_mm):
+    """Outer end correction of the mount's mouth (mm) when the gap radiates outward at its far edge, where
+    :func:`mount_end_correction_mm` releases the pressure: the baffled correction plus the mass reactance of an
+    outgoing cylindrical wave p ∝ H₀⁽²⁾(kr) in the gap from r = a + h (time e^{iωt}; Morse & Ingard 1968,
+    Theoretical Acoustics §7.1), a²/(2h)·Re[H₀⁽²⁾(x)/H₁⁽²⁾(x)]/x at x = k(a + h). For x → 0 it is the radial
+    inertance out to R = 2/(k e^γ) ≈ 1.123/k, whatever the gap's extent (docs/physics.md)."""
+    from scipy.special import hankel2
+
+    a = np.asarray(neck_radius_mm, dtype=float)
+    h = np.asarray(gap_mm, dtype=float)
+    x = np.asarray(wavenumber_per_mm, dtype=float) * (a + h)
+    return baffled_end_correction_mm(a) + a * a / (2.0 * h) * (hankel2(0, x) / hankel2(1, x)).real / x
+
+
 def mouth_end_correction_mm(mouth, neck_radius_mm, gap_mm, gap_radius_mm):
     """Outer end correction for the spec's ``neck.mouth`` choice (mm)."""
     if mouth == "baffled":
