@@ -56,3 +56,15 @@ def test_predict_warns_where_the_edge_moves_f0_past_the_models_error():
         p = predict(d)
         failed = sum(not ok for ok in p.models[p.model].checks.values())
         assert int(warning_count(d, p.f0_hz, failed)) == len(p.warnings)
+
+
+def test_the_hankel_ratio_without_scipy_special_is_scipys():
+    """The quadrature (predict's path loads no scipy.special) and the table the end correction interpolates, against
+    scipy's Hankel functions over the x = k(a + h) a taxel meets."""
+    from scipy.special import hankel2
+
+    x = np.geomspace(0.02, 5.0, 60)
+    exact = hankel2(0, x) / hankel2(1, x)
+    np.testing.assert_allclose(models.hankel2_ratio(x), exact, rtol=1e-5)
+    radial = (models.radiating_gap_end_correction_mm(1.0, 1.0, x / 2) - models.baffled_end_correction_mm(1.0)) * 2
+    np.testing.assert_allclose(radial, exact.real / x, rtol=3e-4)
