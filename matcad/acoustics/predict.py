@@ -173,6 +173,9 @@ def mount_edge_ratio(d: Design, res):
 
     from matcad.acoustics.models import radiating_gap_end_correction_mm
 
+    if d.mouth != "mount":  # a sweep's variants share one mouth
+        return 1.0 if np.ndim(res.neck_area) == 0 else np.ones(np.shape(res.neck_area))
+
     line = registry.model("transmission_line")
     released = np.asarray(line.f0_hz(res), dtype=float)
     mouth_r = res.neck_mouth_radius
@@ -183,7 +186,7 @@ def mount_edge_ratio(d: Design, res):
         delta = radiating_gap_end_correction_mm(mouth_r, d.gap_mm, k) * to_mean
         f = np.asarray(line.f0_hz(replace(res, outer_correction=delta)), dtype=float)
     ratio = f / released
-    return np.where(d.mouth == "mount", ratio, 1.0) if np.ndim(ratio) else (float(ratio) if d.mouth == "mount" else 1.0)
+    return ratio if np.ndim(ratio) else float(ratio)
 
 
 def mount_edge_warned(d: Design, ratio):

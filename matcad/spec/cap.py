@@ -27,7 +27,7 @@ def cap_flange_thickness_mm(spec, t=None) -> float:
 def neck_length_mm(spec, t=None) -> float:
     """Length of the neck of ``t`` (default ``spec``'s own): the plate's sheet (neck.length), plus the riser's where
     the neck runs on through a [riser] (neck.riser; mm)."""
-    through = spec.riser is not None and (spec if t is None else t).neck.riser
+    through = spec.riser is not None and not in_pocket(spec, t)
     return spec.neck.length + (spec.riser.thickness if through else 0.0)
 
 
