@@ -18,7 +18,9 @@ FEM_ELEMENTS = 64
 """P2 elements of the 1-D FEM route: 1e-7 Hz from the line's root on the template (docs/tube.md)."""
 MOUTH_SPREAD = 0.25
 """Assumed ± fraction on the fipple mouth's correction (Rayleigh's aperture conductance for a window in a curved
-wall next to a jet; no measurement of it is at hand): a part of the band, named as an assumption."""
+wall next to a jet; no measurement of it is at hand): a part of the band, named as an assumption. A second route
+(potential flow through the printed window, benchmarks/fipple_window.py) puts the template's window at ~1.21 × it:
+inside +25 %, the wall's depth left out by the model (docs/tube.md)."""
 
 
 @dataclass(frozen=True)
