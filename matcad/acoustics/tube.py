@@ -61,6 +61,10 @@ class TubeDesign:
     air: Air
     wall: WallMaterial
     tube_wall: float
+    edge_angle: float
+    """The labium's outer bevel from vertical (deg, the spec's ``tube.edge_angle``)."""
+    block_length: float
+    """The block under the window (mm, the spec's ``tube.block_length``)."""
 
     @property
     def column_mm(self) -> float:
@@ -84,7 +88,8 @@ def tube_design(spec) -> TubeDesign:
         cap_outer_diameter=spec.end_cap.outer_diameter, cap_top_thickness=spec.end_cap.top_thickness,
         cap_clamp_height=cap_flange_thickness_mm(spec), air=Air(spec.air.temperature_c, spec.air.speed_of_sound),
         wall=WallMaterial(w.model, w.shear_modulus_mpa, w.khz_modulus_factor, w.loss_factor,
-                          spec.silicone.density_g_cm3 * 1000.0), tube_wall=t.wall)
+                          spec.silicone.density_g_cm3 * 1000.0), tube_wall=t.wall,
+        edge_angle=t.edge_angle, block_length=t.block_length)
 
 
 def mouth_correction_mm(td: TubeDesign, factor: float = 1.0) -> float:
@@ -171,19 +176,32 @@ def exterior_fem(td: TubeDesign, level: int | None = None):
     (:func:`flanged_phase_correction_mm`); unflanged with a thin wall, its correction tends to Levine & Schwinger's
     0.6133 a as ka → 0, rising with the wall's thickness towards the flanged value (docs/tube.md). ``level``:
     elements across the bore's radius (default fem's). Returns a :class:`matcad.acoustics.fem.FemResult` (f in Hz).
-    Raises ValueError for 'fipple' (a window in the tube's wall: 3-D)."""
+    Raises ValueError for 'fipple' (a window in the tube's wall: 3-D, :func:`window_fem`)."""
     from matcad.acoustics import fem
 
     exteriors = {"flanged": "baffled", "unflanged": "unflanged"}
     if td.mouth not in exteriors:
         raise ValueError(f"tube.mouth = '{td.mouth}' has no axisymmetric exterior FEM (a fipple's window in the "
-                         f"tube's wall is 3-D), must be one of 'flanged', 'unflanged': docs/tube.md")
+                         f"tube's wall is 3-D: window_fem), must be one of 'flanged', 'unflanged': docs/tube.md")
     a = td.bore_diameter / 2
     g = fem.FemGeometry(neck_radius=a, neck_length=td.length, cavity_radius=a, cavity_tip_radius=a,
                         cavity_length=td.cap_depth, mouth=exteriors[td.mouth],
                         wall=td.tube_wall if td.mouth == "unflanged" else 0.0)
     c = speed_of_sound(td.air)
     return fem.solve(g, 2 * math.pi * line_hz(td) / (c * 1e3), level or fem.DEFAULT_LEVEL, speed_of_sound_m_s=c)
+
+
+def window_fem(td: TubeDesign, level: int | None = None) -> tuple[float, float]:
+    """The fipple window's end correction δ (mm) by the 3-D potential-flow FEM of the printed mouth
+    (:func:`matcad.acoustics.mouth3d.end_correction`, scikit-fem; ``level`` cells across the bore's radius, default
+    its own), and the rigid-capped line's f1 (Hz) with that δ in place of Rayleigh's aperture. ValueError for
+    another mouth."""
+    from matcad.acoustics import mouth3d
+
+    if td.mouth != "fipple":
+        raise ValueError(f"tube.mouth = '{td.mouth}' has no window: exterior_fem resolves it")
+    delta = mouth3d.end_correction(mouth3d.from_tube(td), level or mouth3d.DEFAULT_LEVEL).delta_mm
+    return delta, line_hz(td, correction_factor=delta / mouth_correction_mm(td))
 
 
 def phase_correction_mm(td: TubeDesign, f_hz: float, mode: int = 1) -> float:

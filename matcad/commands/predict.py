@@ -54,11 +54,12 @@ def run(args) -> int:
 
 
 def _tube(spec, forces, args) -> int:
-    """A fipple tube's prediction (docs/tube.md): its own routes; ``--model fem [--fem-level N]`` adds the
-    axisymmetric exterior FEM (a flanged or unflanged mouth), the MAT ladder's other models do not apply."""
+    """A fipple tube's prediction (docs/tube.md): its own routes; ``--model fem [--fem-level N]`` adds the FEM
+    rung (the axisymmetric exterior of a flanged or unflanged mouth, the 3-D window of a fipple), the MAT ladder's
+    other models do not apply."""
     if args.model not in (None, "fem"):
         raise ValueError(f"--model {args.model} is a MAT taxel's model; a kind = 'tube' spec has its own routes "
-                         "(docs/tube.md): leave it out, or --model fem for the exterior FEM of a flanged or unflanged tube")
+                         "(docs/tube.md): leave it out, or --model fem for the FEM of its mouth")
     from matcad.acoustics.fem import DEFAULT_LEVEL
     from matcad.prediction.tube import predict_tube
 

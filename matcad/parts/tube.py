@@ -20,13 +20,9 @@ import math
 
 from matcad.parts.solid import cylinder_up, frustum_up
 from matcad.spec import cap_flange_diameter_mm
+from matcad.spec.tube import EDGE_LAND_MM, SEAT_CONE_DEG
 
 SEAT_THICKNESS_MM = 1.5
-SEAT_CONE_DEG = 30.0
-"""The cone under the cap's seat, from vertical: the FDM overhang limit of :mod:`matcad.rules.printing`."""
-EDGE_LAND_MM = 0.1
-"""The labium's tip sits this far outside the bore's wall line: a plane through the wall line would touch the bore
-at one point (no valid solid), and no printer makes a sharper edge than this anyway."""
 NEEDLE_SEAT_DEPTH_FRACTION = 0.5
 """The needle's seat reaches this fraction of the block; the windway runs the rest."""
 

@@ -16,11 +16,18 @@ from matcad.acoustics.wall import HYBRID_BAND, mode_near
 
 FEM_ELEMENTS = 64
 """P2 elements of the 1-D FEM route: 1e-7 Hz from the line's root on the template (docs/tube.md)."""
-MOUTH_SPREAD = 0.25
-"""Assumed ± fraction on the fipple mouth's correction (Rayleigh's aperture conductance for a window in a curved
-wall next to a jet; no measurement of it is at hand): a part of the band, named as an assumption. A second route
-(potential flow through the printed window, benchmarks/fipple_window.py) puts the template's window at ~1.21 × it:
-inside +25 %, the wall's depth left out by the model (docs/tube.md)."""
+MOUTH_STUDY_BORE_MM = 4.0
+MOUTH_STUDY = ((1.2, 3.5, 2.0, 20.0), (0.8, 3.5, 2.0, 20.0), (2.0, 3.5, 2.0, 20.0), (1.2, 2.5, 2.0, 20.0),
+               (1.2, 3.5, 1.2, 20.0), (1.2, 3.5, 3.0, 20.0), (1.2, 3.5, 2.0, 10.0), (1.2, 3.5, 2.0, 30.0),
+               (1.2, 2.0, 1.0, 20.0), (0.8, 3.9, 3.5, 15.0))
+"""The ten windows :data:`MOUTH_RANGE` was measured on: (tube.wall, windway_width B, edge_distance W mm,
+edge_angle deg) on a bore of :data:`MOUTH_STUDY_BORE_MM`; the template's own first."""
+MOUTH_RANGE = (0.80, 1.40)
+"""The fipple window's true δ over Rayleigh's thin aperture (the model's): measured by the 3-D potential-flow FEM
+of the printed mouth (:func:`matcad.acoustics.tube.window_fem`, level 8) over ten windows, 0.84–1.32 (the wall's
+depth lengthens δ, the labium's bevels and the curved wall shorten it); the FEM's own error at level 8, up to
+−4.5 % (the unflanged pipe against the axisymmetric FEM), widens the top to 1.40 (benchmarks/fipple_window.py,
+docs/tube.md). A part of the band."""
 
 
 @dataclass(frozen=True)
@@ -89,15 +96,34 @@ def _wall_results(td: air.TubeDesign):
     return results, notes
 
 
+def _outside_mouth_study(td: air.TubeDesign) -> list[str]:
+    """A note for each of the window's proportions (per bore radius; the bevel in deg) outside those of
+    :data:`MOUTH_STUDY`, where :data:`MOUTH_RANGE` is not measured."""
+    a, a_study = td.bore_diameter / 2, MOUTH_STUDY_BORE_MM / 2
+    design = {"tube.wall": (td.tube_wall / a, a), "tube.windway_width": (td.windway_width / a, a),
+              "tube.edge_distance": (td.edge_distance / a, a), "tube.edge_angle": (td.edge_angle, 1.0)}
+    notes = []
+    for column, (field, (value, unit)) in enumerate(design.items()):
+        scale = 1.0 if field == "tube.edge_angle" else a_study
+        lo, hi = (f(w[column] / scale for w in MOUTH_STUDY) for f in (min, max))
+        if not lo - 1e-9 <= value <= hi + 1e-9:
+            notes.append(f"{field} = {value * unit:g} lies outside the windows the mouth's range was measured on "
+                         f"({lo * unit:g}-{hi * unit:g} for this bore): the band may not hold the window's "
+                         "correction; `predict --model fem` solves it")
+    return notes
+
+
 def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePrediction:
     """The prediction of a ``kind = "tube"`` spec, with f at ``forces_n`` (N) from the cap mechanics (FElupe,
-    imported only then); with ``fem_level`` (elements across the bore's radius) also the axisymmetric exterior
-    FEM's f1 of a flanged or unflanged tube (scikit-fem, :func:`matcad.acoustics.tube.exterior_fem`; ValueError for
-    a fipple mouth)."""
+    imported only then); with ``fem_level`` (elements across the bore's radius) also the FEM rung (scikit-fem): the
+    axisymmetric exterior FEM's f1 of a flanged or unflanged tube (:func:`matcad.acoustics.tube.exterior_fem`), the
+    line with the 3-D FEM's δ of a fipple window (:func:`matcad.acoustics.tube.window_fem`, ~20 s at level 8)."""
     td = air.tube_design(spec)
     routes = {"closed form (rigid)": air.closed_form_hz(td), "line (rigid)": air.line_hz(td),
               "1-D FEM P2 (rigid)": air.fem_hz(td, 0.0, FEM_ELEMENTS, 2)}
-    if fem_level is not None:
+    if fem_level is not None and td.mouth == "fipple":
+        routes[f"3-D window FEM + line, level {fem_level} (rigid)"] = air.window_fem(td, fem_level)[1]
+    elif fem_level is not None:
         routes[f"exterior FEM, level {fem_level} (rigid)"] = air.exterior_fem(td, fem_level).f0_hz
     notes: list[str] = []
     f0, kappa, band = routes["line (rigid)"], None, [routes["line (rigid)"]] * 2
@@ -111,10 +137,11 @@ def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePredict
         sources = ["cap shear modulus range"]
     if td.mouth == "fipple":
         k = kappa or 0.0
-        for factor in (1 - MOUTH_SPREAD, 1 + MOUTH_SPREAD):
+        for factor in MOUTH_RANGE:
             shifted = f0 * air.line_hz(td, k, correction_factor=factor) / air.line_hz(td, k)
             band = [min(band[0], shifted), max(band[1], shifted)]
-        sources.append(f"fipple mouth correction +-{MOUTH_SPREAD:.0%} (assumed)")
+        sources.append(f"fipple mouth correction x{MOUTH_RANGE[0]:g}-{MOUTH_RANGE[1]:g} (3-D FEM over ten windows)")
+        notes += _outside_mouth_study(td)
     f2 = air.line_hz(td, kappa or 0.0, mode=2)
     windows = tuple(edgetone.window(f, mode, td.edge_distance, td.windway_height, td.windway_width)
                     for mode, f in ((1, f0), (2, f2)))

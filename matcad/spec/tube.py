@@ -15,6 +15,12 @@ from typing import ClassVar
 
 from matcad.spec.fields import LENGTH_MAX_MM, Section, SpecError, length_mm, param
 
+EDGE_LAND_MM = 0.1
+"""The labium's tip sits this far outside the bore's wall line: a plane through the wall line would touch the bore
+at one point (no valid solid), and no printer makes a sharper edge than this anyway."""
+SEAT_CONE_DEG = 30.0
+"""The cones of the printed tube (the bore's floor on the block, the needle seat's ceiling, the cap seat's
+underside, the labium's inner bevel), from vertical: the FDM overhang limit of :mod:`matcad.rules.printing`."""
 KINDS = ("mat", "tube")
 """Taxel kinds: 'mat' the Helmholtz taxel of the MAT paper (default), 'tube' the AcousTac fipple tube."""
 TUBE_TABLES = ("tube", "end_cap", "mold", "machine", "outputs", "air", "wall", "microphone", "silicone",
