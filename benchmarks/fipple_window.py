@@ -6,7 +6,8 @@ Prints, per level (cells across the bore's radius), nodes, δ, its error and CPU
 1. a pipe in an infinite baffle against Norris & Sheng's 0.8216 a (a closed form), with the observed order;
 2. a pipe with the template's 1.2 mm wall (0.6 a) ending in free space against the axisymmetric exterior FEM
    (matcad.acoustics.fem, level 16, 60 mm of bore: ka = 0.048), a second, independent route;
-3. the template's printed window: δ, δ over Rayleigh's thin aperture, the rigid line's f1 with it;
+3. the template's printed window: δ, δ over Rayleigh's thin aperture, the rigid line's f1 with it; and two other
+   windows at levels 8 and 12 (the range's level against a finer one);
 4. ten windows (wall, window width B and height W, labium bevel) at level 8: δ over Rayleigh's, the range that
    :data:`matcad.prediction.tube.MOUTH_RANGE` must hold.
 Run: .venv/bin/python benchmarks/fipple_window.py [--fine]   (--fine adds level 16: ~5 min and ~8 GB for the window)
@@ -66,6 +67,11 @@ def main(fine: bool):
         f1 = T.line_hz(td, correction_factor=r.delta_mm / rayleigh)
         print(f"  level {level:2d} {r.nodes:8d} nodes  delta {r.delta_mm:.4f} mm = {r.delta_mm / rayleigh:.4f} x "
               f"Rayleigh's  line f1 {f1:.0f} Hz ({f1 / T.line_hz(td) - 1:+.2%})  {cpu:.0f} s CPU", flush=True)
+    for wall, b, w, angle in MOUTH_STUDY[1:9:7]:
+        one = dataclasses.replace(td, tube_wall=wall, windway_width=b, edge_distance=w, edge_angle=angle)
+        d8, d12 = (M.end_correction(M.from_tube(one), level).delta_mm for level in (8, 12))
+        print(f"  wall {wall} B {b} W {w}: level 8 {d8:.4f} mm, level 12 {d12:.4f} mm ({d8 / d12 - 1:+.2%})",
+              flush=True)
     print(f"4. ten windows (MOUTH_STUDY) on a {MOUTH_STUDY_BORE_MM} mm bore, level 8: delta / Rayleigh's "
           f"(MOUTH_RANGE {MOUTH_RANGE})")
     ratios = []
