@@ -80,7 +80,7 @@ def test_unflanged_thick_pipe_against_the_axisymmetric_fem(td):
     assert -0.05 < errors[0] < errors[1] < 0 and errors[1] > -0.025
 
 
-def test_window_fem_is_predicts_fem_route_and_inside_the_band(td):
+def test_window_fem_is_the_fem_route_of_predict_and_inside_the_band(td):
     """`predict --model fem` on a fipple tube: the line with the 3-D FEM's δ (no longer refused); at level 4 the
     window's δ lies inside MOUTH_RANGE × Rayleigh's, so the FEM route's f1 lies inside the rigid line's mouth band."""
     from matcad.prediction.tube import MOUTH_RANGE, predict_tube
