@@ -111,12 +111,12 @@ def test_template_window_converges_and_extreme_windows_stay_in_the_mouth_range(t
     benchmark's ten furthest from Rayleigh's aperture (a thin wall under a wide window, 0.84; a small window in the
     template's wall, 1.32) at level 8 inside MOUTH_RANGE; the thin wall's δ at level 12 (11 % above level 8's: a
     0.8 mm wall is a few cells thick at level 8) too."""
-    from matcad.prediction.tube import MOUTH_RANGE
+    from matcad.prediction.tube import MOUTH_RANGE, MOUTH_STUDY
 
     deltas = [T.window_fem(td, level)[0] for level in (6, 8, 12)]
     assert deltas[0] < deltas[1] < deltas[2] and deltas[2] - deltas[1] < 0.02 * deltas[2]
     assert 1.05 < deltas[2] / T.mouth_correction_mm(td) < 1.15
-    for wall, b, w, angle in ((0.8, 3.9, 3.5, 15), (1.2, 2.0, 1.0, 20)):
+    for wall, b, w, angle in (MOUTH_STUDY[9], MOUTH_STUDY[8]):
         one = dataclasses.replace(td, tube_wall=wall, windway_width=b, edge_distance=w, edge_angle=angle)
         ratio = T.window_fem(one, 8)[0] / T.mouth_correction_mm(one)
         assert MOUTH_RANGE[0] < ratio < MOUTH_RANGE[1]

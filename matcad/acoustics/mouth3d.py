@@ -133,13 +133,11 @@ def from_tube(td) -> Mouth:
 
 @dataclass(frozen=True)
 class MouthResult:
-    """δ (mm) at one level, with the mesh's size and the bore's discrete cross-section (mm², half)."""
+    """δ (mm) at one level, with the mesh's node count."""
 
     delta_mm: float
     level: int
     nodes: int
-    tetrahedra: int
-    section_mm2: float
 
 
 def end_correction(mouth: Mouth, level: int = DEFAULT_LEVEL) -> MouthResult:
@@ -186,4 +184,4 @@ def end_correction(mouth: Mouth, level: int = DEFAULT_LEVEL) -> MouthResult:
     if info:
         raise RuntimeError(f"the potential-flow solve did not converge (level {level})")
     delta = section * float(f @ phi) - (mouth.plane_z - mouth.mouth_z)
-    return MouthResult(delta, level, m.p.shape[1], m.t.shape[1], section)
+    return MouthResult(delta, level, m.p.shape[1])
