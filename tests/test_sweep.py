@@ -569,6 +569,32 @@ def test_memo_runs_a_rule_once_per_combination_of_the_fields_it_reads():
             assert memo.outcomes[numbers[j]] == function(chunk.spec(j))
 
 
+def test_mold_rules_and_the_load_slope_read_only_what_they_depend_on():
+    """The mold's rules read the cap (cavity, end cap, whether the neck runs through a riser), not the neck's size,
+    and Eq. 5's slope reads the neck and the air, not the cavity: on a grid over cavity.length x neck.diameter x
+    neck.length each then runs once per cap or once per neck, not once per variant (fails if a one-taxel spec is
+    re-validated through its own taxel, which reads every field, or if the slope builds the whole design)."""
+    from matcad.rules import printing
+    from matcad.sweep.arrays import GridChunk, slope_memo
+    from matcad.sweep.memo import Memo, run
+
+    spec = from_dict(read_spec_data(PAPER))
+    neck_size = {"neck.diameter", "neck.length"}
+    for rule in (printing.clamp_nut, printing.cavity_appendages, printing.print_bed):
+        reads, _ = run(rule, spec)
+        assert "cavity.length" in reads and not reads & neck_size, (rule.__name__, sorted(reads))
+    reads, slope = run(slope_memo().function, spec)
+    assert neck_size <= reads and not any(r.startswith("cavity.") for r in reads), sorted(reads)
+    assert slope == pytest.approx(float(calibration(spec).slope_hz_per_n(0.0)), rel=1e-12)
+
+    axes = parse_axes(["cavity.length=3:6:4", "neck.diameter=1.5:2.4:5", "neck.length=2,3,4"])
+    chunk = GridChunk(read_spec_data(PAPER), axes, np.arange(60))
+    for function, runs in ((printing.clamp_nut, 4), (slope_memo().function, 15)):
+        memo = Memo(function)
+        memo.apply(chunk)
+        assert sum(len(table) for table in memo.tables.values()) == runs
+
+
 def test_large_grid_streams_to_the_csv(tmp_path):
     """A three-axis grid beyond MAX_VARIANTS on arrays: the CSV holds every variant in grid order with the rows an
     in-memory sweep gives, the JSON the counts (no rows), no maps; the sweep kept no rows."""

@@ -107,6 +107,11 @@ class Design:
         return dataclasses.replace(self, **values)
 
 
+def _air(spec) -> Air:
+    """The spec's [air] as the models read it."""
+    return Air(spec.air.temperature_c, spec.air.speed_of_sound)
+
+
 def design(spec, taxel=None) -> Design:
     """The :class:`Design` of ``spec``'s taxel ``taxel`` (a :class:`matcad.spec.board.Taxel`; default: the spec's
     own tables, i.e. a single-taxel spec). The mouth's gap is the spacer height and its vent radius half the plate's
@@ -124,7 +129,7 @@ def design(spec, taxel=None) -> Design:
         neck_diameter=neck.diameter, neck_length=length, mouth=neck.mouth, gap_mm=spec.spacer.height,
         gap_radius_mm=float(gap_radius_mm(spec.plate.width, spec.plate.depth)), cap_outer_diameter=cap.outer_diameter,
         cap_top_thickness=cap.top_thickness, cap_clamp_height=cap_flange_thickness_mm(spec, taxel),
-        air=Air(spec.air.temperature_c, spec.air.speed_of_sound),
+        air=_air(spec),
         wall=WallMaterial(wall.model, wall.shear_modulus_mpa, wall.khz_modulus_factor, wall.loss_factor,
                           spec.silicone.density_g_cm3 * 1000.0),
         making=Making(spec.plate.neck_pilot, spec.plate.thickness_measured, spec.machine.printer,
@@ -168,7 +173,10 @@ def calibration(spec, d: Design | None = None):
     when the caller has it); None without one."""
     if spec.calibration is None:
         return None
-    d = design(spec) if d is None else d
+    if d is None:  # the neck and the air only: what Eq. 5's K reads (a sweep memoises on the fields read)
+        from matcad.spec import neck_length_mm
+
+        return eq5(spec.calibration).bound(speed_of_sound(_air(spec)), spec.neck.diameter, neck_length_mm(spec))
     return eq5(spec.calibration).bound(speed_of_sound(d.air), d.neck_diameter, d.neck_length)
 
 

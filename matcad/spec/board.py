@@ -94,7 +94,11 @@ def taxel_spec(spec, taxel: Taxel):
     """A single-taxel spec with ``taxel``'s geometry (its position dropped) and its own calibration when it has
     one (else the spec's [calibration]; a taxel's own calibration was measured on this taxel as drawn): how per-taxel
     physics (predict, wall modes, cap mechanics) is applied to one taxel of a board. The [riser] stays, so the
-    taxel's neck runs through it or its cap sits in a pocket of it as on the board."""
+    taxel's neck runs through it or its cap sits in a pocket of it as on the board. A one-taxel spec's own taxel
+    is the spec itself (the same tables: nothing to replace, so nothing is read or checked again)."""
+    if (spec.array is None and not spec.taxel and taxel.calibration is None and taxel.cavity is spec.cavity
+            and taxel.neck is spec.neck and taxel.end_cap is spec.end_cap and taxel.needle is spec.needle):
+        return spec
     own = dataclasses.replace(spec, cavity=taxel.cavity, neck=taxel.neck, end_cap=taxel.end_cap,
                               needle=taxel.needle, array=None, taxel=())
     if taxel.calibration is None:
