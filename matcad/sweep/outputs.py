@@ -16,13 +16,19 @@ import json
 import math
 from pathlib import Path
 
-from matcad.sweep.run import LOAD_SENSITIVITY, SweepResult, sensitivity_column, table_columns
+from matcad.sweep.run import LOAD_SENSITIVITY, Block, SweepResult, sensitivity_column, table_columns
 
 
 def _plain(value):
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value
+
+
+def _cells(values: list) -> list:
+    """A column's CSV cells: "" for None and non-finite floats, every other value as the csv module writes it."""
+    isfinite = math.isfinite
+    return ["" if v is None or (isinstance(v, float) and not isfinite(v)) else v for v in values]
 
 
 def table_dict(result: SweepResult) -> dict:
@@ -45,21 +51,25 @@ def table_dict(result: SweepResult) -> dict:
 
 
 class TableWriter:
-    """``sweep.csv`` in ``folder``, written chunk by chunk (call it with each chunk's rows; blank where a variant
-    has no value); the columns are fixed by the first chunk (:func:`matcad.sweep.run.table_columns`)."""
+    """``sweep.csv`` in ``folder``, written chunk by chunk (call it with each chunk's rows, a
+    :class:`~matcad.sweep.run.Block` or row dicts; blank where a variant has no value); the columns are fixed by
+    the first chunk (:func:`matcad.sweep.run.table_columns`). Written a column at a time: the only work per cell
+    is blanking what has no value (None, NaN) before the csv module formats it."""
 
     def __init__(self, folder: Path, axes, rules: bool):
         self.path, self.axes, self.rules = Path(folder) / "sweep.csv", tuple(axes), rules
         self.file = self.writer = self.columns = None
 
     def __call__(self, rows) -> None:
+        block = rows if isinstance(rows, Block) else Block.from_rows(rows)
         if self.file is None:
-            self.columns = table_columns(self.axes, self.rules, rows)
+            self.columns = table_columns(self.axes, self.rules, [dict.fromkeys(block.columns)])
             self.file = open(self.path, "w", newline="", encoding="utf-8")
             self.writer = csv.writer(self.file)
             self.writer.writerow(self.columns)
-        self.writer.writerows(["" if _plain(row.get(k)) is None else row.get(k) for k in self.columns]
-                              for row in rows)
+        blank = [""] * len(block)
+        self.writer.writerows(zip(*(_cells(block.columns[k]) if k in block.columns else blank
+                                    for k in self.columns)))
 
     def close(self) -> list[str]:
         if self.file is None:

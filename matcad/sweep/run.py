@@ -55,12 +55,45 @@ def table_columns(axes, rules: bool, rows=()) -> list[str]:
 
 
 def tally(rows, into: dict | None = None) -> dict:
-    """Variants by status (ok, invalid, failed) and how many break a design rule, added to ``into``."""
+    """Variants by status (ok, invalid, failed) and how many break a design rule, added to ``into``; ``rows``: row
+    dicts or a :class:`Block`."""
     out = into if into is not None else {"ok": 0, "invalid": 0, "failed": 0, "rule_errors": 0}
+    if isinstance(rows, Block):
+        for status in ("ok", "invalid", "failed"):
+            out[status] += rows.columns["status"].count(status)
+        out["rule_errors"] += sum(map(bool, filter(None, rows.columns.get("rule_errors", ()))))
+        return out
     for r in rows:
         out[r["status"]] += 1
         out["rule_errors"] += bool(r.get("rule_errors"))
     return out
+
+
+@dataclass(frozen=True)
+class Block:
+    """Consecutive rows of the table as columns, {column: list}, each as long as the block; None where a variant
+    has no value (a row dict leaves that key out). How the array path's chunks travel and are written: a worker
+    sends lists of numbers, not a dict per variant."""
+
+    columns: dict[str, list]
+
+    @classmethod
+    def from_rows(cls, rows) -> Block:
+        """The block of row dicts (a column for every key any row has, in order of first appearance)."""
+        names = dict.fromkeys(k for r in rows for k in r)
+        return cls({k: [r.get(k) for r in rows] for k in names})
+
+    def __len__(self) -> int:
+        return len(next(iter(self.columns.values()), ()))
+
+    def rows(self) -> list[dict]:
+        """The row dicts (keys in column order, those without a value left out)."""
+        names = list(self.columns)
+        return [{k: v for k, v in zip(names, values) if v is not None} for values in zip(*self.columns.values())]
+
+    def __iter__(self):
+        """The row dicts, one by one (a sink that wants rows reads a block as it read a list of them)."""
+        return iter(self.rows())
 
 
 @dataclass(frozen=True)
@@ -130,7 +163,8 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     """Sweep the spec ``data`` (raw TOML-like data; each variant is it with the axes' values set, validated like a
     file, so defaults such as the cap's 2.5 × D follow the varied cavity) over the full grid of ``axes``.
     ``model`` defaults to the spec's own choice (:func:`predict`); ``cad`` also builds each variant's end cap.
-    ``sink`` (a callable) is given the rows chunk by chunk, in grid order, as they are made; ``progress`` (a
+    ``sink`` (a callable) is given the rows chunk by chunk (a :class:`Block`, or a list of row dicts), in grid
+    order, as they are made; ``progress`` (a
     callable, :mod:`matcad.progress`) is told (variants done, variants) as chunks come back."""
     from matcad.acoustics.design import calibration
     from matcad.prediction import predict
@@ -210,20 +244,21 @@ def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, s
     kept, counted, seconds = [], tally(()), 0.0
     for task, results in zip(tasks, stream(array_chunks, tasks, executor)):
         result = results[0]
-        if "rows" in result:
-            rows = result["rows"]
+        if "block" in result:
+            block = result["block"]
             seconds += result["seconds"]
         else:
-            rows = [{"index": i, **{a.field: v for a, v in zip(axes, values)}, "status": "failed",
-                     "reason": result["reason"], "model": model}
-                    for i, values in zip(range(task["start"], task["stop"]), grid(axes, task["start"], task["stop"]))]
-        tally(rows, counted)
+            block = Block.from_rows(
+                [{"index": i, **{a.field: v for a, v in zip(axes, values)}, "status": "failed",
+                  "reason": result["reason"], "model": model}
+                 for i, values in zip(range(task["start"], task["stop"]), grid(axes, task["start"], task["stop"]))])
+        tally(block, counted)
         if progress is not None:
             progress(task["stop"], size)
         if sink is not None:
-            sink(rows)
+            sink(block)
         if keep:
-            kept += rows
+            kept += block.rows()
     return kept, counted, seconds
 
 
@@ -244,7 +279,8 @@ def array_chunks(tasks: list[dict]) -> list[dict]:
 
 
 def array_chunk(task: dict, rule_memos=None, slope_memo=None, seen=None) -> dict:
-    """The rows of variants ``start:stop`` of the grid by :func:`matcad.sweep.arrays.evaluate`."""
+    """The rows of variants ``start:stop`` of the grid by :func:`matcad.sweep.arrays.evaluate`, as a
+    :class:`Block`."""
     from matcad.spec import from_dict
 
     t0 = time.perf_counter()
@@ -252,22 +288,29 @@ def array_chunk(task: dict, rule_memos=None, slope_memo=None, seen=None) -> dict
     chunk = arrays.GridChunk(data, axes, np.arange(task["start"], task["stop"]))
     out = arrays.evaluate(chunk, from_dict(data), model, task["rules"], rule_memos or arrays.rule_memos(),
                           slope_memo or arrays.slope_memo(), seen)
-    columns = [(sensitivity_column(a), out[("slope", a.field)]) for a in axes if ("slope", a.field) in out]
-    rows = []
-    for j, i in enumerate(chunk.rows.tolist()):
-        row = {"index": i, **{a.field: a.values[int(chunk.index[k][j])] for k, a in enumerate(axes)},
-               "status": out["status"][j], "reason": out["reason"][j], "model": model}
-        if row["status"] != "invalid":
-            row.update(f0_hz=float(out["f0_hz"][j]), band_low_hz=float(out["band_low_hz"][j]),
-                       band_high_hz=float(out["band_high_hz"][j]), model_valid=bool(out["model_valid"][j]),
-                       **{name: float(c[j]) for name, c in columns})
-            if out["load_slope"][j] is not None and not isinstance(out["load_slope"][j], tuple):
-                row[LOAD_SENSITIVITY] = out["load_slope"][j]
-            if task["rules"] and row["status"] == "ok":
-                row.update(rule_errors=int(out["rule_errors"][j]), rule_warnings=int(out["rule_warnings"][j]),
-                           failing_rules=out["failing_rules"][j])
-        rows.append(row)
-    return {"index": task["index"], "rows": rows, "seconds": time.perf_counter() - t0}
+    n, status = len(chunk), out["status"]
+    valued = status != "invalid"
+
+    def where(mask, values) -> list:
+        return np.where(mask, np.asarray(values, dtype=object), None).tolist()
+
+    load = out["load_slope"]
+    has_load = np.array([v is not None and not isinstance(v, tuple) for v in load], dtype=bool) & valued
+    judged = valued & (status == "ok") if task["rules"] else np.zeros(n, dtype=bool)
+    columns = {"index": chunk.rows.tolist(),
+               **{a.field: np.asarray(a.values, dtype=object)[chunk.index[k]].tolist() for k, a in enumerate(axes)},
+               "status": status.tolist(), "reason": out["reason"].tolist(), "model": [model] * n,
+               **{key: where(valued, out[key].astype(float).tolist()) for key in ("f0_hz", "band_low_hz",
+                                                                                 "band_high_hz")},
+               "model_valid": where(valued, [bool(v) for v in out["model_valid"]]),
+               **{sensitivity_column(a): where(valued, out[("slope", a.field)].tolist())
+                  for a in axes if ("slope", a.field) in out},
+               LOAD_SENSITIVITY: where(has_load, load)}
+    if task["rules"]:
+        columns.update(rule_errors=where(judged, out["rule_errors"].tolist()),
+                       rule_warnings=where(judged, out["rule_warnings"].tolist()),
+                       failing_rules=where(judged, out["failing_rules"]))
+    return {"index": task["index"], "block": Block(columns), "seconds": time.perf_counter() - t0}
 
 
 def _grid_slopes(result: SweepResult) -> None:
