@@ -10,9 +10,16 @@ from matcad.parts.registry import Kind, PrintPose, parts, wanted
 __all__ = ["PrintPose", "laser_parts", "print_poses", "in_print_pose", "printed_parts", "needs_cad_kernel"]
 
 
+_LAST_LASER: list = [None, ()]
+"""The last spec :func:`laser_parts` was asked for and its parts: the laser rules ask for one spec's parts in turn."""
+
+
 def laser_parts(spec) -> list[Flat]:
-    """Every laser part ``[outputs]`` asks for (design intent, finished sizes)."""
-    return [p.make(spec) for p in wanted(spec, Kind.LASER)]
+    """Every laser part ``[outputs]`` asks for (design intent, finished sizes). Asked again for the very same spec
+    object (specs are frozen), the same parts are given again without being made again."""
+    if _LAST_LASER[0] is not spec:
+        _LAST_LASER[:] = spec, tuple(p.make(spec) for p in wanted(spec, Kind.LASER))
+    return list(_LAST_LASER[1])
 
 
 def print_poses() -> dict[str, PrintPose]:

@@ -17,6 +17,8 @@ slope, chunk by chunk of the grid. Every number is the one `matcad predict` / `m
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from matcad.sweep import calibrated, fast
@@ -240,15 +242,15 @@ def _array_column(chunk: GridChunk, base, memo: Memo, v: fast.Variants, entry) -
 def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0, low, high,
                  model_warnings) -> dict:
     """rule_errors, rule_warnings, failing_rules (and status/reason where a rule raised) of the chunk's valid
-    variants, as :func:`matcad.sweep.tasks.rule_verdicts` gives them one by one (``model_warnings``: each variant's
-    count of its prediction's warnings from its own model)."""
+    variants, as :func:`matcad.sweep.tasks.rule_verdicts` gives them one by one (``memos``: :func:`rule_memos`;
+    ``model_warnings``: each variant's count of its prediction's warnings from its own model)."""
     from matcad.acoustics.design import speed_of_sound
     from matcad.rules import acoustic, jet
 
     n = len(chunk)
-    rules, on_arrays = spec_rules(), _array_rules()
-    numbers = [_array_column(chunk, base, memo, v, on_arrays[rule]) if rule in on_arrays else memo.apply(chunk)
-               for rule, memo in zip(rules, memos)]
+    groups, on_arrays = rule_groups(), _array_rules()
+    numbers = [_array_column(chunk, base, memo, v, on_arrays[group[0]]) if group[0] in on_arrays
+               else memo.apply(chunk) for group, memo in zip(groups, memos)]
     d = v.design()
     sound = acoustic.array_counts(chunk.field(base, "microphone.sample_rate_hz"),
                                   chunk.field(base, "microphone.floor_hz"), low, high,
@@ -261,15 +263,19 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0
     errors, warnings, failing, failed = [], [], [], []
     for combo in uniq:
         items, broken = [], ""
-        for rule, memo, number in zip(rules, memos, combo[:len(memos)]):
-            if rule in on_arrays and number >= 0:
-                items += [(on_arrays[rule].id, on_arrays[rule].level)] * int(number)
-                continue
-            outcome = memo.outcomes[-number - 1 if rule in on_arrays else number]
-            if isinstance(outcome, tuple) and outcome[:1] == ("failed",):
-                broken = broken or outcome[1]
-                continue
-            items += list(outcome)
+        for group, memo, number in zip(groups, memos, combo[:len(memos)]):
+            if group[0] in on_arrays:
+                if number >= 0:
+                    items += [(on_arrays[group[0]].id, on_arrays[group[0]].level)] * int(number)
+                    continue
+                outcomes = (memo.outcomes[-number - 1],)
+            else:
+                outcomes = memo.outcomes[number]
+            for outcome in outcomes:
+                if isinstance(outcome, tuple) and outcome[:1] == ("failed",):
+                    broken = broken or outcome[1]
+                    continue
+                items += list(outcome)
         for (rule_id, level), count in zip(sound, combo[len(memos):]):
             items += [(rule_id, level)] * int(count)
         ordered = [x for x in items if x[1] == "error"] + [x for x in items if x[1] == "warning"]
@@ -284,12 +290,40 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0
             "failed": np.array(failed, dtype=object)[inverse] if n else np.zeros(0, object)}
 
 
-def rule_memos() -> list[Memo]:
-    """One :class:`Memo` per spec rule, keeping the summary of its findings (id, level) at error and warning; for a
-    rule judged on arrays, its inputs (:func:`_array_rules`)."""
+def rule_groups() -> list[tuple]:
+    """The spec rules as the sweep memoises them, in :func:`spec_rules`' order: each rule judged on arrays alone,
+    and the other rules of one module together (they read the same tables and build the same parts: the laser
+    rules' five kit sheets are one build per variant, :func:`matcad.parts.catalogue.laser_parts`)."""
     on_arrays = _array_rules()
-    return [Memo(on_arrays[rule].inputs) if rule in on_arrays else Memo(lambda spec, rule=rule: _summary(rule(spec)))
-            for rule in spec_rules()]
+    groups: list[tuple] = []
+    for rule in spec_rules():
+        if rule in on_arrays:
+            groups.append((rule,))
+        elif groups and groups[-1][0] not in on_arrays and groups[-1][0].__module__ == rule.__module__:
+            groups[-1] += (rule,)
+        else:
+            groups.append((rule,))
+    return groups
+
+
+def _verdicts(rules, spec) -> tuple:
+    """Each rule's summary of its findings on ``spec`` (:func:`_summary`), or ("failed", "Type: message") where it
+    raised (as :func:`matcad.sweep.memo.run` records a failure)."""
+    out = []
+    for rule in rules:
+        try:
+            out.append(_summary(rule(spec)))
+        except Exception as exc:  # noqa: BLE001 - a variant's failure is a row of the table, never fatal
+            out.append(("failed", f"{exc.__class__.__name__}: {exc}"))
+    return tuple(out)
+
+
+def rule_memos() -> list[Memo]:
+    """One :class:`Memo` per group of :func:`rule_groups`: a module's rules keep the tuple of their summaries of
+    findings (id, level) at error and warning; a rule judged on arrays, its inputs (:func:`_array_rules`)."""
+    on_arrays = _array_rules()
+    return [Memo(on_arrays[group[0]].inputs) if group[0] in on_arrays
+            else Memo(functools.partial(_verdicts, group)) for group in rule_groups()]
 
 
 def slope_memo() -> Memo:
