@@ -124,6 +124,10 @@ def rows(tmp: Path, quick: bool) -> list[Row]:
         Row("sweep-paper", "`sweep` mat-paper (silicone wall), 1 000 variants, rules off, 1 process",
             ["sweep", PAPER, "--vary", "cavity.length=3:6:40", "--vary", "neck.diameter=1.5:2.4:25", "--no-rules",
              "--workers", "1", "--out", "{tmp}/sp"], None, "", "rate", "1e5/s", 1 if quick else 3, 1_000),
+        Row("sweep-paper-rules", "`sweep` mat-paper (silicone wall, its calibration anchor), 10^4 variants (3 axes), "
+            "rules on, 1 process",
+            ["sweep", PAPER, "--vary", "cavity.length=3:6:20", "--vary", "neck.diameter=1.5:2.4:20", "--vary",
+             "neck.length=1:8:25", "--workers", "1", "--out", "{tmp}/spr"], None, "", "rate", "1e5/s", 1, 10_000),
         Row("sweep-million", "`sweep` laser-only, 10^6 variants (3 axes), rules on, 1 process: CPU and peak memory",
             ["sweep", LASER, "--vary", "cavity.length=2:10:100", "--vary", "neck.diameter=0.8:2.4:100",
              "--vary", "neck.length=1:8:100", "--workers", "1", "--out", "{tmp}/sm"], None, "", "rate", "1e5/s", 1,
@@ -248,7 +252,8 @@ def main() -> None:
     ap.add_argument("--tree", action="append", default=[], metavar="LABEL=PATH",
                     help="also measure another checkout (alternated with this one)")
     ap.add_argument("--only", nargs="+", metavar="ROW", help="rows to run: predict laser build analyze "
-                                                              "sweep-laser sweep-paper sweep-million fem")
+                                                              "sweep-laser sweep-paper sweep-paper-rules "
+                                                              "sweep-million fem")
     ap.add_argument("--runs", type=int, help="runs per command (default per row)")
     ap.add_argument("--quick", action="store_true", help="fewer runs per row")
     ap.add_argument("--readme", action="store_true", help="rewrite README's performance table with the result")
