@@ -72,18 +72,15 @@ class Framer:
 
 def running_median_rows(rows: np.ndarray, width: int) -> np.ndarray:
     """Median over ``width`` (odd) neighbouring columns of each row, edges continued by their end values (the
-    same numbers as scipy's median_filter(size=(1, width), mode='nearest')), in numpy: the middle of each window
-    partitioned, a few rows at a time (bounded memory). scipy.ndimage is not imported: its import alone costs
-    ~0.3 s, several times the tracker's own work on a 10 s recording."""
-    from numpy.lib.stride_tricks import sliding_window_view
+    same numbers as scipy's median_filter(size=(1, width), mode='nearest')): Bottleneck's moving median (a double
+    heap, O(log width) per value) over the edge-padded rows. scipy.ndimage is not imported: its import alone costs
+    ~0.3 s, several times the tracker's own work on a 10 s recording; numpy's partition of every window took
+    2.6 times as long as the heap on a 10 s recording's spectra."""
+    import bottleneck
 
     half = width // 2
-    padded = np.pad(rows, ((0, 0), (half, half)), mode="edge")
-    out = np.empty(rows.shape, dtype=np.result_type(rows.dtype, np.float64))
-    step = max(1, 200_000 // max(1, rows.shape[1] * width))
-    for i in range(0, rows.shape[0], step):
-        out[i:i + step] = np.partition(sliding_window_view(padded[i:i + step], width, axis=1), half, axis=-1)[..., half]
-    return out
+    padded = np.pad(np.asarray(rows, dtype=np.float64), ((0, 0), (half, half)), mode="edge")
+    return bottleneck.move_median(padded, width, axis=1)[:, width - 1:]
 
 
 def running_max(x: np.ndarray, size: int, mode: str = "reflect") -> np.ndarray:

@@ -54,11 +54,22 @@ class TableWriter:
     """``sweep.csv`` in ``folder``, written chunk by chunk (call it with each chunk's rows, a
     :class:`~matcad.sweep.run.Block` or row dicts; blank where a variant has no value); the columns are fixed by
     the first chunk (:func:`matcad.sweep.run.table_columns`). Written a column at a time: the only work per cell
-    is blanking what has no value (None, NaN) before the csv module formats it."""
+    is blanking what has no value (None, NaN) before the csv module formats it; an axis's values, which repeat
+    down the grid, are formatted once each."""
 
     def __init__(self, folder: Path, axes, rules: bool):
         self.path, self.axes, self.rules = Path(folder) / "sweep.csv", tuple(axes), rules
         self.file = self.writer = self.columns = None
+        self.axis_cells = {a.field: {v: str(v) for v in a.values} for a in self.axes}
+
+    def _column(self, block: Block, name: str) -> list:
+        values = block.columns.get(name)
+        if values is None:
+            return [""] * len(block)
+        known = self.axis_cells.get(name)
+        if known is not None and all(v in known for v in set(values)):
+            return [known[v] for v in values]
+        return _cells(values)
 
     def __call__(self, rows) -> None:
         block = rows if isinstance(rows, Block) else Block.from_rows(rows)
@@ -67,9 +78,7 @@ class TableWriter:
             self.file = open(self.path, "w", newline="", encoding="utf-8")
             self.writer = csv.writer(self.file)
             self.writer.writerow(self.columns)
-        blank = [""] * len(block)
-        self.writer.writerows(zip(*(_cells(block.columns[k]) if k in block.columns else blank
-                                    for k in self.columns)))
+        self.writer.writerows(zip(*(self._column(block, k) for k in self.columns)))
 
     def close(self) -> list[str]:
         if self.file is None:
