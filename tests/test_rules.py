@@ -136,3 +136,23 @@ def test_info_rules_only_inform():
     for spec in specs:
         for rule in rules:
             assert {f.level for f in rule(spec)} <= {"info"}, (rule.__name__, spec.name)
+
+
+def test_laser_parts_are_made_once_per_spec_and_again_for_another():
+    """The laser rules ask for one spec's kit in turn: the same spec object gets the very parts made for it (one
+    build for five rules), any other spec its own, made from its own values (fails if the cache keys on equality
+    or outlives a change)."""
+    import dataclasses
+
+    from matcad.parts.catalogue import laser_parts
+
+    spec = spec_mod.load(ROOT / "templates" / "mat-laser-only.toml")
+    first = laser_parts(spec)
+    assert all(a is b for a, b in zip(first, laser_parts(spec))) and first is not laser_parts(spec)
+    wider = dataclasses.replace(spec, neck=dataclasses.replace(spec.neck, diameter=spec.neck.diameter + 0.2))
+    again = laser_parts(wider)
+    assert not any(a is b for a, b in zip(first, again))
+    plate = {f.name: f for f in again}["neck_plate"]
+    assert {h.diameter for h in plate.holes if h.purpose == "neck"} != \
+        {h.diameter for h in {f.name: f for f in first}["neck_plate"].holes if h.purpose == "neck"}
+    assert [f.name for f in laser_parts(spec)] == [f.name for f in first]

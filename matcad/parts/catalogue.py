@@ -10,16 +10,19 @@ from matcad.parts.registry import Kind, PrintPose, parts, wanted
 __all__ = ["PrintPose", "laser_parts", "print_poses", "in_print_pose", "printed_parts", "needs_cad_kernel"]
 
 
-_LAST_LASER: list = [None, ()]
-"""The last spec :func:`laser_parts` was asked for and its parts: the laser rules ask for one spec's parts in turn."""
+_LAST_LASER: list = [(None, ())]
+"""The last spec :func:`laser_parts` was asked for and its parts, as one pair (read and replaced whole, so that
+threads asking for different specs never mix them): the laser rules ask for one spec's parts in turn."""
 
 
 def laser_parts(spec) -> list[Flat]:
     """Every laser part ``[outputs]`` asks for (design intent, finished sizes). Asked again for the very same spec
     object (specs are frozen), the same parts are given again without being made again."""
-    if _LAST_LASER[0] is not spec:
-        _LAST_LASER[:] = spec, tuple(p.make(spec) for p in wanted(spec, Kind.LASER))
-    return list(_LAST_LASER[1])
+    last, parts = _LAST_LASER[0]
+    if last is not spec:
+        parts = tuple(p.make(spec) for p in wanted(spec, Kind.LASER))
+        _LAST_LASER[0] = (spec, parts)
+    return list(parts)
 
 
 def print_poses() -> dict[str, PrintPose]:
