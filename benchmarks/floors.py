@@ -6,7 +6,8 @@ measured against, whole process, medians (issue 25's table).
     python benchmarks/floors.py --only predict analyze --readme   # also rewrite README's performance table
 
 Each row runs its command and its floor alternately (command, floor, command, floor, ...) in fresh interpreters and
-reports the medians; CPU is user + system time of the process and every process it waited for (``os.wait4``),
+reports the medians (with ``--tree``, the trees take turns at going first: the second of two back-to-back runs was
+measured 2-5 % slower, enough to invert a small difference); CPU is user + system time of the process and every process it waited for (``os.wait4``),
 peak memory its largest resident set. ``--tree LABEL=PATH`` measures the same commands on another checkout
 (``PYTHONPATH=PATH``), alternated with this one, so a before/after table comes from one run on one machine. The
 machine's load average is printed with the table: on a shared machine the ratios are what to compare, not the
@@ -161,7 +162,8 @@ def run_row(row: Row, trees: dict[str, Path], scratch: Path) -> None:
     prints = row.floor is not None and not per_tree and "print(" in row.floor[2]
     warm = 1 if row.metric == "wall" else 0  # a first round warms the file cache and writes bytecode: not counted
     for i in range(1 - warm, row.runs + 1):
-        for label, tree in trees.items():
+        order = list(trees.items())
+        for label, tree in order if i % 2 else order[::-1]:  # each tree first in every other round
             env = environment(tree)
             _clear(scratch)
             try:
