@@ -595,6 +595,37 @@ def test_mold_rules_and_the_load_slope_read_only_what_they_depend_on():
         assert sum(len(table) for table in memo.tables.values()) == runs
 
 
+def test_the_column_writer_writes_what_the_csv_module_writes_row_by_row(tmp_path):
+    """sweep.csv from columns (run.Block) is, byte for byte, the csv module's row-by-row table of the same rows: a
+    blank for a missing value, None and NaN, floats as repr, text with commas, quotes and line breaks quoted, an
+    integer axis as integers (fails if the columnar writer formats or quotes a cell differently)."""
+    from matcad.sweep.outputs import TableWriter
+    from matcad.sweep.run import Block, table_columns
+
+    axes = parse_axes(["cavity.length=3:6:3", "mold.count=1,2"])
+    rows = [{"index": 0, "cavity.length": 3.0, "mold.count": 1, "status": "ok", "reason": "", "model": "lumped",
+             "f0_hz": 4276.123456789012, "band_low_hz": float("nan"), "band_high_hz": 1e17, "model_valid": True,
+             "rule_errors": 2, "rule_warnings": 0, "failing_rules": "a:error b:warning"},
+            {"index": 1, "cavity.length": 4.5, "mold.count": 2, "status": "invalid",
+             "reason": 'neck.diameter = 5 "too wide", must be < 4\nsee [cavity]', "model": "lumped"},
+            {"index": 2, "cavity.length": 6.0, "mold.count": 1, "status": "failed", "reason": "x,y", "model": "lumped",
+             "f0_hz": 1e-05, "model_valid": False, "rule_errors": None}]
+    writer = TableWriter(tmp_path, axes, True)
+    writer(Block.from_rows(rows[:2]))
+    writer(rows[2:])
+    writer.close()
+    expected = tmp_path / "expected.csv"
+    with open(expected, "w", newline="", encoding="utf-8") as f:
+        out = csv.writer(f)
+        columns = table_columns(axes, True, rows)
+        out.writerow(columns)
+        for row in rows:
+            out.writerow(["" if row.get(k) is None or (isinstance(row.get(k), float) and not np.isfinite(row[k]))
+                          else row[k] for k in columns])
+    assert (tmp_path / "sweep.csv").read_bytes() == expected.read_bytes()
+    assert Block.from_rows(rows).rows() == [{k: v for k, v in r.items() if v is not None} for r in rows]
+
+
 def test_large_grid_streams_to_the_csv(tmp_path):
     """A three-axis grid beyond MAX_VARIANTS on arrays: the CSV holds every variant in grid order with the rows an
     in-memory sweep gives, the JSON the counts (no rows), no maps; the sweep kept no rows."""
