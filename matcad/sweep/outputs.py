@@ -163,9 +163,10 @@ def write_maps(result: SweepResult, folder: Path) -> list[str]:
             xe, ye = _edges(x_axis.values), _edges(y_axis.values)
             cells = [Outline([(xe[j], ye[i]), (xe[j + 1], ye[i]), (xe[j + 1], ye[i + 1]), (xe[j], ye[i + 1]),
                            (xe[j], ye[i])], closed=True) for i, j in zip(*np.nonzero(errors > 0))]
-            if cells:  # every hatched cell in one path: one fill however large the grid
-                ax.add_patch(PathPatch(Outline.make_compound_path(*cells), fill=False, hatch="///",
-                                       edgecolor="white", linewidth=0.0))
+            if cells:  # every hatched cell in one path: one fill however large the grid; added as an artist, not
+                # a patch, so its thousands of vertices are not walked again for limits the mesh has already set
+                ax.add_artist(PathPatch(Outline.make_compound_path(*cells), fill=False, hatch="///",
+                                        edgecolor="white", linewidth=0.0))
             ax.set_title(f"{label}\nhatched: design-rule errors; blank: invalid or failed", fontsize=10)
             y_label = _label(y_axis)
         ax.set_xlabel(_label(x_axis))
