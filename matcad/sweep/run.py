@@ -58,14 +58,10 @@ def tally(rows, into: dict | None = None) -> dict:
     """Variants by status (ok, invalid, failed) and how many break a design rule, added to ``into``; ``rows``: row
     dicts or a :class:`Block`."""
     out = into if into is not None else {"ok": 0, "invalid": 0, "failed": 0, "rule_errors": 0}
-    if isinstance(rows, Block):
-        for status in ("ok", "invalid", "failed"):
-            out[status] += rows.columns["status"].count(status)
-        out["rule_errors"] += sum(map(bool, filter(None, rows.columns.get("rule_errors", ()))))
-        return out
-    for r in rows:
-        out[r["status"]] += 1
-        out["rule_errors"] += bool(r.get("rule_errors"))
+    columns = (rows if isinstance(rows, Block) else Block.from_rows(rows)).columns
+    for status in ("ok", "invalid", "failed"):
+        out[status] += columns.get("status", []).count(status)
+    out["rule_errors"] += sum(map(bool, filter(None, columns.get("rule_errors", ()))))
     return out
 
 
@@ -164,8 +160,8 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     file, so defaults such as the cap's 2.5 × D follow the varied cavity) over the full grid of ``axes``.
     ``model`` defaults to the spec's own choice (:func:`predict`); ``cad`` also builds each variant's end cap.
     ``sink`` (a callable) is given the rows chunk by chunk (a :class:`Block`, or a list of row dicts), in grid
-    order, as they are made; ``progress`` (a
-    callable, :mod:`matcad.progress`) is told (variants done, variants) as chunks come back."""
+    order, as they are made; ``progress`` (a callable, :mod:`matcad.progress`) is told (variants done, variants)
+    as chunks come back."""
     from matcad.acoustics.design import calibration
     from matcad.prediction import predict
     from matcad.spec import SpecError, from_dict
@@ -296,7 +292,6 @@ def array_chunk(task: dict, rule_memos=None, slope_memo=None, seen=None) -> dict
 
     load = out["load_slope"]
     has_load = np.array([v is not None and not isinstance(v, tuple) for v in load], dtype=bool) & valued
-    judged = valued & (status == "ok") if task["rules"] else np.zeros(n, dtype=bool)
     columns = {"index": chunk.rows.tolist(),
                **{a.field: np.asarray(a.values, dtype=object)[chunk.index[k]].tolist() for k, a in enumerate(axes)},
                "status": status.tolist(), "reason": out["reason"].tolist(), "model": [model] * n,
@@ -307,6 +302,7 @@ def array_chunk(task: dict, rule_memos=None, slope_memo=None, seen=None) -> dict
                   for a in axes if ("slope", a.field) in out},
                LOAD_SENSITIVITY: where(has_load, load)}
     if task["rules"]:
+        judged = status == "ok"
         columns.update(rule_errors=where(judged, out["rule_errors"].tolist()),
                        rule_warnings=where(judged, out["rule_warnings"].tolist()),
                        failing_rules=where(judged, out["failing_rules"]))
