@@ -176,8 +176,10 @@ def calibration(spec, d: Design | None = None):
     if d is None:  # the neck and the air only: what Eq. 5's K reads (a sweep memoises on the fields read)
         from matcad.spec import neck_length_mm
 
-        return eq5(spec.calibration).bound(speed_of_sound(_air(spec)), spec.neck.diameter, neck_length_mm(spec))
-    return eq5(spec.calibration).bound(speed_of_sound(d.air), d.neck_diameter, d.neck_length)
+        air, diameter, length = _air(spec), spec.neck.diameter, neck_length_mm(spec)
+    else:
+        air, diameter, length = d.air, d.neck_diameter, d.neck_length
+    return eq5(spec.calibration).bound(speed_of_sound(air), diameter, length)
 
 
 def speed_of_sound(air: Air):

@@ -19,16 +19,11 @@ from pathlib import Path
 from matcad.sweep.run import LOAD_SENSITIVITY, Block, SweepResult, sensitivity_column, table_columns
 
 
-def _plain(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
-def _cells(values: list) -> list:
-    """A column's CSV cells: "" for None and non-finite floats, every other value as the csv module writes it."""
+def _cells(values: list, blank="") -> list:
+    """A column's values with ``blank`` for what has no value (None, NaN and other non-finite floats): "" in the
+    CSV, None (null) in the JSON."""
     isfinite = math.isfinite
-    return ["" if v is None or (isinstance(v, float) and not isfinite(v)) else v for v in values]
+    return [blank if v is None or (isinstance(v, float) and not isfinite(v)) else v for v in values]
 
 
 def table_dict(result: SweepResult) -> dict:
@@ -47,7 +42,8 @@ def table_dict(result: SweepResult) -> dict:
            "columns": columns}
     if result.tally is not None:
         return {**doc, "variants": result.variants, "counts": result.counts(), "rows_in": "sweep.csv"}
-    return {**doc, "rows": [{k: _plain(row.get(k)) for k in columns} for row in result.rows]}
+    values = [_cells([row.get(k) for row in result.rows], None) for k in columns]
+    return {**doc, "rows": [dict(zip(columns, row)) for row in zip(*values)]}
 
 
 class TableWriter:
