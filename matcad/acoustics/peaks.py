@@ -87,12 +87,15 @@ the first :data:`FIRST_WIDTH` coarse steps wide, each next one as wide as the la
 finite-difference derivative and curvature: superlinear), at least :data:`SMALLEST_WIDTH` in log f."""
 DIRECT_WIDTH = 0.02
 """Width (log f) of the first parabola that refines a rigid wall's peak from f_TL."""
+FOLLOW_WIDTH = 1e-3
+"""Width (log f) of the first parabola that follows a peak from a known start (:func:`peaks`' ``start``): 1000× a
+sensitivity's step (:data:`matcad.sweep.fast.RELATIVE_STEP`), the distance its peak moves."""
 FAST_BLOCK = 1024
 """Rows per numpy pass of the root find (1024 × 97 frequencies × ~22 modes: ~20 MB a temporary; 256 rows was
 1.5× slower, 2048 no faster)."""
 
 
-def peaks(geometry: tuple, wall, loss_factor) -> np.ndarray:
+def peaks(geometry: tuple, wall, loss_factor, start=None) -> np.ndarray:
     """Peak frequency (Hz) of the driven response per row: ``geometry`` = (f_TL, c, A, S, l_eff, L, V_side) arrays
     of one shape, and the wall (None: rigid) with its loss, broadcast against it. The peak is a minimum of
     |D(f)|² = 1/|H|² (the mouth's pressure per unit closed-end pressure): bracketed by a coarse scan of
@@ -101,18 +104,35 @@ def peaks(geometry: tuple, wall, loss_factor) -> np.ndarray:
     curvature), the lowest refined one kept; a rigid wall has one peak, refined from f_TL. The same f0 as the
     601-point scan :func:`scanned_peaks` to < 1e-4 on the templates and on 99.5 % of random variants; where they
     differ by more it is the scan's grid error (a 200 001-point search agrees with the root find to 1e-5; tested).
-    ~5-9× faster than the scan (benchmarks/sweep.py)."""
-    rows, shape, n = rows_of(geometry, wall, loss_factor)
-    out = np.empty(n)
-    for start in range(0, n, FAST_BLOCK):
+    ~5-9× faster than the scan (benchmarks/sweep.py). With a wall, ``start`` (log offsets from f_TL, broadcast
+    against the rows) follows each row's peak from there instead: no scan, the parabolas from
+    :data:`FOLLOW_WIDTH` (a design moved a little from one whose peak is known, as a sensitivity's are)."""
+    rows, shape, n = rows_of(geometry, wall, loss_factor, start)
+    rows, inverse = distinct_rows(rows) if wall is not None else (rows, None)
+    m = len(rows["f_tl"])
+    out = np.empty(m)
+    for start in range(0, m, FAST_BLOCK):
         block = {k: v[start:start + FAST_BLOCK] for k, v in rows.items()}
         out[start:start + FAST_BLOCK] = _block_peak(block, wall is not None)
-    return out.reshape(shape)
+    return (out if inverse is None else out[inverse]).reshape(shape)
 
 
-def rows_of(geometry: tuple, wall, loss_factor):
+def distinct_rows(rows: dict) -> tuple[dict, np.ndarray | None]:
+    """The distinct rows of :func:`rows_of`'s inputs and, for each input row, the index of its distinct row
+    (None when every row is distinct). A peak depends on its own row only, so searching each distinct row once gives
+    the same numbers: a calibrated sweep's drawn taxel is one design repeated over every variant of a chunk."""
+    table = np.column_stack([np.asarray(v, dtype=float).reshape(len(v), -1) for v in rows.values()])
+    _, first, inverse = np.unique(table, axis=0, return_index=True, return_inverse=True)
+    if len(first) == len(table):
+        return rows, None
+    return {k: v[first] for k, v in rows.items()}, inverse.reshape(-1)
+
+
+def rows_of(geometry: tuple, wall, loss_factor, start=None):
     """The broadcast inputs of :func:`peaks` flattened to rows: {name: (n,) or (n, modes)}, the shape, n."""
     parts = [*geometry] if wall is None else [*geometry, wall.static_mm3_pa, np.asarray(loss_factor, dtype=float)]
+    if start is not None:
+        parts.append(np.asarray(start, dtype=float))
     shape = np.broadcast_shapes(*(np.shape(x) for x in parts))
     n = math.prod(shape)
     rows = {name: np.broadcast_to(x, shape).reshape(n) for name, x in zip(("f_tl", "c", "A", "S", "l", "L", "side"),
@@ -123,6 +143,8 @@ def rows_of(geometry: tuple, wall, loss_factor):
         rows["comps"] = np.broadcast_to(wall.compliances_mm3_pa, shape + (m,)).reshape(n, m)
         rows["static"] = np.broadcast_to(wall.static_mm3_pa, shape).reshape(n)
         rows["loss"] = np.broadcast_to(loss_factor, shape).reshape(n)
+        if start is not None:
+            rows["start"] = np.broadcast_to(start, shape).reshape(n)
     return rows, shape, n
 
 
@@ -138,9 +160,10 @@ def _block_peak(rows: dict, elastic: bool) -> np.ndarray:
     """Peak frequency (Hz) of each row of a block (:func:`peaks`): with a wall, the coarse scan's candidates
     refined; a rigid wall's one peak refined from f_TL."""
     n = len(rows["f_tl"])
-    if elastic:
+    if elastic and "start" not in rows:
         return rows["f_tl"] * np.exp(scanned_x(rows))
-    x, _, _ = _refine(rows, np.zeros((n, 1)), np.ones((n, 1), dtype=bool), DIRECT_WIDTH, False)
+    start, width = (rows["start"], FOLLOW_WIDTH) if elastic else (np.zeros(n), DIRECT_WIDTH)
+    x, _, _ = _refine(rows, start[:, None], np.ones((n, 1), dtype=bool), width, elastic)
     return rows["f_tl"] * np.exp(x[:, 0])
 
 

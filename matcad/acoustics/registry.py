@@ -38,7 +38,8 @@ class AcousticModel:
     """One rung (see the module docstring). ``wall`` says which silicone modulus its f0 takes: '' none (rigid
     walls), 'static' the static shear modulus, 'dynamic' the kHz storage modulus and the loss factor, each at the
     middle of the spec's range. ``describe`` (``"module:function"`` of (evaluation, f0) → text) words the source
-    with the numbers of one evaluation; without it the source is ``source``."""
+    with the numbers of one evaluation; without it the source is ``source``. ``follows``: its f0 is a peak that
+    a nearby design's f0 lets it follow rather than search for (``near_hz`` of :meth:`f0_hz`)."""
 
     name: str
     rung: int
@@ -49,6 +50,7 @@ class AcousticModel:
     checks: tuple[str, ...] = ()
     wall: str = ""
     describe: str | None = None
+    follows: bool = False
 
     @property
     def cheap(self) -> bool:
@@ -68,15 +70,17 @@ class AcousticModel:
             return material.static_moduli_pa()[1], 0.0
         return None, 0.0
 
-    def f0_hz(self, res, material=None, shear_modulus_pa=None, loss_factor=None):
+    def f0_hz(self, res, material=None, shear_modulus_pa=None, loss_factor=None, near_hz=None):
         """f0 (Hz) of a closed-form rung on a resonator (floats, or arrays of variants; the wall rungs also at arrays
         of moduli and loss factors), at the middle of ``material``'s ranges unless a modulus (Pa) and loss factor
-        are given."""
+        are given. ``near_hz`` (Hz: the f0 of designs these were moved a little from) is followed by a rung that
+        ``follows``; a closed form has nothing to follow."""
         if not self.cheap:
             raise ValueError(f"model {self.name!r} solves a mesh: evaluate it through its result()")
         if shear_modulus_pa is None and material is not None:
             shear_modulus_pa, loss_factor = self.wall_arguments(material)
-        return self.function()(res, shear_modulus_pa, 0.0 if loss_factor is None else loss_factor)
+        near = {"near_hz": near_hz} if self.follows and near_hz is not None else {}
+        return self.function()(res, shear_modulus_pa, 0.0 if loss_factor is None else loss_factor, **near)
 
     def result(self, ev, f_guess_hz: float | None = None, level: int | None = None) -> ModelResult:
         """This rung on one :class:`matcad.acoustics.evaluation.Evaluation`: f0 (Hz), checks, source. A mesh rung
@@ -117,7 +121,7 @@ MODELS: tuple[AcousticModel, ...] = (
     AcousticModel("elastic_wall", 5, ("silicone",), False, "matcad.acoustics.resonator:elastic_wall_hz",
                   "transmission line coupled to the cap's wall modes (from the coupled FEM's elastic operator, "
                   "wall_modes.json)", PLANE + ("wall_shape_in_table", "no_wall_mode_near_f"), "dynamic",
-                  "matcad.acoustics.evaluation:describe_elastic_wall"),
+                  "matcad.acoustics.evaluation:describe_elastic_wall", follows=True),
     AcousticModel("fem", 6, ("rigid", "silicone"), True, "matcad.acoustics.fem_model:fem_result",
                   "axisymmetric P2 FEM (scikit-fem); with silicone the elastic cap coupled to the air"),
 )

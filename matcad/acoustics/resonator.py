@@ -146,13 +146,16 @@ def soft_wall_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0):
                                        res.cavity_length, n, extra, res.side_volume, _cone(res))
 
 
-def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor=0.0):
+def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor=0.0, near_hz=None):
     """The transmission line coupled to the cap's wall modes at the (dynamic) shear modulus (Pa) and loss factor:
     peak of the driven response (Hz). Arrays of designs, or one design at arrays of moduli and loss factors, give
-    arrays, each entry the same arithmetic as one call (:func:`matcad.acoustics.wall.peak_ratio`)."""
+    arrays, each entry the same arithmetic as one call (:func:`matcad.acoustics.wall.peak_ratio`). ``near_hz``
+    (Hz, the f0 of a design this one was moved a little from) follows that design's peak instead of searching."""
     f_tl = transmission_line_hz(res)
+    near = None if near_hz is None else np.asarray(near_hz, dtype=float) / f_tl
     return f_tl * wall.peak_ratio(f_tl, res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
-                                  res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor, res.side_volume)
+                                  res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor, res.side_volume,
+                                  near=near)
 
 
 def elastic_wall_doublet_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0) -> float | None:

@@ -183,7 +183,7 @@ def _losses(loss_factor: float) -> np.ndarray:
 
 
 def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
-               loss_factor, side_volume=0.0, scan: bool = False):
+               loss_factor, side_volume=0.0, scan: bool = False, near=None):
     """Peak of the cavity pressure with the elastic wall over the peak with a rigid wall (same network, air of
     ``side_volume`` mm³ joined at the neck in both): a float for one design, an array for arrays of designs, moduli
     or loss factors (each row the same arithmetic as one design: the root find of :func:`matcad.acoustics.peaks.peaks`, so the
@@ -191,7 +191,9 @@ def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
     found at SELECT_LOSS and followed down to ``loss_factor``: an almost undamped wall mode rings as a sharp spike
     that can out-peak it on the grid (η = 0 on the paper's taxel gave 3033 Hz, a wall mode, for its 5288 Hz), though
     it is not the resonance the jet drives. Its peaks are found by a root find (:mod:`matcad.acoustics.peaks`), or with ``scan``
-    by the 601-point reference scan."""
+    by the 601-point reference scan. ``near`` (the ratio of a design close to this one, broadcast against it) makes
+    the root find follow the peak from that ratio instead of searching the band: a sensitivity's moved designs, whose
+    peak lies on the branch of the design they were moved from (below SELECT_LOSS each design is followed anyway)."""
     geometry = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
         f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume)))
     if np.any(np.asarray(loss_factor) < SELECT_LOSS):  # row by row, each following its Helmholtz branch
@@ -206,8 +208,13 @@ def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
             out[i] = _followed_ratio(*(float(g[i]) for g in rows[:6]),
                                      Modes(freqs[i], comps[i], float(static[i])), float(loss[i]), float(rows[6][i]))
         return float(out) if out.ndim == 0 else out
-    peaks = _scanned_peaks if scan else _peaks
-    ratio = peaks(tuple(geometry), wall, loss_factor) / peaks(tuple(geometry), None, 0.0)
+    rigid = (_scanned_peaks if scan else _peaks)(tuple(geometry), None, 0.0)
+    if scan:
+        soft = _scanned_peaks(tuple(geometry), wall, loss_factor)
+    else:
+        start = None if near is None else np.log(np.asarray(near, dtype=float) * rigid / geometry[0])
+        soft = _peaks(tuple(geometry), wall, loss_factor, start)
+    ratio = soft / rigid
     return float(ratio) if ratio.ndim == 0 else ratio
 
 

@@ -352,12 +352,12 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
     good = chunk.subset(ok)
     v = variants(good, base)
     if model == calibrated.MODEL:
-        anchor = calibrated.CalibratedSweep(good, base)
-        f0, low, high = anchor.columns(v)
+        anchor = calibrated.CalibratedSweep(good, base, v)
+        f0, low, high = anchor.columns()
         valid, warned = np.ones(len(f0), dtype=bool), np.zeros(len(f0), dtype=np.int64)
 
         def slope_of(field, follows):
-            return anchor.sensitivity(v, field, follows)
+            return anchor.sensitivity(field, follows)
     else:
         from matcad.acoustics.predict import warning_count
 
@@ -367,7 +367,7 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
         low, high = fast.band_hz(v, model, f0, valid)
 
         def slope_of(field, follows):
-            return fast.sensitivity(v, model, field, follows)
+            return fast.sensitivity(v, model, field, follows, at_hz=f0)
     out["f0_hz"][ok], out["band_low_hz"][ok], out["band_high_hz"][ok] = f0, low, high
     out["model_valid"][ok] = valid
     for a in chunk.axes:

@@ -28,9 +28,9 @@ def eligible(base, axes) -> bool:
 
 
 class CalibratedSweep:
-    """The anchor of ``base`` (a one-taxel spec with [calibration]) for the variants of one chunk."""
+    """The anchor of ``base`` (a one-taxel spec with [calibration]) for the variants ``v`` of one chunk."""
 
-    def __init__(self, chunk, base):
+    def __init__(self, chunk, base, v: fast.Variants):
         from matcad.acoustics.registry import CHOSEN
         from matcad.prediction.anchor import CalibrationAnchor
         from matcad.spec.drawn import DRAWN
@@ -41,6 +41,9 @@ class CalibratedSweep:
         self.same = np.all([chunk.field(base, key) == value for key, value in self.drawing.items()], axis=0)
         """Variants that draw the calibrated taxel: the ratio is exactly 1, and the band has no model-ratio line."""
         self.base = base
+        self.v = v
+        self.physics_hz = (fast.f0_hz(v, self.physics), fast.f0_hz(self.drawn(v), self.physics))
+        """The physics f0 of the variants and of their calibrated drawings (Hz)."""
 
     def drawn(self, v: fast.Variants) -> fast.Variants:
         """The variants with the calibrated drawing's fields (:data:`matcad.spec.drawn.DRAWN`; their others kept)."""
@@ -48,15 +51,18 @@ class CalibratedSweep:
             v = v.with_value(key, np.full(len(v), value))
         return v
 
-    def anchored_hz(self, v: fast.Variants) -> np.ndarray:
-        """f(0) x physics(variant) / physics(calibrated drawing) (Hz)."""
-        return self.anchor.f_cal * (fast.f0_hz(v, self.physics) / fast.f0_hz(self.drawn(v), self.physics))
+    def anchored_hz(self, v: fast.Variants, near_hz=(None, None)) -> np.ndarray:
+        """f(0) x physics(variant) / physics(calibrated drawing) (Hz) of variants moved a little from the chunk's,
+        each physics followed from ``near_hz`` (:func:`matcad.sweep.fast.f0_hz`)."""
+        return self.anchor.f_cal * (fast.f0_hz(v, self.physics, near_hz[0])
+                                    / fast.f0_hz(self.drawn(v), self.physics, near_hz[1]))
 
-    def f0_hz(self, v: fast.Variants) -> np.ndarray:
-        """The anchored f0 (Hz): :meth:`anchored_hz`, and f(0) itself where ``same``."""
-        return np.where(self.same, self.anchor.f_cal * 1.0, self.anchored_hz(v))
+    def f0_hz(self) -> np.ndarray:
+        """The chunk's anchored f0 (Hz): f(0) x the physics ratio, and f(0) itself where ``same``."""
+        physics, drawn = self.physics_hz
+        return np.where(self.same, self.anchor.f_cal * 1.0, self.anchor.f_cal * (physics / drawn))
 
-    def columns(self, v: fast.Variants) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def columns(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(f0, band low, band high) of the variants (Hz): :meth:`CalibrationAnchor.anchored`'s lines (the
         calibration's f(0), the model ratio unless ``same``, the air temperature unless the speed of sound is
         given) combined by :func:`matcad.acoustics.uncertainty.combine`. The anchored prediction has no warnings
@@ -67,7 +73,7 @@ class CalibratedSweep:
         from matcad.acoustics.uncertainty import TEMPERATURE_TOL_C, combine
         from matcad.prediction.anchor import Z95, ratio_share
 
-        f0 = self.f0_hz(v)
+        f0 = self.f0_hz()
         half = Z95 * self.anchor.sd * f0
         share = ratio_share(self.base)
         lows, highs = [-half, np.where(self.same, 0.0, -share * f0)], [half, np.where(self.same, 0.0, share * f0)]
@@ -80,8 +86,9 @@ class CalibratedSweep:
         low, high = combine(lows, highs, f0)
         return f0, f0 + low, f0 + high
 
-    def sensitivity(self, v: fast.Variants, field: str, follows: dict | None = None) -> np.ndarray:
-        """df0/dfield of the anchored f0 (Hz per the field's unit) by :func:`matcad.sweep.fast.sensitivity`'s
+    def sensitivity(self, field: str, follows: dict | None = None) -> np.ndarray:
+        """df0/dfield of the chunk's anchored f0 (Hz per the field's unit) by :func:`matcad.sweep.fast.sensitivity`'s
         central difference: the ratio's own derivative (a drawn field moves the variant only; any other field
-        moves the calibrated drawing too)."""
-        return fast.sensitivity(v, self.physics, field, follows, f0=self.anchored_hz)
+        moves the calibrated drawing too), each physics followed from the chunk's own."""
+        return fast.sensitivity(self.v, self.physics, field, follows,
+                                f0=lambda moved: self.anchored_hz(moved, self.physics_hz))

@@ -112,16 +112,17 @@ def _model(model: str):
     return registry.model(model)
 
 
-def f0_hz(v: Variants, model: str) -> np.ndarray:
+def f0_hz(v: Variants, model: str, near_hz=None) -> np.ndarray:
     """f0 (Hz) of every variant by one of :data:`VECTORISED` (paper Eq. 1; Rayleigh/Ingard; Selamet 1997; the
-    silicone wall at the middle of its modulus and loss ranges)."""
+    silicone wall at the middle of its modulus and loss ranges). ``near_hz`` (per variant, Hz: the f0 of the
+    variants these were moved a little from) lets a model that searches for its peak follow it from there."""
     m = _model(model)
 
-    def chunk(part):
+    def chunk(part, *near):
         d = part.design()
-        return np.asarray(m.f0_hz(Evaluation(d).res, d.wall), dtype=float)
+        return np.asarray(m.f0_hz(Evaluation(d).res, d.wall, near_hz=near[0] if near else None), dtype=float)
 
-    return _chunked(chunk, v)
+    return _chunked(chunk, v, *(() if near_hz is None else (np.asarray(near_hz, dtype=float),)))
 
 
 def failed_checks(v: Variants, model: str, f0) -> np.ndarray:
@@ -156,11 +157,14 @@ def band_hz(v: Variants, model: str, f0, ok) -> tuple[np.ndarray, np.ndarray]:
     return _chunked(chunk, v, np.asarray(f0, dtype=float), np.asarray(ok))
 
 
-def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None, f0=None) -> np.ndarray:
+def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None, f0=None,
+                at_hz=None) -> np.ndarray:
     """df0/dfield per variant (Hz per the field's unit: Hz/mm for lengths) by a central difference of the
     vectorised model, step :data:`RELATIVE_STEP` × the value; exactly 0 for a field the model does not read.
     ``follows`` ({field: factor}) moves the fields whose default follows this one with it (the cap's size follows
-    the cavity diameter); ``f0`` (variants → Hz), when given, is differentiated instead of the model's f0."""
+    the cavity diameter); ``f0`` (variants → Hz), when given, is differentiated instead of the model's f0. A model
+    that searches for its peak follows it from the variants' own f0 (``at_hz``, Hz; computed when not given) to the
+    moved variants' rather than searching again: the derivative of the branch the variant sings on."""
     if field not in v.values:
         return np.zeros(len(v))
     x = v.values[field]
@@ -172,5 +176,10 @@ def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None
             out = out.with_value(other, factor * value)
         return out
 
-    f = f0 or (lambda moved_v: f0_hz(moved_v, model))
-    return (f(moved(x + h)) - f(moved(x - h))) / (2 * h)
+    if f0 is None:
+        near = (f0_hz(v, model) if at_hz is None else at_hz) if _model(model).follows else None
+
+        def f0(moved_v):
+            return f0_hz(moved_v, model, near_hz=near)
+
+    return (f0(moved(x + h)) - f0(moved(x - h))) / (2 * h)

@@ -202,7 +202,7 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
         f0 = fast.f0_hz(v, model)
         valid = fast.valid(v, model, f0)
         low, high = fast.band_hz(v, model, f0, valid)
-        slopes = {sensitivity_column(a): fast.sensitivity(v, model, a.field) for a in axes}
+        slopes = {sensitivity_column(a): fast.sensitivity(v, model, a.field, at_hz=f0) for a in axes}
         for j, i in enumerate(ok):
             rows[i].update(f0_hz=float(f0[j]), band_low_hz=float(low[j]), band_high_hz=float(high[j]),
                            model_valid=bool(valid[j]), **{k: float(s[j]) for k, s in slopes.items()})
