@@ -133,6 +133,13 @@ def rows(tmp: Path, quick: bool) -> list[Row]:
             ["sweep", LASER, "--vary", "cavity.length=2:10:100", "--vary", "neck.diameter=0.8:2.4:100",
              "--vary", "neck.length=1:8:100", "--workers", "1", "--out", "{tmp}/sm"], None, "", "rate", "1e5/s", 1,
             1_000_000),
+        Row("sweep-million-parquet", "the same to `--table parquet`", ["sweep", LASER, "--vary",
+            "cavity.length=2:10:100", "--vary", "neck.diameter=0.8:2.4:100", "--vary", "neck.length=1:8:100",
+            "--workers", "1", "--table", "parquet", "--out", "{tmp}/smp"], None, "", "rate", "1e5/s", 1, 1_000_000),
+        Row("sweep-million-2", "the same on 2 processes (`--workers 2`), designs per wall second", ["sweep", LASER,
+            "--vary", "cavity.length=2:10:100", "--vary", "neck.diameter=0.8:2.4:100", "--vary",
+            "neck.length=1:8:100", "--workers", "2", "--table", "parquet", "--out", "{tmp}/smp2"], None, "",
+            "wall_rate", "1e5/s", 1, 1_000_000),
         Row("fem", "`predict --model fem`, coupled, `baffled` mouth (CPU)",
             ["predict", PAPER, "--model", "fem", "--set", "neck.mouth='baffled'"],
             ["predict", PAPER, "--model", "fem"], "the same with `mount`", "cpu", "2", few),
@@ -255,7 +262,8 @@ def main() -> None:
                     help="also measure another checkout (alternated with this one)")
     ap.add_argument("--only", nargs="+", metavar="ROW", help="rows to run: predict laser build analyze "
                                                               "sweep-laser sweep-paper sweep-paper-rules "
-                                                              "sweep-million fem")
+                                                              "sweep-million sweep-million-parquet "
+                                                              "sweep-million-2 fem")
     ap.add_argument("--runs", type=int, help="runs per command (default per row)")
     ap.add_argument("--quick", action="store_true", help="fewer runs per row")
     ap.add_argument("--readme", action="store_true", help="rewrite README's performance table with the result")

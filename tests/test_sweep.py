@@ -4,6 +4,7 @@ the executors (local processes, a Dask LocalCluster) giving the same table, fail
 import csv
 import dataclasses
 import json
+import math
 import subprocess
 import sys
 
@@ -15,6 +16,7 @@ from matcad.prediction import predict
 from matcad.spec import from_dict, read_spec_data
 from matcad.sweep import MAX_POINTS, Executor, parse_axes, sweep
 from matcad.sweep import fast
+from matcad.sweep.arrays import CHUNK
 from matcad.sweep.run import LOAD_SENSITIVITY, sensitivity_column
 from tests.conftest import MINIMAL, PAPER, ROOT, run_cli
 
@@ -605,7 +607,7 @@ def test_the_column_writer_writes_what_the_csv_module_writes_row_by_row(tmp_path
     """sweep.csv from columns (run.Block) is, byte for byte, the csv module's row-by-row table of the same rows: a
     blank for a missing value, None and NaN, floats as repr, text with commas, quotes and line breaks quoted, an
     integer axis as integers (fails if the columnar writer formats or quotes a cell differently)."""
-    from matcad.sweep.outputs import TableWriter
+    from matcad.sweep.outputs import CsvTable
     from matcad.sweep.run import Block, table_columns
 
     axes = parse_axes(["cavity.length=3:6:3", "mold.count=1,2"])
@@ -616,7 +618,7 @@ def test_the_column_writer_writes_what_the_csv_module_writes_row_by_row(tmp_path
              "reason": 'neck.diameter = 5 "too wide", must be < 4\nsee [cavity]', "model": "lumped"},
             {"index": 2, "cavity.length": 6.0, "mold.count": 1, "status": "failed", "reason": "x,y", "model": "lumped",
              "f0_hz": 1e-05, "model_valid": False, "rule_errors": None}]
-    writer = TableWriter(tmp_path, axes, True)
+    writer = CsvTable(tmp_path, axes, True)
     writer(Block.from_rows(rows[:2]))
     writer(rows[2:])
     writer.close()
@@ -630,6 +632,52 @@ def test_the_column_writer_writes_what_the_csv_module_writes_row_by_row(tmp_path
                           else row[k] for k in columns])
     assert (tmp_path / "sweep.csv").read_bytes() == expected.read_bytes()
     assert Block.from_rows(rows).rows() == [{k: v for k, v in r.items() if v is not None} for r in rows]
+
+
+def test_the_parquet_table_holds_what_the_csv_holds_typed(tmp_path):
+    """sweep.parquet (`--table parquet`) of a streamed 22 500-variant grid and of a small grid with invalid variants
+    and an integer axis: every cell the CSV's (a number equal to the CSV's text read back, null where the CSV is
+    blank), the columns typed (counts and integer axes int64, flags bool, text string, the rest float64), one row
+    group per streamed chunk, and sweep.json pointing at it."""
+    import pyarrow.parquet as pq
+
+    laser = ROOT / "templates" / "mat-laser-only.toml"
+    grids = ((laser, ["cavity.length=2:10:30", "neck.diameter=0.8:2.4:30", "neck.length=1:8:25"]),
+             (laser, ["neck.diameter=1.5,9.5", "mold.count=1,2"]))
+    for spec, vary in grids:
+        tables = {}
+        for fmt in ("csv", "parquet"):
+            out = tmp_path / f"{len(vary)}-{fmt}"
+            code, _, err = run_cli("sweep", spec, *[x for v in vary for x in ("--vary", v)], "--workers", "1",
+                                   "--table", fmt, "--out", out)
+            assert code == 0, err
+            tables[fmt] = out
+        with open(tables["csv"] / "sweep.csv", newline="") as f:
+            rows = list(csv.DictReader(f))
+        parquet = pq.ParquetFile(tables["parquet"] / "sweep.parquet")
+        columns = parquet.read().to_pydict()
+        assert list(columns) == list(rows[0]) and not (tables["parquet"] / "sweep.csv").exists()
+        types = {f.name: str(f.type) for f in parquet.schema_arrow}
+        assert types["index"] == types["rule_errors"] == "int64" and types["model_valid"] == "bool"
+        assert types["status"] == types["failing_rules"] == "string" and types["f0_hz"] == "double"
+        for name, values in columns.items():
+            for row, value in zip(rows, values):
+                text = row[name]
+                assert (text == "") if value is None else (
+                    text == str(value) if isinstance(value, (bool, str)) else float(text) == value), (name, text)
+        doc = json.loads((tables["parquet"] / "sweep.json").read_text())
+        if len(rows) > 100:
+            assert doc["rows_in"] == "sweep.parquet" and parquet.num_row_groups == math.ceil(len(rows) / CHUNK) > 1
+        else:
+            assert types["mold.count"] == "int64" and any(r["status"] == "invalid" for r in rows)
+            assert [r["f0_hz"] for r in doc["rows"]] == columns["f0_hz"]
+
+
+def test_a_table_format_that_does_not_exist_is_exit_2_and_writes_nothing(tmp_path):
+    out = tmp_path / "sweep"
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--table", "xlsx", "--out", out)
+    assert code == 2 and "--table 'xlsx' invalid, must be one of csv, parquet" in err and "Traceback" not in err
+    assert not list(tmp_path.iterdir())
 
 
 def test_large_grid_streams_to_the_csv(tmp_path):

@@ -29,6 +29,9 @@ def arguments(cmd) -> None:
                                                             "(tcp://host:8786; needs matcad[cluster])")
     cmd.add_argument("--no-rules", action="store_true", help="skip the design rules (fast-model sweeps then "
                                                              "need no per-variant work)")
+    cmd.add_argument("--table", default="csv", metavar="FORMAT",
+                     help="the table's format: csv (default) or parquet (typed columns, ~10x faster to write a "
+                          "large grid; needs matcad[parquet])")
     cmd.add_argument("--cad", action="store_true", help="also build each variant's end cap (build123d) and read "
                                                         "its STL volume back")
 
@@ -38,7 +41,7 @@ def run(args) -> int:
     from matcad.sweep import Executor, parse_axes, sweep
     from matcad.output import staged_output
     from matcad.progress import line
-    from matcad.sweep.outputs import TableWriter, write_json, write_maps
+    from matcad.sweep.outputs import table_format, write_json, write_maps
 
     lo, hi = WORKERS
     if not lo <= args.workers <= hi:
@@ -48,12 +51,13 @@ def run(args) -> int:
     data = apply_sets(read_spec_data(args.spec), args.set)
     spec = load_spec(args.spec, args)  # validates the base spec (exit 2 naming the field) and prints its notes
     executor = Executor(args.workers, args.scheduler)
+    writer = table_format(args.table)
     target = Path(args.out or Path("out") / f"{spec.name}-sweep")
     with staged_output(target) as tmp, line("sweep", "variants", quiet=args.json) as progress:
-        table = TableWriter(tmp, axes, not args.no_rules)  # the table streams into tmp; on an error nothing is left
+        table = writer(tmp, axes, not args.no_rules)  # the table streams into tmp; on an error nothing is left
         result = sweep(data, axes, model=args.model, executor=executor, rules=not args.no_rules, cad=args.cad,
                        fem_level=args.fem_level, sink=table, progress=progress)
-        files = table.close() + write_json(result, tmp) + write_maps(result, tmp)
+        files = table.close() + write_json(result, tmp, table.name) + write_maps(result, tmp)
     if args.json:
         print_json(result.summary_dict(target, files))
     else:
