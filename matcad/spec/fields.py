@@ -10,6 +10,7 @@ the same declaration validates input (:func:`convert`, :func:`read_section`), pr
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import re
 import sys
@@ -148,21 +149,16 @@ def read_section(cls: type, path: str, data: Any) -> Any:
     missing required fields are refused, and an error of the section's own checks is named where the table sits."""
     if not isinstance(data, dict):
         raise SpecError(path, data, "must be a table, e.g. [" + path + "]")
-    fields = {f.name: f for f in dataclasses.fields(cls)}
+    declared = declarations(cls)
     for key in data:
-        if key not in fields:
-            raise SpecError(f"{path}.{key}", data[key], did_you_mean(key, list(fields)))
-    values = {}
-    for name, f in fields.items():
-        if name in data and data[name] is None and f.default is None:  # to_dict's unset optional field
-            continue
-        if name in data:
-            values[name] = convert(f"{path}.{name}", data[name], dict(f.metadata))
-        elif f.default is dataclasses.MISSING:
-            raise SpecError(f"{path}.{name}", MISSING, f"is required ({f.metadata['doc']})")
+        if key not in declared:
+            raise SpecError(f"{path}.{key}", data[key], did_you_mean(key, list(declared)))
+    for name, (default, meta) in declared.items():
+        if name not in data and default is dataclasses.MISSING:
+            raise SpecError(f"{path}.{name}", MISSING, f"is required ({meta['doc']})")
     own = cls.table
     try:
-        return cls(**values)
+        return cls(**data)  # its __post_init__ converts every field (None: an unset optional field, as to_dict writes)
     except SpecError as err:  # a cross-field check names the table by its own name: name it where it sits
         if path == own or not err.field.startswith(own + "."):
             raise
@@ -179,10 +175,17 @@ class Section:
 
     def __post_init__(self) -> None:
         path = self.table
-        for f in dataclasses.fields(self):
-            value = getattr(self, f.name)
-            if value is None and f.default is None:
+        for name, (default, meta) in declarations(type(self)).items():
+            value = getattr(self, name)
+            if value is None and default is None:
                 continue
-            if value is None and f.default is dataclasses.MISSING:
-                raise SpecError(f"{path}.{f.name}", MISSING, f"is required ({f.metadata['doc']})")
-            object.__setattr__(self, f.name, convert(f"{path}.{f.name}", value, dict(f.metadata)))
+            if value is None and default is dataclasses.MISSING:
+                raise SpecError(f"{path}.{name}", MISSING, f"is required ({meta['doc']})")
+            object.__setattr__(self, name, convert(f"{path}.{name}", value, meta))
+
+
+@functools.cache
+def declarations(cls: type) -> dict[str, tuple[Any, dict]]:
+    """Each field of the Section class ``cls``: name → (default, its declaration as :func:`param` made it), in
+    order (read once per class, not per section made)."""
+    return {f.name: (f.default, dict(f.metadata)) for f in dataclasses.fields(cls)}

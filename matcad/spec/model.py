@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 from typing import Any
 
 from matcad.materials import GRADES
 from matcad.spec.calibration import Calibration
 from matcad.spec.checks import cross_checks
 from matcad.spec.drawn import filled
-from matcad.spec.fields import MISSING, SpecError, convert, did_you_mean, param, read_section
+from matcad.spec.fields import MISSING, SpecError, convert, declarations, did_you_mean, param, read_section
 from matcad.spec.measured import Measured
 from matcad.spec.tube import KINDS, TUBE_TABLES, Tube
 from matcad.spec.sections import (CAP_OUTER_PER_D, CAP_TOP_PER_D, MAX_TAXELS, Air, Array, Cavity, EndCap,
@@ -56,9 +57,8 @@ class Spec:
                       "the [tube] table; docs/tube.md)", default="mat", kind="choice", choices=KINDS)
 
     def __post_init__(self) -> None:
-        name_meta = dict(dataclasses.fields(Spec)[0].metadata)
-        object.__setattr__(self, "name", convert("name", self.name, name_meta))
-        object.__setattr__(self, "kind", convert("kind", self.kind, _kind_meta()))
+        object.__setattr__(self, "name", convert("name", self.name, _meta("name")))
+        object.__setattr__(self, "kind", convert("kind", self.kind, _meta("kind")))
         for section, cls in SECTIONS.items():
             value = getattr(self, section)
             if value is None and section in required_sections(self.kind):
@@ -87,8 +87,11 @@ def required_sections(kind: str) -> tuple[str, ...]:
     return TUBE_REQUIRED if kind == "tube" else REQUIRED_SECTIONS
 
 
-def _kind_meta() -> dict:
-    return dict(next(f for f in dataclasses.fields(Spec) if f.name == "kind").metadata)
+def _meta(name: str) -> dict:
+    """The declaration of the Spec's own field ``name`` ('name' or 'kind')."""
+    return declarations(Spec)[name][1]
+
+
 ARRAY_TABLES: dict[str, type] = {"taxel": TaxelEntry, "measured": Measured}
 """Arrays of tables ([[taxel]], [[measured]]): key → the Section class of one entry."""
 
@@ -99,11 +102,10 @@ def from_dict(data: dict) -> Spec:
     for key in data:
         if key not in known:
             raise SpecError(key, data[key], did_you_mean(key, known))
-    name_meta = dict(dataclasses.fields(Spec)[0].metadata)
     if "name" not in data:
-        raise SpecError("name", MISSING, f"is required ({name_meta['doc']})")
-    values: dict[str, Any] = {"name": convert("name", data["name"], name_meta)}
-    kind = values["kind"] = convert("kind", data.get("kind", "mat"), _kind_meta())
+        raise SpecError("name", MISSING, f"is required ({_meta('name')['doc']})")
+    values: dict[str, Any] = {"name": convert("name", data["name"], _meta("name"))}
+    kind = values["kind"] = convert("kind", data.get("kind", "mat"), _meta("kind"))
     if kind == "tube":
         data = _tube_data(data)
     elif "tube" in data and data["tube"] is not None:
@@ -154,39 +156,47 @@ Prusa Research's specifications (``machine.print_volume_*`` override it)."""
 
 def _resolve_defaults(spec: Spec) -> Spec:
     """Fill defaults that depend on other fields (cap body proportional to the cavity; key clearance and build
-    volume by printer; silicone values from its grade)."""
+    volume by printer; silicone values from its grade), then the measured taxels' drawings from the spec so
+    resolved: each table remade once, where something of it was left to a default, and the spec once."""
     cap = spec.end_cap
-    entries = tuple(dataclasses.replace(
-        e, cap_outer_diameter=_proportional(e.cap_outer_diameter, cap.outer_diameter, CAP_OUTER_PER_D,
-                                            e.cavity_diameter or spec.cavity.diameter),
-        cap_top_thickness=_proportional(e.cap_top_thickness, cap.top_thickness, CAP_TOP_PER_D,
-                                        e.cavity_diameter or spec.cavity.diameter)) for e in spec.taxel)
     d = spec.cavity.diameter
+    changes: dict[str, Any] = {}
+    if spec.taxel:
+        changes["taxel"] = tuple(dataclasses.replace(
+            e, cap_outer_diameter=_proportional(e.cap_outer_diameter, cap.outer_diameter, CAP_OUTER_PER_D,
+                                                e.cavity_diameter or d),
+            cap_top_thickness=_proportional(e.cap_top_thickness, cap.top_thickness, CAP_TOP_PER_D,
+                                            e.cavity_diameter or d)) for e in spec.taxel)
     per_d = {key.split(".")[1]: factor for key, factor in PROPORTIONAL_DEFAULTS.items()}
-    cap = dataclasses.replace(cap, **{name: getattr(cap, name) if getattr(cap, name) is not None else factor * d
-                                      for name, factor in per_d.items()})
+    _remade(changes, "end_cap", cap, {name: factor * d for name, factor in per_d.items()
+                                      if getattr(cap, name) is None})
     machine = spec.machine
-    if machine.key_clearance is None:
-        machine = dataclasses.replace(machine, key_clearance=KEY_CLEARANCE_MM[machine.printer])
-    if None in (machine.print_volume_x, machine.print_volume_y, machine.print_volume_z):
-        given = (machine.print_volume_x, machine.print_volume_y, machine.print_volume_z)
-        x, y, z = (v if v is not None else d for v, d in zip(given, PRINT_VOLUME_MM[machine.printer]))
-        machine = dataclasses.replace(machine, print_volume_x=x, print_volume_y=y, print_volume_z=z)
+    given = (machine.print_volume_x, machine.print_volume_y, machine.print_volume_z)
+    _remade(changes, "machine", machine,
+            {**({"key_clearance": KEY_CLEARANCE_MM[machine.printer]} if machine.key_clearance is None else {}),
+             **{name: default for name, v, default in zip(("print_volume_x", "print_volume_y", "print_volume_z"),
+                                                          given, PRINT_VOLUME_MM[machine.printer])
+                if None in given and v is None}})
     grade = GRADES[spec.silicone.grade]
-    silicone = spec.silicone
-    if silicone.density_g_cm3 is None:
-        silicone = dataclasses.replace(silicone, density_g_cm3=grade.density_kg_m3 / 1000.0)
-    wall = spec.wall
-    if wall.shear_modulus_mpa is None:
-        wall = dataclasses.replace(wall, shear_modulus_mpa=grade.shear_modulus_mpa)
-    if wall.loss_factor is None:
-        wall = dataclasses.replace(wall, loss_factor=grade.loss_factor)
-    if wall.khz_modulus_factor is None:
-        wall = dataclasses.replace(wall, khz_modulus_factor=grade.khz_modulus_factor)
-    spec = dataclasses.replace(spec, end_cap=cap, machine=machine, silicone=silicone, wall=wall, taxel=entries)
-    return dataclasses.replace(spec, reference=spec.reference and filled(spec.reference, spec),
-                               calibration=spec.calibration and filled(spec.calibration, spec),
-                               measured=tuple(filled(e, spec) for e in spec.measured))
+    _remade(changes, "silicone", spec.silicone,
+            {"density_g_cm3": grade.density_kg_m3 / 1000.0} if spec.silicone.density_g_cm3 is None else {})
+    _remade(changes, "wall", spec.wall, {name: getattr(grade, name) for name in ("shear_modulus_mpa", "loss_factor",
+                                                                                 "khz_modulus_factor")
+                                         if getattr(spec.wall, name) is None})
+    resolved = SimpleNamespace(**{**{key: getattr(spec, key) for key in SECTIONS}, **changes})
+    if spec.reference is not None:
+        changes["reference"] = filled(spec.reference, resolved)
+    if spec.calibration is not None:
+        changes["calibration"] = filled(spec.calibration, resolved)
+    if spec.measured:
+        changes["measured"] = tuple(filled(e, resolved) for e in spec.measured)
+    return dataclasses.replace(spec, **changes) if changes else spec
+
+
+def _remade(changes: dict, key: str, section, values: dict) -> None:
+    """``changes[key]``: ``section`` with ``values`` set (remade, so validated, once), when there are any."""
+    if values:
+        changes[key] = dataclasses.replace(section, **values)
 
 
 def _proportional(own: float | None, shared: float | None, per_d: float, cavity_diameter: float) -> float:
