@@ -189,7 +189,9 @@ def validate(chunk: GridChunk, base, seen: dict | None = None) -> np.ndarray:
     return reason
 
 
+@functools.cache
 def _schema_range(key: str) -> tuple[float, float]:
+    """The allowed (lo, hi) of a spec field (read from the schema once per field, not once per chunk)."""
     from matcad.spec import schema
 
     row = next(r for r in schema() if r["key"] == key)
