@@ -673,6 +673,21 @@ def test_the_parquet_table_holds_what_the_csv_holds_typed(tmp_path):
             assert [r["f0_hz"] for r in doc["rows"]] == columns["f0_hz"]
 
 
+def test_parquet_without_pyarrow_says_which_extra_installs_it(monkeypatch):
+    """Without pyarrow (the optional extra), `--table parquet` is refused before anything is written, naming the
+    extra (the CLI turns the ValueError into exit 2, as for an unknown format below)."""
+    import importlib.util
+
+    from matcad.sweep.outputs import ParquetTable, table_format
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "pyarrow" else real(name, *a))
+    with pytest.raises(ValueError, match=r"--table parquet needs pyarrow: pip install 'matcad\[parquet\]'"):
+        table_format("parquet")
+    monkeypatch.undo()
+    assert table_format("parquet") is ParquetTable
+
+
 def test_a_table_format_that_does_not_exist_is_exit_2_and_writes_nothing(tmp_path):
     out = tmp_path / "sweep"
     code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3,4", "--table", "xlsx", "--out", out)
