@@ -208,13 +208,10 @@ def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
             out[i] = _followed_ratio(*(float(g[i]) for g in rows[:6]),
                                      Modes(freqs[i], comps[i], float(static[i])), float(loss[i]), float(rows[6][i]))
         return float(out) if out.ndim == 0 else out
-    rigid = (_scanned_peaks if scan else _peaks)(tuple(geometry), None, 0.0)
-    if scan:
-        soft = _scanned_peaks(tuple(geometry), wall, loss_factor)
-    else:
-        start = None if near is None else np.log(np.asarray(near, dtype=float) * rigid / geometry[0])
-        soft = _peaks(tuple(geometry), wall, loss_factor, start)
-    ratio = soft / rigid
+    search = _scanned_peaks if scan else _peaks
+    rigid = search(tuple(geometry), None, 0.0)
+    follow = {} if near is None or scan else {"start": np.log(np.asarray(near, dtype=float) * rigid / geometry[0])}
+    ratio = search(tuple(geometry), wall, loss_factor, **follow) / rigid
     return float(ratio) if ratio.ndim == 0 else ratio
 
 

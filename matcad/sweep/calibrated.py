@@ -51,11 +51,12 @@ class CalibratedSweep:
             v = v.with_value(key, np.full(len(v), value))
         return v
 
-    def anchored_hz(self, v: fast.Variants, near_hz=(None, None)) -> np.ndarray:
+    def anchored_hz(self, v: fast.Variants) -> np.ndarray:
         """f(0) x physics(variant) / physics(calibrated drawing) (Hz) of variants moved a little from the chunk's,
-        each physics followed from ``near_hz`` (:func:`matcad.sweep.fast.f0_hz`)."""
-        return self.anchor.f_cal * (fast.f0_hz(v, self.physics, near_hz[0])
-                                    / fast.f0_hz(self.drawn(v), self.physics, near_hz[1]))
+        each physics followed from the chunk's own (:attr:`physics_hz`, :func:`matcad.sweep.fast.f0_hz`)."""
+        variant, drawing = self.physics_hz
+        return self.anchor.f_cal * (fast.f0_hz(v, self.physics, variant)
+                                    / fast.f0_hz(self.drawn(v), self.physics, drawing))
 
     def f0_hz(self) -> np.ndarray:
         """The chunk's anchored f0 (Hz): f(0) x the physics ratio, and f(0) itself where ``same``."""
@@ -90,5 +91,4 @@ class CalibratedSweep:
         """df0/dfield of the chunk's anchored f0 (Hz per the field's unit) by :func:`matcad.sweep.fast.sensitivity`'s
         central difference: the ratio's own derivative (a drawn field moves the variant only; any other field
         moves the calibrated drawing too), each physics followed from the chunk's own."""
-        return fast.sensitivity(self.v, self.physics, field, follows,
-                                f0=lambda moved: self.anchored_hz(moved, self.physics_hz))
+        return fast.sensitivity(self.v, self.physics, field, follows, f0=self.anchored_hz)
