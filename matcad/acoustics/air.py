@@ -36,6 +36,26 @@ def boundary_layer_shift(frequency_hz, neck_radius_mm):
     return np.sqrt(KINEMATIC_VISCOSITY_M2_S / omega) / (a_m * np.sqrt(2.0)) * (1 + (GAMMA - 1) / np.sqrt(PRANDTL))
 
 
+def wavenumber_ratio(frequency_hz, radius_mm):
+    """k/k₀ of plane waves in a rigid circular tube of radius a (mm) at ``frequency_hz`` (Hz) with its viscous and
+    thermal boundary layers (complex, e^{iωt}: the real part the phase speed's fall c/c_φ, the imaginary part, < 0,
+    the attenuation per radian): the low-reduced-frequency solution of Zwikker & Kosten (Sound Absorbing Materials,
+    1949; Tijdeman 1975, J. Sound Vib. 39:1; Keefe 1984, J. Acoust. Soc. Am. 75:58),
+    k/k₀ = √((1 + (γ − 1) F(r_t)) / (1 − F(r_v))), F(r) = 2 J₁(r√−i) / (r√−i J₀(r√−i)), r_v = a √(ω/ν), r_t = r_v √Pr.
+    Exact for any r_v (a bore of any width against its boundary layer); tends to 1 + (1 − i) ε, ε of
+    :func:`boundary_layer_shift`, as r_v → ∞. Pure scipy (Bessel functions, exponentially scaled: no overflow)."""
+    from scipy.special import jve
+
+    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+    r_v = np.asarray(radius_mm, dtype=float) / 1e3 * np.sqrt(omega / KINEMATIC_VISCOSITY_M2_S)
+
+    def f(r):
+        z = r * np.sqrt(-1j)
+        return 2 * jve(1, z) / (z * jve(0, z))
+
+    return np.sqrt((1 + (GAMMA - 1) * f(r_v * np.sqrt(PRANDTL))) / (1 - f(r_v)))
+
+
 def boundary_layer_drop(frequency_hz, neck_radius_mm) -> float:
     """Relative frequency drop from boundary layers, ε/(1 + ε) with ε from :func:`boundary_layer_shift`
     (the phase speed falls to c/(1 + ε)); bounded below 1 however thin the neck."""

@@ -17,11 +17,14 @@ same bore) to the cap's inner wall (x = ℓ). Two end conditions close the 1-D H
 Three routes to the same resonance: :func:`closed_form_hz` f = (2n−1) c / 4(ℓ + δ + κ), the textbook quarter wave
 with its corrections; :func:`line_hz` the exact root of the transmission line's characteristic equation
 (1 − k²δκ) cos kℓ = k(δ + κ) sin kℓ; :func:`fem_hz` a 1-D finite-element eigenproblem with the same end conditions
-as boundary terms, an independent discretisation that converges to :func:`line_hz` as h² (P1) or h⁴ (P2).
+as boundary terms, an independent discretisation that converges to :func:`line_hz` as h² (P1) or h⁴ (P2). Each
+route solves the lossless column and then slows it by the bore's viscous and thermal boundary layers
+(:func:`boundary_layer_hz`, Zwikker & Kosten), unless the design says ``boundary_layers=False``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -39,6 +42,7 @@ is its piston approximation)."""
 WALL_FIXED_POINT_TOL = 1e-10
 WALL_FIXED_POINT_STEPS = 60
 WALL_SCAN_POINTS = 401
+BOUNDARY_LAYER_STEPS = 100
 
 
 @dataclass(frozen=True)
@@ -65,6 +69,9 @@ class TubeDesign:
     """The labium's outer bevel from vertical (deg, the spec's ``tube.edge_angle``)."""
     block_length: float
     """The block under the window (mm, the spec's ``tube.block_length``)."""
+    boundary_layers: bool = True
+    """Whether the bore's viscous and thermal boundary layers slow the wave (:func:`boundary_layer_hz`); False:
+    the lossless column, the one the exterior FEMs solve (their checks compare like with like)."""
 
     @property
     def column_mm(self) -> float:
@@ -110,10 +117,32 @@ def compliance_length_mm(td: TubeDesign, compliance_mm3_pa: float) -> float:
     return BULK_MODULUS_PA * compliance_mm3_pa / td.bore_area_mm2
 
 
+def boundary_layer_hz(td: TubeDesign, lossless_hz: float) -> float:
+    """The resonance (Hz) whose phase wavenumber Re k = (2πf/c) Re(k/k₀) in the bore equals the lossless column's
+    wavenumber 2π f_lossless/c: f = f_lossless / Re(k/k₀)(f), the boundary layers' k/k₀ of
+    :func:`matcad.acoustics.air.wavenumber_ratio` (Zwikker & Kosten), by fixed-point iteration (it contracts by about
+    half the layers' ε per step). ``lossless_hz`` itself when ``td.boundary_layers`` is False. The column is the bore
+    throughout (the cap's cavity continues it); the mouth's mass and the cap keep their lossless lengths, the
+    layers' smaller change of the line's impedance is left out (docs/tube.md: 0.16 % on a 2 mm bore at 185 Hz
+    against the lossy transfer matrix's impedance peak)."""
+    if not td.boundary_layers:
+        return lossless_hz
+    from matcad.acoustics.air import wavenumber_ratio
+
+    radius, f = td.bore_diameter / 2, lossless_hz
+    for _ in range(BOUNDARY_LAYER_STEPS):
+        f_new = lossless_hz / float(np.real(wavenumber_ratio(f, radius)))
+        if abs(f_new - f) <= 1e-14 * f:
+            return f_new
+        f = f_new
+    raise ArithmeticError(f"the boundary layers' fixed point did not settle from {lossless_hz:g} Hz")
+
+
 def closed_form_hz(td: TubeDesign, kappa_mm: float = 0.0, mode: int = 1) -> float:
-    """The quarter-wave closed form f_n = (2n − 1) c / 4(ℓ + δ + κ) (Hz): exact for the rigid cap as kδ → 0."""
+    """The quarter-wave closed form f_n = (2n − 1) c_φ / 4(ℓ + δ + κ) (Hz), c_φ the bore's phase speed
+    (:func:`boundary_layer_hz`): exact for the rigid cap as kδ → 0."""
     c_mm_s = speed_of_sound(td.air) * 1e3
-    return (2 * mode - 1) * c_mm_s / (4 * (td.column_mm + mouth_correction_mm(td) + kappa_mm))
+    return boundary_layer_hz(td, (2 * mode - 1) * c_mm_s / (4 * (td.column_mm + mouth_correction_mm(td) + kappa_mm)))
 
 
 def _characteristic(k, length, delta, kappa):
@@ -134,7 +163,7 @@ def line_hz(td: TubeDesign, kappa_mm: float = 0.0, mode: int = 1, correction_fac
         raise ValueError(f"no resonance of mode {mode} for this tube (kappa = {kappa_mm:g} mm)")
     i = roots[mode - 1]
     root = brentq(_characteristic, k[i], k[i + 1], args=(length, delta, kappa_mm), xtol=1e-14, rtol=1e-14)
-    return root * speed_of_sound(td.air) * 1e3 / (2 * math.pi)
+    return boundary_layer_hz(td, root * speed_of_sound(td.air) * 1e3 / (2 * math.pi))
 
 
 def fem_hz(td: TubeDesign, kappa_mm: float = 0.0, elements: int = 64, order: int = 1, mode: int = 1) -> float:
@@ -162,7 +191,7 @@ def fem_hz(td: TubeDesign, kappa_mm: float = 0.0, elements: int = 64, order: int
     mass[-1, -1] += kappa_mm
     k2 = eig(stiff, mass, right=False)
     k2 = np.sort(k2.real[(np.abs(k2.imag) < 1e-9 * np.abs(k2.real) + 1e-30) & (k2.real > 0)])
-    return math.sqrt(k2[mode - 1]) * speed_of_sound(td.air) * 1e3 / (2 * math.pi)
+    return boundary_layer_hz(td, math.sqrt(k2[mode - 1]) * speed_of_sound(td.air) * 1e3 / (2 * math.pi))
 
 
 def exterior_fem(td: TubeDesign, level: int | None = None):
@@ -175,8 +204,8 @@ def exterior_fem(td: TubeDesign, level: int | None = None):
     f1 tends to the quarter wave with Norris & Sheng's frequency-dependent correction
     (:func:`flanged_phase_correction_mm`); unflanged with a thin wall, its correction tends to Levine & Schwinger's
     0.6133 a as ka → 0, rising with the wall's thickness towards the flanged value (docs/tube.md). ``level``:
-    elements across the bore's radius (default fem's). Returns a :class:`matcad.acoustics.fem.FemResult` (f in Hz).
-    Raises ValueError for 'fipple' (a window in the tube's wall: 3-D, :func:`window_fem`)."""
+    elements across the bore's radius (default fem's). Returns a :class:`matcad.acoustics.fem.FemResult` (f in Hz,
+    lossless: :func:`boundary_layer_hz` adds the bore's boundary layers). Raises ValueError for 'fipple' (a window in the tube's wall: 3-D, :func:`window_fem`)."""
     from matcad.acoustics import fem
 
     exteriors = {"flanged": "baffled", "unflanged": "unflanged"}
@@ -188,7 +217,8 @@ def exterior_fem(td: TubeDesign, level: int | None = None):
                         cavity_length=td.cap_depth, mouth=exteriors[td.mouth],
                         wall=td.tube_wall if td.mouth == "unflanged" else 0.0)
     c = speed_of_sound(td.air)
-    return fem.solve(g, 2 * math.pi * line_hz(td) / (c * 1e3), level or fem.DEFAULT_LEVEL, speed_of_sound_m_s=c)
+    guess = line_hz(dataclasses.replace(td, boundary_layers=False))
+    return fem.solve(g, 2 * math.pi * guess / (c * 1e3), level or fem.DEFAULT_LEVEL, speed_of_sound_m_s=c)
 
 
 def window_fem(td: TubeDesign, level: int | None = None) -> tuple[float, float]:

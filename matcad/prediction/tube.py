@@ -125,7 +125,8 @@ def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePredict
     if fem_level is not None and td.mouth == "fipple":
         routes[f"3-D window FEM + line, level {fem_level} (rigid)"] = air.window_fem(td, fem_level)[1]
     elif fem_level is not None:
-        routes[f"exterior FEM, level {fem_level} (rigid)"] = air.exterior_fem(td, fem_level).f0_hz
+        routes[f"exterior FEM, level {fem_level} (rigid)"] = air.boundary_layer_hz(td, air.exterior_fem(td, fem_level)
+                                                                                   .f0_hz)
     notes: list[str] = []
     f0, kappa, band = routes["line (rigid)"], None, [routes["line (rigid)"]] * 2
     sources = ["rigid cap"]
