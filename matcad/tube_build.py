@@ -11,28 +11,42 @@ from matcad.output import staged_output
 
 CAP_PARTS = ("end_cap", "end_cap_mold_base", "end_cap_mold_lid")
 """The MAT path's registered parts the tube kit reuses: the cast cap (reference shape) and its two-part mold."""
+POSES = {
+    "block": ("the block's face (needle seat); bore vertical",
+              "Print tube.stl as exported (block on the bed, bore vertical; the labium starts as a bridge across the "
+              "window: see the report's support note); check the windway with a {h:g} mm feeler and the bore with a "
+              "{d:g} mm gauge pin.", "in the block"),
+    "transverse": ("the tube's foot and the windway's boss; bore vertical",
+                   "Print tube.stl as exported (its foot and the windway's boss on the bed, bore vertical; no support: "
+                   "nothing overhangs more than 30° from vertical); check the windway with a {h:g} mm feeler and the "
+                   "bore with a {d:g} mm gauge pin.", "at the boss's end (horizontal)"),
+}
+"""Per printed tube (:func:`matcad.parts.tube.tube_solid`: the transverse mouth's, else the block's): its face on
+the bed, the print step, where the needle's seat is."""
 STEPS = (
-    "Print tube.stl as exported (block on the bed, bore vertical; the labium starts as a bridge across the window: "
-    "see the report's support note); check the windway "
-    "with a {h:g} mm feeler and the bore with a {d:g} mm gauge pin.",
     "Print end_cap_mold_base.stl and end_cap_mold_lid.stl; cast the cap in {grade} (report: silicone.batch).",
     "Glue the cap's flange on the tube's seat (silicone adhesive), the cap's cavity over the bore.",
-    "Push the supply needle ({needle:g} mm) into its seat in the block; blow {flow:g} L/min (the edge-tone rule's "
+    "Push the supply needle ({needle:g} mm) into its seat {seat}; blow {flow:g} L/min (the edge-tone rule's "
     "window is in the report).",
 )
+"""The steps after the print step (:data:`POSES`)."""
+
+
+def _pose(spec) -> tuple[str, str, str]:
+    return POSES["transverse" if spec.tube.mouth == "transverse" else "block"]
 
 
 def _tube_files(spec, folder: Path) -> dict:
     """tube.stl/.step in its print pose and its read-back checks (mm, mm³)."""
     from matcad.export.mesh import mesh_checks, write_step, write_stl
-    from matcad.parts.tube import fipple_tube
+    from matcad.parts.tube import tube_solid
 
-    solid = fipple_tube(spec)
+    solid = tube_solid(spec)
     stl = folder / "tube.stl"
     tolerance = write_stl(solid, stl, spec.machine.stl_tolerance, spec.machine.stl_angular_tolerance)
     write_step(solid, folder / "tube.step")
     return mesh_checks(stl) | {"brep_volume_mm3": float(solid.volume), "printed": True,
-                               "bed_face": "the block's face (needle seat); bore vertical", "rotation_x_deg": 0.0,
+                               "bed_face": _pose(spec)[0], "rotation_x_deg": 0.0,
                                "chordal_tolerance_mm": tolerance}
 
 
@@ -55,8 +69,9 @@ def build_tube(spec, out_dir: Path | None = None, force: bool = False):
         raise failure
     target = Path(out_dir) if out_dir is not None else default_out_dir(spec)
     t = spec.tube
-    steps = [s.format(h=t.windway_height, d=t.bore_diameter, grade=spec.silicone.grade,
-                      needle=spec.needle.outer_diameter, flow=t.supply_flow_l_min) for s in STEPS]
+    _, printing, seat = _pose(spec)
+    steps = [s.format(h=t.windway_height, d=t.bore_diameter, grade=spec.silicone.grade, seat=seat,
+                      needle=spec.needle.outer_diameter, flow=t.supply_flow_l_min) for s in (printing, *STEPS)]
     comparison = compare(spec, prediction.f0_hz, steps)
     with staged_output(target) as tmp:
         meshes = {"tube.stl": _tube_files(spec, tmp)}

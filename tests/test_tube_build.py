@@ -133,3 +133,61 @@ def test_the_report_sets_a_mat_taxel_at_the_same_pitch_beside_the_tube(kit):
     assert side["tube_steps"] == len(report["fabrication"]) and len(side["mat_steps"]) > side["tube_steps"]
     text = (out / "report.md").read_text(encoding="utf-8")
     assert "## Beside a MAT taxel" in text and f"| taxel length (mm) | {side['mat_length_mm']:.2f}" in text
+
+
+@pytest.fixture(scope="module")
+def transverse_kit(tmp_path_factory):
+    out = tmp_path_factory.mktemp("transverse") / "kit"
+    run = subprocess.run([sys.executable, "-m", "matcad", "build", str(TEMPLATE), "--out", str(out), "--set",
+                          "tube.mouth='transverse'"], capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert run.returncode == 0, run.stderr
+    from matcad.spec import from_dict
+
+    report = json.loads((out / "report.json").read_text())
+    return out, report, from_dict(report["spec"])
+
+
+def test_a_transverse_mouth_prints_with_no_support_read_back_from_its_files(transverse_kit, tmp_path):
+    """The transverse mouth (matcad.parts.tube.transverse_tube), read back from tube.stl: one watertight body as
+    tall as its levels, the bore's two radii above the window, the window one loop at its mid-height, its gable's
+    apex in the wall, the windway open from the needle's seat to the window; no downward face steeper than the
+    FDM limit (+5° for facets) and, unlike the fipple's labium, nothing starting in mid-air; PrusaSlicer with
+    automatic supports adds none (the fipple tube: 453-458 mm³). The kit no longer warns of a bridge."""
+    import trimesh
+
+    from matcad.parts.tube import SEAT_CONE_DEG, heights_mm
+    from matcad.spec.tube import transverse_window_mm
+    from tests.test_real_clients import need, support_volume_mm3
+
+    out, report, spec = transverse_kit
+    t, z = spec.tube, heights_mm(spec)
+    mesh = trimesh.load_mesh(out / "tube.stl")
+    assert mesh.is_watertight and mesh.body_count == 1
+    assert mesh.bounds[0][2] == pytest.approx(0, abs=1e-6) and mesh.bounds[1][2] == pytest.approx(z["top"], abs=1e-3)
+    radii = sorted(c[2] for c in section_circles(mesh, z["edge"] + 0.5 * (z["cone_start"] - z["edge"])))
+    assert radii == pytest.approx([t.bore_diameter / 2, t.bore_diameter / 2 + t.wall], abs=0.01)
+    sides, gable = transverse_window_mm(t.windway_height, t.windway_width, t.edge_distance)
+    mid = z["windway_exit"] + sides / 2
+    a, wall_mid = t.bore_diameter / 2, t.bore_diameter / 2 + t.wall / 2
+    ys = np.array([0.0, 0.45, 0.55, 1.0]) * t.edge_distance  # along the wall's mid-circle, across the window
+    across = np.c_[np.sqrt(wall_mid**2 - ys**2), ys, np.full_like(ys, mid)]
+    assert mesh.contains(across).tolist() == [False, False, True, True]  # the window W wide, the edge's wall past it
+    just_below_apex = z["edge"] + 0.9 * gable
+    assert not mesh.contains([[wall_mid, 0.0, just_below_apex]])[0]  # the gable is open to its apex ...
+    assert mesh.contains([[wall_mid, 0.0, z["edge"] + 1.1 * gable]])[0]  # ... and closed above it
+    ys = np.linspace(-t.edge_distance / 2 - t.block_length + 0.05, 0.0, 60)  # the windway's axis, seat to window
+    axis = np.c_[np.full_like(ys, a), ys, np.full_like(ys, z["windway_exit"] + t.windway_width / 2)]
+    assert not mesh.contains(axis).any()
+    n, c = mesh.face_normals, mesh.triangles_center
+    steep = (n[:, 2] < 0) & (np.degrees(np.arcsin(np.clip(-n[:, 2], 0, 1))) > SEAT_CONE_DEG + 5) & (c[:, 2] > 1e-3)
+    assert not steep.any()
+    assert hanging_edge_length_mm(mesh) == {}
+    assert not any(f["id"] in ("tube.window_bridge", "tube.labium_overhang") for f in report["findings"])
+    assert report["meshes"]["tube.stl"]["bed_face"].startswith("the tube's foot")
+    need("prusa-slicer")
+    gcode = tmp_path / "tube.gcode"
+    run = subprocess.run(["prusa-slicer", "--export-gcode", "--support-material", "--support-material-auto",
+                          "--output", str(gcode), str(out / "tube.stl")], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-500:]
+    text = gcode.read_text()
+    assert "; support_material = 1" in text and support_volume_mm3(text) == 0.0

@@ -49,6 +49,19 @@ def test_levine_schwinger_and_flanged_corrections_and_the_fipple_window(td):
     assert T.line_hz(wider) > T.line_hz(td)
 
 
+def test_a_transverse_window_is_rayleighs_aperture_of_its_sides_and_gable(td):
+    """The transverse mouth's window (matcad.parts.tube.transverse_tube): W wide, its sides B + (h/2)/tan 30° high
+    under a gable (W/2)/tan 30° high; Rayleigh's δ of that area; a larger window than the fipple's B·W, so a shorter
+    correction and a higher f at the same column."""
+    transverse = dataclasses.replace(td, mouth="transverse")
+    h, b, w, t30 = td.windway_height, td.windway_width, td.edge_distance, math.tan(math.radians(30))
+    area = w * (b + h / 2 / t30) + w * (w / 2 / t30) / 2
+    a = td.bore_diameter / 2
+    assert T.mouth_correction_mm(transverse) == pytest.approx(math.pi * a**2 / (2 * math.sqrt(area / math.pi)))
+    assert T.mouth_correction_mm(transverse) < T.mouth_correction_mm(td)
+    assert T.line_hz(transverse) > T.line_hz(td)
+
+
 @pytest.mark.parametrize("kappa", [0.0, 1.5, -1.5])
 def test_fem_converges_to_the_line_at_order_2_for_p1_and_4_for_p2(td, kappa):
     exact = T.line_hz(td, kappa)

@@ -35,6 +35,8 @@ def test_cap_depth_defaults_to_the_bore_and_mat_is_the_default_kind():
     ({"array": {"rows": 2, "columns": 2}}, "array", "does not apply"),
     ({"kind": "pipe"}, "kind", "'mat', 'tube'"),
     ({"tube": {"bore_diameter": 6.0, "length": 16.0, "windway_width": 7.0}}, "tube.windway_width", "<= tube.bore"),
+    ({"tube": {"bore_diameter": 6.0, "length": 16.0, "mouth": "transverse", "edge_distance": 6.0}},
+     "tube.edge_distance", "< tube.bore_diameter = 6 mm for a transverse mouth"),
     ({"tube": {"bore_diameter": 6.0, "length": 16.0, "windway_height": 3.0}}, "tube.windway_height", "< tube.bore"),
     ({"tube": {"bore_diameter": 6.0, "length": 0.5}}, "tube.length", "2 <= value"),
     ({"tube": {"bore_diameter": 6.0, "length": 16.0, "edge_angle": 80}}, "tube.edge_angle", "<= 60 deg"),
@@ -43,6 +45,14 @@ def test_tube_spec_refuses_what_does_not_apply_naming_the_field(extra, field, wo
     with pytest.raises(SpecError) as err:
         from_dict({**TUBE_DATA, **extra})
     assert err.value.field == field and words in str(err.value)
+
+
+def test_a_transverse_window_runs_along_the_bore_so_its_height_may_exceed_the_bore():
+    """A transverse mouth's windway width B is the window's height along the bore (matcad.parts.tube.transverse_tube):
+    no bound by the bore, which bounds its width W instead."""
+    spec = from_dict({**TUBE_DATA, "tube": {"bore_diameter": 6.0, "length": 16.0, "mouth": "transverse",
+                                            "windway_width": 7.0, "edge_distance": 3.0}})
+    assert spec.tube.mouth == "transverse" and spec.tube.windway_width == 7.0
 
 
 def test_a_mat_spec_with_a_tube_table_and_a_tube_without_one_are_refused():

@@ -12,8 +12,9 @@ by 0.0044 a from ka = 0.048 to 0.182, docs/tube.md).
 
 Mouths (:data:`MOUTHS`): ``fipple`` the printed window as :mod:`matcad.parts.tube` cuts it (the window through the
 wall over the windway's width, the labium's two bevels above it, the bore's floor funnel below it; not the windway
-slot, a dead end at ka → 0), its δ measured from the edge; ``baffled`` a pipe ending in an infinite rigid baffle
-(Norris & Sheng 1989's 0.8216 a, the closed form that verifies this route); ``unflanged`` a pipe of wall w ending
+slot, a dead end at ka → 0), its δ measured from the edge; ``transverse`` the side window of a transverse mouth
+(its sides and gable, the funnel below; not the windway's boss), measured from its sides' top; ``baffled`` a pipe
+ending in an infinite rigid baffle (Norris & Sheng 1989's 0.8216 a, the closed form that verifies this route); ``unflanged`` a pipe of wall w ending
 in free space (the axisymmetric exterior FEM's geometry, :mod:`matcad.acoustics.fem`, the second route).
 """
 
@@ -25,20 +26,22 @@ from dataclasses import dataclass
 import numpy as np
 
 from matcad.acoustics import fem_cut
-from matcad.spec.tube import EDGE_LAND_MM, SEAT_CONE_DEG
+from matcad.spec.tube import EDGE_LAND_MM, SEAT_CONE_DEG, WINDOWED, transverse_floor_mm, transverse_window_mm
 
 FAR_PER_A = 20.0
 """The far box's half size in bore radii (the monopole condition on it), and the bore's length to its driven end."""
 DEFAULT_LEVEL = 8
 """Cells across the bore's radius near the mouth."""
 CG_TOLERANCE = 1e-10
-MOUTHS = ("fipple", "baffled", "unflanged")
+MOUTHS = ("fipple", "transverse", "baffled", "unflanged")
 
 
 @dataclass(frozen=True)
 class Mouth:
-    """A mouth's geometry (mm, deg): the bore's radius ``a``, the printed wall, and for a fipple the window's width
-    B and height W (edge distance), the labium's bevel and the block's length (:func:`from_tube` fills them)."""
+    """A mouth's geometry (mm, deg): the bore's radius ``a``, the printed wall, and for a window its width across
+    the jet's path and height along the bore (a fipple's B and W; a transverse window's W and its sides' height,
+    under a ``gable`` of that rise), a fipple's labium bevel, and the block's (a fipple) or the floor's (transverse)
+    depth below the window (:func:`from_tube` fills them)."""
 
     kind: str
     a: float
@@ -47,6 +50,7 @@ class Mouth:
     window_height: float = 0.0
     edge_angle: float = 0.0
     block_length: float = 0.0
+    gable: float = 0.0
 
     def __post_init__(self) -> None:
         if self.kind not in MOUTHS:
@@ -54,8 +58,9 @@ class Mouth:
 
     @property
     def mouth_z(self) -> float:
-        """The plane δ is measured from (mm): the edge for a fipple, the pipe's end otherwise."""
-        return self.window_height if self.kind == "fipple" else 0.0
+        """The plane δ is measured from (mm): a window's top (a fipple's edge, a transverse window's sides' top,
+        where the spec's ``tube.length`` starts), the pipe's end otherwise."""
+        return self.window_height if self.kind in WINDOWED else 0.0
 
     @property
     def plane_z(self) -> float:
@@ -65,7 +70,7 @@ class Mouth:
     @property
     def centre(self) -> np.ndarray:
         """Where the far field's monopole sits (mm)."""
-        if self.kind == "fipple":
+        if self.kind in WINDOWED:
             return np.array([self.a + self.wall, 0.0, self.window_height / 2])
         return np.zeros(3)
 
@@ -81,6 +86,8 @@ class Mouth:
         outer = a + self.wall
         if self.kind == "unflanged":
             return np.maximum(np.maximum(r - outer, -z), bore)
+        if self.kind == "transverse":
+            return self._transverse(x, y, z, r, outer)
         return self._fipple(x, y, z, r, outer)
 
     def _fipple(self, x, y, z, r, outer):
@@ -98,6 +105,20 @@ class Mouth:
         body = np.minimum(outer - r, z + self.block_length)
         return np.maximum.reduce([-body, carved, window, outside, inside])
 
+    def _transverse(self, x, y, z, r, outer):
+        """The transverse window (:func:`matcad.parts.tube.transverse_tube`): through the wall on +x, W wide along
+        y, its sides ``window_height`` high under the gable at 30° from vertical; the funnel floor below z = 0.
+        Not the windway's boss beside it (it breaks the plane of symmetry y = 0; outside the tube, it moves δ
+        little)."""
+        a, half = self.a, self.window_width / 2
+        cone = math.radians(SEAT_CONE_DEG)
+        floor = (np.minimum(z, 0.0) + a / math.tan(cone)) * math.tan(cone)
+        carved = np.where(z < 0, (floor - r) * math.cos(cone), a - r)
+        roof = (self.window_height + (half - np.abs(y)) / math.tan(cone) - z) * math.sin(cone)
+        window = np.minimum.reduce([half - np.abs(y), x, z, roof])
+        body = np.minimum(outer - r, z + self.block_length)
+        return np.maximum.reduce([-body, carved, window])
+
     def axes(self, level: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Grid lines (mm): cells a/level over the mouth and the tube's section, graded out to the far box."""
         a, h = self.a, self.a / level
@@ -107,7 +128,7 @@ class Mouth:
         xs = fem_cut.graded(-reach, reach, h, -far, far, planes=(0.0,))
         ys = fem_cut.graded(0.0, reach, h, 0.0, far, planes=(0.0, self.window_width / 2))
         ys = ys[ys >= 0]
-        fine_top = self.mouth_z + 1.5 * a
+        fine_top = self.mouth_z + max(1.5 * a, self.gable + 0.5 * a)
         below = fem_cut.graded(-a, fine_top, h, self.mouth_z - far, fine_top, planes=(0.0, self.mouth_z))
         zs = fem_cut.merged(np.concatenate([below, _bore_lines(fine_top, top, h, a)]), h / 4, (0.0, self.mouth_z))
         return xs, ys, zs
@@ -124,8 +145,13 @@ def _bore_lines(start: float, stop: float, h: float, a: float) -> np.ndarray:
 
 
 def from_tube(td) -> Mouth:
-    """The :class:`Mouth` of a :class:`matcad.acoustics.tube.TubeDesign` (its ``mouth``: fipple, flanged or
-    unflanged; 'flanged' is the baffled pipe)."""
+    """The :class:`Mouth` of a :class:`matcad.acoustics.tube.TubeDesign` (its ``mouth``: fipple, transverse,
+    flanged or unflanged; 'flanged' is the baffled pipe)."""
+    if td.mouth == "transverse":
+        sides, gable = transverse_window_mm(td.windway_height, td.windway_width, td.edge_distance)
+        a = td.bore_diameter / 2
+        return Mouth("transverse", a, td.tube_wall, td.edge_distance, sides, 0.0,
+                     transverse_floor_mm(a, td.tube_wall), gable)
     kind = {"flanged": "baffled"}.get(td.mouth, td.mouth)
     return Mouth(kind, td.bore_diameter / 2, td.tube_wall, td.windway_width, td.edge_distance, td.edge_angle,
                  td.block_length)

@@ -7,9 +7,10 @@ same bore) to the cap's inner wall (x = ℓ). Two end conditions close the 1-D H
 
 - at the mouth, the radiating air is a mass: p(0) = δ p'(0), δ the mouth's end correction as a length of bore —
   0.6133 a for an unflanged open end (Levine & Schwinger 1948), 0.8216 a flanged (Norris & Sheng 1989), and for a
-  fipple's window of area S_m = B·W in the tube's wall S_p / K_R, with K_R = 2 a_m Rayleigh's conductance of an
-  aperture of equal area in a thin wall (Rayleigh, Theory of Sound II §306; the flue-pipe mouth as an inertance:
-  Fletcher & Rossing 1998, "The Physics of Musical Instruments", §17.4);
+  window in the tube's wall (a fipple's B·W, a transverse mouth's sides and gable) of area S_m, S_p / K_R, with
+  K_R = 2 a_m Rayleigh's conductance of an aperture of equal area in a thin wall (Rayleigh, Theory of Sound II
+  §306; the flue-pipe mouth as an inertance: Fletcher & Rossing 1998, "The Physics of Musical Instruments",
+  §17.4);
 - at the cap, the wall's volume compliance C_w (its volume swept per unit pressure, the MAT path's wall model
   :mod:`matcad.acoustics.wall`) is a compliant termination: p'(ℓ) = k² κ p(ℓ), κ = K C_w / S_p the length of air with
   the same compliance (K = ρc² the bulk modulus). A rigid cap is κ = 0.
@@ -33,6 +34,7 @@ import numpy as np
 from matcad.acoustics import wall as wall_model
 from matcad.acoustics.air import BULK_MODULUS_PA
 from matcad.acoustics.design import Air, WallMaterial, speed_of_sound
+from matcad.spec.tube import WINDOWED, transverse_window_area_mm2
 
 UNFLANGED = 0.6133
 """Open-end correction of an unflanged thin-walled tube, per radius (Levine & Schwinger 1948, ka → 0)."""
@@ -48,7 +50,7 @@ BOUNDARY_LAYER_STEPS = 100
 @dataclass(frozen=True)
 class TubeDesign:
     """One fipple tube as built (mm, deg): bore, length mouth → cap seat, the cap's cavity depth, the open end's
-    ``mouth`` ('fipple', 'unflanged', 'flanged'), windway height h and width B, edge distance W, the cap around
+    ``mouth`` (:data:`matcad.spec.tube.MOUTHS`), windway height h and width B, edge distance W, the cap around
     the cavity (outer diameter, top thickness, clamped height), the air, the cap's wall material and the printed
     tube's wall thickness ``tube_wall`` (mm, the spec's ``tube.wall``)."""
 
@@ -101,15 +103,17 @@ def tube_design(spec) -> TubeDesign:
 
 def mouth_correction_mm(td: TubeDesign, factor: float = 1.0) -> float:
     """δ, the open end's correction as a length of bore (mm): Levine & Schwinger's 0.6133 a unflanged, Norris &
-    Sheng's 0.8216 a flanged, or a fipple window's inertance S_p / (2 a_m), a_m = √(B W / π) (Rayleigh's
-    conductance of a thin-walled aperture of the window's area); times ``factor`` (an uncertainty study)."""
+    Sheng's 0.8216 a flanged, or a window's inertance S_p / (2 a_m), a_m = √(S_m / π) (Rayleigh's conductance of a
+    thin-walled aperture of the window's area S_m: B W for a fipple, the sides and gable of a transverse window,
+    :func:`matcad.spec.tube.transverse_window_area_mm2`); times ``factor`` (an uncertainty study)."""
     a = td.bore_diameter / 2
     if td.mouth == "unflanged":
         return factor * UNFLANGED * a
     if td.mouth == "flanged":
         return factor * FLANGED * a
-    a_m = math.sqrt(td.windway_width * td.edge_distance / math.pi)
-    return factor * td.bore_area_mm2 / (2 * a_m)
+    area = td.windway_width * td.edge_distance if td.mouth == "fipple" else \
+        transverse_window_area_mm2(td.windway_height, td.windway_width, td.edge_distance)
+    return factor * td.bore_area_mm2 / (2 * math.sqrt(area / math.pi))
 
 
 def compliance_length_mm(td: TubeDesign, compliance_mm3_pa: float) -> float:
@@ -205,13 +209,14 @@ def exterior_fem(td: TubeDesign, level: int | None = None):
     (:func:`flanged_phase_correction_mm`); unflanged with a thin wall, its correction tends to Levine & Schwinger's
     0.6133 a as ka → 0, rising with the wall's thickness towards the flanged value (docs/tube.md). ``level``:
     elements across the bore's radius (default fem's). Returns a :class:`matcad.acoustics.fem.FemResult` (f in Hz,
-    lossless: :func:`boundary_layer_hz` adds the bore's boundary layers). Raises ValueError for 'fipple' (a window in the tube's wall: 3-D, :func:`window_fem`)."""
+    lossless: :func:`boundary_layer_hz` adds the bore's boundary layers). Raises ValueError for a window in the
+    tube's wall, 'fipple' or 'transverse' (3-D: :func:`window_fem`)."""
     from matcad.acoustics import fem
 
     exteriors = {"flanged": "baffled", "unflanged": "unflanged"}
     if td.mouth not in exteriors:
-        raise ValueError(f"tube.mouth = '{td.mouth}' has no axisymmetric exterior FEM (a fipple's window in the "
-                         f"tube's wall is 3-D: window_fem), must be one of 'flanged', 'unflanged': docs/tube.md")
+        raise ValueError(f"tube.mouth = '{td.mouth}' has no axisymmetric exterior FEM (a window in the tube's wall "
+                         f"is 3-D: window_fem), must be one of 'flanged', 'unflanged': docs/tube.md")
     a = td.bore_diameter / 2
     g = fem.FemGeometry(neck_radius=a, neck_length=td.length, cavity_radius=a, cavity_tip_radius=a,
                         cavity_length=td.cap_depth, mouth=exteriors[td.mouth],
@@ -222,13 +227,13 @@ def exterior_fem(td: TubeDesign, level: int | None = None):
 
 
 def window_fem(td: TubeDesign, level: int | None = None) -> tuple[float, float]:
-    """The fipple window's end correction δ (mm) by the 3-D potential-flow FEM of the printed mouth
+    """A window's end correction δ (mm) by the 3-D potential-flow FEM of the printed mouth, fipple or transverse
     (:func:`matcad.acoustics.mouth3d.end_correction`, scikit-fem; ``level`` cells across the bore's radius, default
     its own), and the rigid-capped line's f1 (Hz) with that δ in place of Rayleigh's aperture. ValueError for
     another mouth."""
     from matcad.acoustics import mouth3d
 
-    if td.mouth != "fipple":
+    if td.mouth not in WINDOWED:
         raise ValueError(f"tube.mouth = '{td.mouth}' has no window: exterior_fem resolves it")
     delta = mouth3d.end_correction(mouth3d.from_tube(td), level or mouth3d.DEFAULT_LEVEL).delta_mm
     return delta, line_hz(td, correction_factor=delta / mouth_correction_mm(td))

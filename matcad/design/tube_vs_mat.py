@@ -48,7 +48,7 @@ class Comparison:
         rows = (("pitch f1 (Hz)", f"{self.mat_f_hz[0]:.0f} ({VARIED} {d:.3f} mm)", f"{self.tube_f_hz[0]:.0f}"),
                 ("resonator (mm)", f"cavity Ø{dc:g} × {lc:g}, neck Ø{d:.2f} × {l:g}", f"column Ø{bore:g} × {column:g}"),
                 ("taxel length (mm)", f"{self.mat_length_mm:.2f} (spacer + plate + cap)",
-                 f"{self.tube_length_mm:.2f} (block + window + bore + cap)"),
+                 f"{self.tube_length_mm:.2f} (foot + window + bore + cap)"),
                 ("air volume (mm³)", f"{sum(self.mat_air_mm3):.1f} (cavity {self.mat_air_mm3[0]:.1f} + neck "
                  f"{self.mat_air_mm3[1]:.1f})", f"{self.tube_air_mm3:.1f} (column)"),
                 ("f(F) − f(0)", _shifts(self.mat_f_hz), _shifts(self.tube_f_hz)),

@@ -29,6 +29,38 @@ depth lengthens δ, the labium's bevels and the curved wall shorten it). Level 8
 on the 1.32 window and level 12 by 1.8 % (the unflanged pipe against the axisymmetric FEM), 1.36 in all, kept at
 1.45 for the windows not refined; on thin walls by 6–10 % (0.8 mm walls: their 0.89 and 0.84 rise to 0.95 and
 0.93, away from the bottom). benchmarks/fipple_window.py, docs/tube.md. A part of the band."""
+TRANSVERSE_STUDY = ((1.2, 3.5, 2.0, 0.5), (0.8, 3.5, 2.0, 0.5), (2.0, 3.5, 2.0, 0.5), (1.2, 2.5, 2.0, 0.5),
+                    (1.2, 5.0, 2.0, 0.5), (1.2, 3.5, 1.2, 0.5), (1.2, 3.5, 3.0, 0.5), (1.2, 3.5, 2.0, 1.0))
+"""The windows :data:`TRANSVERSE_RANGE` was measured on: (tube.wall, windway_width B, edge_distance W,
+windway_height h mm) on a bore of :data:`MOUTH_STUDY_BORE_MM`; the template's own first."""
+TRANSVERSE_RANGE = (0.85, 1.70)
+"""A transverse window's δ over Rayleigh's aperture of its area, by the 3-D FEM (level 8) over
+:data:`TRANSVERSE_STUDY`: 0.89 (W 3 mm, a window across most of the bore's side) to 1.52 (a 2 mm wall). Level 8
+is low: the template's 1.188 is 1.215 at level 10 and 1.226 at level 12, still rising (~4 % in all); the top
+widened by 6 % and rounded up, the bottom kept below the lowest. docs/tube.md. A part of the band."""
+
+
+@dataclass(frozen=True)
+class WindowStudy:
+    """Where a window's δ over Rayleigh's was measured by the 3-D FEM: the design's fields per window (the
+    :class:`matcad.acoustics.tube.TubeDesign` attribute and the spec's field; lengths on a bore of
+    :data:`MOUTH_STUDY_BORE_MM`, angles in deg), the windows, the ratio's range the band carries, its source."""
+
+    fields: tuple[tuple[str, str], ...]
+    windows: tuple[tuple[float, ...], ...]
+    ratio: tuple[float, float]
+    source: str
+
+
+WINDOW_STUDIES = {
+    "fipple": WindowStudy((("tube_wall", "tube.wall"), ("windway_width", "tube.windway_width"),
+                           ("edge_distance", "tube.edge_distance"), ("edge_angle", "tube.edge_angle")),
+                          MOUTH_STUDY, MOUTH_RANGE, "3-D FEM over ten windows"),
+    "transverse": WindowStudy((("tube_wall", "tube.wall"), ("windway_width", "tube.windway_width"),
+                               ("edge_distance", "tube.edge_distance"), ("windway_height", "tube.windway_height")),
+                              TRANSVERSE_STUDY, TRANSVERSE_RANGE, "3-D FEM over eight transverse windows"),
+}
+"""Per windowed mouth (:data:`matcad.spec.tube.WINDOWED`), its :class:`WindowStudy`."""
 
 
 @dataclass(frozen=True)
@@ -97,16 +129,16 @@ def _wall_results(td: air.TubeDesign):
     return results, notes
 
 
-def _outside_mouth_study(td: air.TubeDesign) -> list[str]:
-    """A note for each of the window's proportions (per bore radius; the bevel in deg) outside those of
-    :data:`MOUTH_STUDY`, where :data:`MOUTH_RANGE` is not measured."""
+def _outside_mouth_study(td: air.TubeDesign, study: WindowStudy) -> list[str]:
+    """A note for each of the window's proportions (per bore radius; an angle in deg) outside those of ``study``'s
+    windows, where its ratio's range is not measured."""
     a, a_study = td.bore_diameter / 2, MOUTH_STUDY_BORE_MM / 2
-    design = {"tube.wall": (td.tube_wall / a, a), "tube.windway_width": (td.windway_width / a, a),
-              "tube.edge_distance": (td.edge_distance / a, a), "tube.edge_angle": (td.edge_angle, 1.0)}
     notes = []
-    for column, (field, (value, unit)) in enumerate(design.items()):
-        scale = 1.0 if field == "tube.edge_angle" else a_study
-        lo, hi = (f(w[column] / scale for w in MOUTH_STUDY) for f in (min, max))
+    for column, (attribute, field) in enumerate(study.fields):
+        angle = attribute.endswith("angle")
+        value, unit = (getattr(td, attribute), 1.0) if angle else (getattr(td, attribute) / a, a)
+        scale = 1.0 if angle else a_study
+        lo, hi = (f(w[column] / scale for w in study.windows) for f in (min, max))
         if not lo - 1e-9 <= value <= hi + 1e-9:
             notes.append(f"{field} = {value * unit:g} lies outside the windows the mouth's range was measured on "
                          f"({lo * unit:g}-{hi * unit:g} for this bore): the band may not hold the window's "
@@ -118,11 +150,12 @@ def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePredict
     """The prediction of a ``kind = "tube"`` spec, with f at ``forces_n`` (N) from the cap mechanics (FElupe,
     imported only then); with ``fem_level`` (elements across the bore's radius) also the FEM rung (scikit-fem): the
     axisymmetric exterior FEM's f1 of a flanged or unflanged tube (:func:`matcad.acoustics.tube.exterior_fem`), the
-    line with the 3-D FEM's δ of a fipple window (:func:`matcad.acoustics.tube.window_fem`, ~20 s at level 8)."""
+    line with the 3-D FEM's δ of a fipple or transverse window (:func:`matcad.acoustics.tube.window_fem`, ~20-30 s
+    at level 8)."""
     td = air.tube_design(spec)
     routes = {"closed form (rigid)": air.closed_form_hz(td), "line (rigid)": air.line_hz(td),
               "1-D FEM P2 (rigid)": air.fem_hz(td, 0.0, FEM_ELEMENTS, 2)}
-    if fem_level is not None and td.mouth == "fipple":
+    if fem_level is not None and td.mouth in WINDOW_STUDIES:
         routes[f"3-D window FEM + line, level {fem_level} (rigid)"] = air.window_fem(td, fem_level)[1]
     elif fem_level is not None:
         routes[f"exterior FEM, level {fem_level} (rigid)"] = air.boundary_layer_hz(td, air.exterior_fem(td, fem_level)
@@ -137,13 +170,13 @@ def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePredict
         f0, kappa = results[1]
         band = [min(f for f, _ in results), max(f for f, _ in results)]
         sources = ["cap shear modulus range"]
-    if td.mouth == "fipple":
-        k = kappa or 0.0
-        for factor in MOUTH_RANGE:
+    if td.mouth in WINDOW_STUDIES:
+        study, k = WINDOW_STUDIES[td.mouth], kappa or 0.0
+        for factor in study.ratio:
             shifted = f0 * air.line_hz(td, k, correction_factor=factor) / air.line_hz(td, k)
             band = [min(band[0], shifted), max(band[1], shifted)]
-        sources.append(f"fipple mouth correction x{MOUTH_RANGE[0]:g}-{MOUTH_RANGE[1]:g} (3-D FEM over ten windows)")
-        notes += _outside_mouth_study(td)
+        sources.append(f"{td.mouth} mouth correction x{study.ratio[0]:g}-{study.ratio[1]:g} ({study.source})")
+        notes += _outside_mouth_study(td, study)
     f2 = air.line_hz(td, kappa or 0.0, mode=2)
     windows = tuple(edgetone.window(f, mode, td.edge_distance, td.windway_height, td.windway_width)
                     for mode, f in ((1, f0), (2, f2)))

@@ -42,7 +42,8 @@ def edge_tone(spec, p) -> list[Finding]:
 
 
 def tube_print(spec, p) -> list[Finding]:
-    """The printed tube, bore vertical: its wall, the windway slot, the window's bridge, the labium's overhang."""
+    """The printed tube, bore vertical: its wall, the windway slot, and for a fipple the window's bridge and the
+    labium's overhang (a transverse mouth has neither)."""
     t, m = spec.tube, spec.machine
     out = []
     limit = 2 * m.nozzle if m.printer == "fdm" else MIN_WALL_SLA_MM
@@ -54,12 +55,15 @@ def tube_print(spec, p) -> list[Finding]:
         out.append(Finding("tube.windway", "error", t.windway_height, slot,
                            f"windway {t.windway_height:g} mm is narrower than the {m.printer} printer keeps open "
                            f"({slot:g} mm)", "raise tube.windway_height (and tube.edge_distance with it, W ~ 4 h)"))
+    if t.mouth == "transverse":  # its edge is vertical: no bridge, no bevel (matcad.parts.tube.transverse_tube)
+        return out
     if m.printer == "fdm" and t.windway_width > FDM_BRIDGE_MAX_MM:
         out.append(Finding("tube.window_bridge", "warning", t.windway_width, FDM_BRIDGE_MAX_MM,
                            f"the labium's edge is a {t.windway_width:g} mm bridge over the mouth window with the bore "
                            "vertical: the slicer fills the window, windway and needle seat with support (docs/tube.md)",
-                           'print on an SLA printer (machine.printer = "sla"), or with supports and clear the windway '
-                           "with a feeler gauge"))
+                           'set tube.mouth = "transverse" (prints without support), print on an SLA printer '
+                           '(machine.printer = "sla"), or print with supports and clear the windway with a feeler '
+                           "gauge"))
     if m.printer == "fdm" and t.edge_angle > FDM_OVERHANG_DEG:
         out.append(Finding("tube.labium_overhang", "warning", t.edge_angle, FDM_OVERHANG_DEG,
                            f"the labium's bevel overhangs {t.edge_angle:g} deg from vertical: FDM sags the edge",
