@@ -39,6 +39,14 @@ TRANSVERSE_RANGE = (0.85, 1.70)
 is low: the template's 1.188 is 1.215 at level 10 and 1.226 at level 12, still rising (~4 % in all); the top
 widened by 6 % and rounded up, the bottom kept below the lowest. docs/tube.md. A part of the band."""
 
+JET_RANGE = (0.93, 1.0)
+"""The sounding pitch over the air column's resonance (f0): a jet-driven pipe sounds below its resonance when blown
+softly, up to it when blown hard (the jet's delay across the mouth sets the loop's phase: Fletcher & Rossing 1998
+§16.3, §17.3). Measured on four fipple whistles with every hole closed, their softest to hardest speaking pitch
+(WWIDesigner v2.6.0's tunings, github.com/edwardkort/WWIDesigner: Feadog Mk 1 560-600 Hz, BP7 568-589, BP8
+568-585, a sample PVC whistle 560-589; fmin/fmax 0.933-0.971), the hardest taken as the resonance there
+(its ``PlayingRange``: fmax where Im Z = 0). A part of the band (docs/tube.md)."""
+
 
 @dataclass(frozen=True)
 class WindowStudy:
@@ -177,6 +185,8 @@ def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePredict
             band = [min(band[0], shifted), max(band[1], shifted)]
         sources.append(f"{td.mouth} mouth correction x{study.ratio[0]:g}-{study.ratio[1]:g} ({study.source})")
         notes += _outside_mouth_study(td, study)
+    band = [min(band[0], JET_RANGE[0] * f0), max(band[1], JET_RANGE[1] * f0)]
+    sources.append(f"the jet: sounding x{JET_RANGE[0]:g}-{JET_RANGE[1]:g} of the resonance (four measured whistles)")
     f2 = air.line_hz(td, kappa or 0.0, mode=2)
     windows = tuple(edgetone.window(f, mode, td.edge_distance, td.windway_height, td.windway_width)
                     for mode, f in ((1, f0), (2, f2)))
