@@ -28,7 +28,8 @@ def test_rigid_cap_tends_to_the_quarter_wave_closed_form_as_the_third_power_of_k
     """cot kℓ = kδ against f = c/4(ℓ + δ): relative error (kδ)³/3 to leading order, so halving the bore (δ ∝ a) divides
     it by 8; a line that dropped δ, or used a length extension at the cap, fails. Lossless: the boundary layers'
     phase speed, which depends on the bore, would blur the ratio (the layers: test_tube_measured.py)."""
-    long_thin = dataclasses.replace(td, mouth="unflanged", length=200.0, cap_depth=1.0, boundary_layers=False)
+    long_thin = dataclasses.replace(td, mouth="unflanged", length=200.0, cap_depth=1.0, boundary_layers=False,
+                                    tube_wall=0.0)  # δ ∝ a
     errors = []
     for bore in (4.0, 2.0, 1.0):
         t = dataclasses.replace(long_thin, bore_diameter=bore)
@@ -40,8 +41,13 @@ def test_rigid_cap_tends_to_the_quarter_wave_closed_form_as_the_third_power_of_k
 
 
 def test_levine_schwinger_and_flanged_corrections_and_the_fipple_window(td):
+    """Unflanged: the printed wall's end face lengthens Levine & Schwinger's 0.6133 a (a wall of no thickness, the
+    interpolation's limit) towards Norris & Sheng's 0.8216 a (an infinite flange, its other limit)."""
     a = td.bore_diameter / 2
-    assert T.mouth_correction_mm(dataclasses.replace(td, mouth="unflanged")) == pytest.approx(0.6133 * a)
+    unflanged = dataclasses.replace(td, mouth="unflanged")
+    assert T.wall_end_correction(0.0) == pytest.approx(0.6133) and T.wall_end_correction(1e9) == pytest.approx(0.8216)
+    assert T.mouth_correction_mm(unflanged) == pytest.approx(T.wall_end_correction(td.tube_wall / a) * a)
+    assert 0.6133 * a < T.mouth_correction_mm(unflanged) < 0.8216 * a
     assert T.mouth_correction_mm(dataclasses.replace(td, mouth="flanged")) == pytest.approx(0.8216 * a)
     a_m = math.sqrt(td.windway_width * td.edge_distance / math.pi)  # Rayleigh: K = 2 a_m, δ = S_p / K
     assert T.mouth_correction_mm(td) == pytest.approx(math.pi * a**2 / (2 * a_m))
@@ -140,17 +146,13 @@ def test_exterior_fem_resolves_the_unflanged_mouth_fast(td):
     data = to_dict(load(TEMPLATE))
     data["tube"]["mouth"] = "unflanged"
     run = T.exterior_fem(T.tube_design(from_dict(data)), 2)  # the template's own 1.2 mm wall (0.6 a): thick
-    assert 0.6133 * a < T.phase_correction_mm(T.tube_design(from_dict(data)), run.f0_hz) < 0.8216 * a
+    delta = T.phase_correction_mm(T.tube_design(from_dict(data)), run.f0_hz)
+    assert 0.6133 * a < delta < 0.8216 * a
+    assert delta == pytest.approx(T.mouth_correction_mm(T.tube_design(from_dict(data))), rel=0.05)  # the line's
     assert predict_tube(from_dict(data), fem_level=2).routes_hz["exterior FEM, level 2 (rigid)"] == pytest.approx(
         T.boundary_layer_hz(T.tube_design(from_dict(data)), run.f0_hz), rel=1e-9)
 
 
-def _wall_interpolation(wall_per_a):
-    """The end correction per radius of a tube whose end face reaches out to b = a + w, interpolated between the
-    unflanged and the infinitely flanged end: 0.8216 + (a/b)(0.6133 − 0.8216) + 0.057 (a/b)(1 − (a/b)⁵) (Dalmont,
-    Nederveen & Joly 2001, as WWIDesigner's ThickFlangedOpenEndCalculator implements it; not read in the paper)."""
-    x = 1 / (1 + wall_per_a)
-    return T.FLANGED + x * (T.UNFLANGED - T.FLANGED) + 0.057 * x * (1 - x**5)
 
 
 @pytest.mark.slow
@@ -166,11 +168,11 @@ def test_exterior_fem_unflanged_converges_rises_with_the_wall_and_ignores_the_ex
     steps = np.diff(deltas)
     assert np.all(steps > 0) and 1.6 < steps[0] / steps[1] < 2.6
     limit = deltas[2] + steps[1] ** 2 / (steps[0] - steps[1])  # Aitken; levels 4, 8, 16 give 0.0017 a less
-    assert 0 < limit - T.UNFLANGED < 0.016 and limit == pytest.approx(_wall_interpolation(0.02), abs=0.006)
+    assert 0 < limit - T.UNFLANGED < 0.016 and limit == pytest.approx(T.wall_end_correction(0.02), abs=0.006)
     walls = (0.05, 0.2, 1.0)
     thick = [T.phase_correction_mm(t, T.exterior_fem(t, 8).f0_hz) / a for t in (_unflanged(td, w) for w in walls)]
     assert deltas[2] < thick[0] < thick[1] < thick[2] < T.FLANGED
-    assert thick == pytest.approx([_wall_interpolation(w) for w in walls], abs=0.006)
+    assert thick == pytest.approx([T.wall_end_correction(w) for w in walls], abs=0.006)
     by_radius = []
     for radius in (10.0, 20.0):
         monkeypatch.setattr("matcad.acoustics.fem.EXTERIOR_RADIUS_PER_A", radius)
