@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 from matcad.acoustics import edgetone
 from matcad.acoustics import tube as air
+from matcad.acoustics.design import Air
+from matcad.acoustics.uncertainty import CAVITY_DIAMETER_TOL_MM, TEMPERATURE_TOL_C
 from matcad.acoustics.wall import HYBRID_BAND, mode_near
 
 FEM_ELEMENTS = 64
@@ -137,6 +139,17 @@ def _wall_results(td: air.TubeDesign):
     return results, notes
 
 
+def _made(td: air.TubeDesign, printer: str) -> tuple[air.TubeDesign, ...]:
+    """The design as it may be made and run: the printed bore ± the printer's tolerance on a printed core
+    (:data:`matcad.acoustics.uncertainty.CAVITY_DIAMETER_TOL_MM`, as the MAT cavity's), the air ±
+    :data:`matcad.acoustics.uncertainty.TEMPERATURE_TOL_C` (unless its speed of sound is given: exact)."""
+    tol = CAVITY_DIAMETER_TOL_MM[printer]
+    out = [dataclasses.replace(td, bore_diameter=td.bore_diameter + s * tol) for s in (-1, 1)]
+    if td.air.speed_of_sound_m_s is None:
+        out += [dataclasses.replace(td, air=Air(td.air.temperature_c + s * TEMPERATURE_TOL_C)) for s in (-1, 1)]
+    return tuple(out)
+
+
 def _outside_mouth_study(td: air.TubeDesign, study: WindowStudy) -> list[str]:
     """A note for each of the window's proportions (per bore radius; an angle in deg) outside those of ``study``'s
     windows, where its ratio's range is not measured."""
@@ -185,6 +198,12 @@ def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePredict
             band = [min(band[0], shifted), max(band[1], shifted)]
         sources.append(f"{td.mouth} mouth correction x{study.ratio[0]:g}-{study.ratio[1]:g} ({study.source})")
         notes += _outside_mouth_study(td, study)
+    for made in _made(td, spec.machine.printer):
+        shifted = f0 * air.line_hz(made, kappa or 0.0) / air.line_hz(td, kappa or 0.0)
+        band = [min(band[0], shifted), max(band[1], shifted)]
+    temperature = "" if td.air.speed_of_sound_m_s is not None else f", air +-{TEMPERATURE_TOL_C:g} C"
+    sources.append(f"printed bore +-{CAVITY_DIAMETER_TOL_MM[spec.machine.printer]:g} mm "
+                   f"({spec.machine.printer}){temperature}")
     band = [min(band[0], JET_RANGE[0] * f0), max(band[1], JET_RANGE[1] * f0)]
     sources.append(f"the jet: sounding x{JET_RANGE[0]:g}-{JET_RANGE[1]:g} of the resonance (four measured whistles)")
     f2 = air.line_hz(td, kappa or 0.0, mode=2)
