@@ -718,3 +718,33 @@ def test_large_grid_streams_to_the_csv(tmp_path):
     for row, line in zip(kept[::997], rows[::997]):
         assert line["failing_rules"] == (row.get("failing_rules") or "")
         assert float(line["f0_hz"]) == row["f0_hz"] and line["status"] == row["status"]
+
+
+def test_a_table_finds_many_codes_at_once_as_its_dict_does():
+    """Table.find of an array of codes is, code for code, the dict's get(code, -1), after every growth of the
+    table (fails if the sorted arrays go stale after an insert or the binary search misses a code at an end)."""
+    from matcad.sweep.memo import Table
+
+    rng = np.random.default_rng(7)
+    table, numbers = Table(), {}
+    assert table.find(np.array([0, 5], dtype=np.int64)).tolist() == [-1, -1]
+    for _ in range(30):
+        for code in rng.integers(-50, 1_000, size=rng.integers(1, 20)).tolist():
+            numbers[code] = table[code] = int(rng.integers(0, 9))
+        codes = rng.integers(-60, 1_010, size=200)
+        assert table.find(codes).tolist() == [numbers.get(c, -1) for c in codes.tolist()]
+        assert len(table) == len(numbers) and all(c in table for c in numbers)
+
+
+def test_distinct_rows_are_numpys_unique_rows():
+    """distinct_rows(m) is np.unique(m, axis=0, return_inverse=True), rows and numbers, on small and huge ranges of
+    values (fails if the mixed-radix key overflows or does not keep the rows' order)."""
+    from matcad.sweep.arrays import distinct_rows
+
+    rng = np.random.default_rng(3)
+    for k in range(200):
+        scale = (3, 100, 2**40, 2**62)[k % 4]
+        matrix = rng.integers(-scale, scale, size=(int(rng.integers(0, 60)), int(rng.integers(1, 9))))
+        rows, numbers = distinct_rows(matrix)
+        expected_rows, expected_numbers = np.unique(matrix, axis=0, return_inverse=True)
+        assert np.array_equal(rows, expected_rows) and np.array_equal(numbers, expected_numbers.reshape(-1))

@@ -23,7 +23,7 @@ import numpy as np
 
 from matcad.sweep import calibrated, fast
 from matcad.sweep.grid import variant_data
-from matcad.sweep.memo import Memo
+from matcad.sweep.memo import Memo, Table
 
 CHUNK = 4_096
 """Variants per pass of the whole pipeline (the models split it further: :data:`matcad.sweep.fast.CHUNK`)."""
@@ -126,21 +126,23 @@ def one_sheet(base, axes=()) -> bool:
 
 def _by_combination(chunk: GridChunk, axes: tuple[int, ...], positions, function, seen: dict) -> np.ndarray:
     """``function(j)`` once per combination of the values on ``axes`` among ``positions`` (j: the first variant
-    with it), given to every variant with that combination: an object array. ``seen`` keeps the results by
-    (axes, combination) across the grid's chunks (its codes are the whole grid's): a combination met in an earlier
-    chunk is not asked again."""
+    with it), given to every variant with that combination: an object array. ``seen`` keeps the results across the
+    grid's chunks (its codes are the whole grid's), by ``axes``: (a :class:`matcad.sweep.memo.Table` {combination:
+    result number}, the results): a combination met in an earlier chunk is not asked again."""
     positions = np.asarray(positions, dtype=np.int64)
-    out = np.empty(len(positions), dtype=object)
-    if not len(positions):
-        return out
-    uniq, first, inverse = np.unique(chunk.codes(axes, positions), return_index=True, return_inverse=True)
-    results = np.empty(len(uniq), dtype=object)
-    for k, (code, f) in enumerate(zip(uniq.tolist(), first.tolist())):
-        if (axes, code) not in seen:
-            seen[axes, code] = function(int(positions[f]))
-        results[k] = seen[axes, code]
-    out[:] = results[inverse.reshape(-1)]
-    return out
+    table, results = seen.setdefault(axes, (Table(), []))
+    codes = chunk.codes(axes, positions)
+    numbers = table.find(codes)
+    new = np.flatnonzero(numbers < 0)
+    if len(new):
+        uniq, first = np.unique(codes[new], return_index=True)
+        for code, f in zip(uniq.tolist(), first.tolist()):
+            table[code] = len(results)
+            results.append(function(int(positions[new[f]])))
+        numbers[new] = table.find(codes[new])
+    out = np.empty(len(results), dtype=object)
+    out[:] = results
+    return out[numbers]
 
 
 def validate(chunk: GridChunk, base, seen: dict | None = None) -> np.ndarray:
@@ -261,7 +263,7 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0
                               chunk.field(base, "needle.outer_diameter"), speed_of_sound(d.air))
     matrix = np.stack(numbers + [np.asarray(c, dtype=np.int64) for c in sound.values()], axis=1) if n else \
         np.zeros((0, len(memos) + len(sound)), dtype=np.int64)
-    uniq, inverse = np.unique(matrix, axis=0, return_inverse=True)
+    uniq, inverse = distinct_rows(matrix)
     errors, warnings, failing, failed = [], [], [], []
     for combo in uniq:
         items, broken = [], ""
@@ -285,11 +287,28 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0
         warnings.append(sum(x[1] == "warning" for x in items))
         failing.append(" ".join(dict.fromkeys(f"{i}:{lvl}" for i, lvl in ordered)))
         failed.append(broken)
-    inverse = inverse.reshape(-1)
     return {"rule_errors": np.array(errors, dtype=np.int64)[inverse] if n else np.zeros(0, np.int64),
             "rule_warnings": np.array(warnings, dtype=np.int64)[inverse] if n else np.zeros(0, np.int64),
             "failing_rules": np.array(failing, dtype=object)[inverse] if n else np.zeros(0, object),
             "failed": np.array(failed, dtype=object)[inverse] if n else np.zeros(0, object)}
+
+
+def distinct_rows(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(the distinct rows of the 2-D integer ``matrix`` in ascending order, each row's number among them): what
+    ``np.unique(matrix, axis=0, return_inverse=True)`` gives, from one int64 key per row, its columns as the digits
+    of a mixed radix (key and column renumbered densely first where the next digit could overflow), so one sort of
+    integers instead of a sort of rows."""
+    key = np.zeros(len(matrix), dtype=np.int64)
+    for column in matrix.T if len(matrix) else ():
+        low = column.min()
+        radix = int(column.max() - low) + 1
+        if (int(key.max()) + 1) * radix > 2**62:
+            key = np.unique(key, return_inverse=True)[1].reshape(-1)
+            column, low = np.unique(column, return_inverse=True)[1].reshape(-1), 0
+            radix = int(column.max()) + 1
+        key = key * radix + (column - low)
+    _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+    return matrix[first], inverse.reshape(-1)
 
 
 def rule_groups() -> list[tuple]:

@@ -75,13 +75,52 @@ def run(function, spec) -> tuple[frozenset, object]:
         _state.reads = None
 
 
+class Table:
+    """{integer code: integer number} that also looks up a whole array of codes at once: its keys ascending and
+    their numbers as arrays, remade only after it has grown (a chunk's lookup is a binary search, not a Python
+    loop over its codes)."""
+
+    def __init__(self):
+        self._numbers: dict[int, int] = {}
+        self._arrays: tuple[np.ndarray, np.ndarray] | None = None
+
+    def __len__(self) -> int:
+        return len(self._numbers)
+
+    def __contains__(self, code: int) -> bool:
+        return code in self._numbers
+
+    def __setitem__(self, code: int, number: int) -> None:
+        self._numbers[code] = number
+        self._arrays = None
+
+    def find(self, codes: np.ndarray) -> np.ndarray:
+        """The number of each of ``codes`` (int64 array), -1 where the table has none."""
+        if self._arrays is None:
+            keys = np.fromiter(self._numbers, dtype=np.int64, count=len(self._numbers))
+            numbers = np.fromiter(self._numbers.values(), dtype=np.int64, count=len(self._numbers))
+            order = np.argsort(keys)
+            self._arrays = keys[order], numbers[order]
+        return lookup(*self._arrays, codes)
+
+
+def lookup(keys: np.ndarray, numbers: np.ndarray, codes: np.ndarray) -> np.ndarray:
+    """``numbers[i]`` where ``keys[i]`` is the code, for each of ``codes``, -1 where no key is (``keys``: distinct,
+    ascending; int64 arrays)."""
+    codes = np.asarray(codes, dtype=np.int64)
+    if not len(keys):
+        return np.full(codes.shape, -1, dtype=np.int64)
+    at = np.minimum(np.searchsorted(keys, codes), len(keys) - 1)
+    return np.where(keys[at] == codes, numbers[at], -1)
+
+
 class Memo:
-    """One function's results over a grid: for each set of axes it was seen to read, {code of those axes' value
-    indices: outcome number}; outcomes are stored once each (:attr:`outcomes`)."""
+    """One function's results over a grid: for each set of axes it was seen to read, a :class:`Table` {code of those
+    axes' value indices: outcome number}; outcomes are stored once each (:attr:`outcomes`)."""
 
     def __init__(self, function):
         self.function = function
-        self.tables: dict[tuple[int, ...], dict[int, int]] = {}
+        self.tables: dict[tuple[int, ...], Table] = {}
         self.outcomes: list = []
         self._number: dict = {}
 
@@ -102,7 +141,7 @@ class Memo:
         while (todo := np.flatnonzero(out < 0)).size:
             reads, outcome = run(self.function, grid.spec(int(todo[0])))
             axes = grid.axes_of(reads)
-            table = self.tables.setdefault(axes, {})
+            table = self.tables.setdefault(axes, Table())
             codes = grid.codes(axes, todo)
             first = {}
             for j, code in zip(todo.tolist(), codes.tolist()):
@@ -118,7 +157,7 @@ class Memo:
                     table[code] = self._intern(outcome_j)
                 else:  # another path through the function: its own key
                     other = grid.axes_of(reads_j)
-                    self.tables.setdefault(other, {})[int(grid.codes(other, np.array([j]))[0])] = \
+                    self.tables.setdefault(other, Table())[int(grid.codes(other, np.array([j]))[0])] = \
                         self._intern(outcome_j)
             for axes_k, table_k in self.tables.items():
                 self._fill(out, grid, axes_k, table_k)
@@ -129,7 +168,4 @@ class Memo:
         todo = np.flatnonzero(out < 0)
         if not todo.size or not table:
             return
-        codes = grid.codes(axes, todo)
-        uniq, inverse = np.unique(codes, return_inverse=True)
-        found = np.array([table.get(int(c), -1) for c in uniq.tolist()], dtype=np.int64)
-        out[todo] = found[inverse]
+        out[todo] = table.find(grid.codes(axes, todo))
