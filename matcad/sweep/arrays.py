@@ -244,10 +244,11 @@ def _array_column(chunk: GridChunk, base, memo: Memo, v: fast.Variants, entry) -
 
 
 def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0, low, high,
-                 model_warnings) -> dict:
+                 model_warnings, known: dict | None = None) -> dict:
     """rule_errors, rule_warnings, failing_rules (and status/reason where a rule raised) of the chunk's valid
     variants, as :func:`matcad.sweep.tasks.rule_verdicts` gives them one by one (``memos``: :func:`rule_memos`;
-    ``model_warnings``: each variant's count of its prediction's warnings from its own model)."""
+    ``model_warnings``: each variant's count of its prediction's warnings from its own model; ``known``: the
+    verdicts of the grid's earlier chunks by row of outcome numbers and counts (:func:`_verdict`), filled in)."""
     from matcad.acoustics.design import speed_of_sound
     from matcad.rules import acoustic, jet
 
@@ -264,33 +265,43 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0
     matrix = np.stack(numbers + [np.asarray(c, dtype=np.int64) for c in sound.values()], axis=1) if n else \
         np.zeros((0, len(memos) + len(sound)), dtype=np.int64)
     uniq, inverse = distinct_rows(matrix)
-    errors, warnings, failing, failed = [], [], [], []
-    for combo in uniq:
-        items, broken = [], ""
-        for group, memo, number in zip(groups, memos, combo[:len(memos)]):
-            if group[0] in on_arrays:
-                if number >= 0:
-                    items += [(on_arrays[group[0]].id, on_arrays[group[0]].level)] * int(number)
-                    continue
-                outcomes = (memo.outcomes[-number - 1],)
-            else:
-                outcomes = memo.outcomes[number]
-            for outcome in outcomes:
-                if isinstance(outcome, tuple) and outcome[:1] == ("failed",):
-                    broken = broken or outcome[1]
-                    continue
-                items += list(outcome)
-        for (rule_id, level), count in zip(sound, combo[len(memos):]):
-            items += [(rule_id, level)] * int(count)
-        ordered = [x for x in items if x[1] == "error"] + [x for x in items if x[1] == "warning"]
-        errors.append(sum(x[1] == "error" for x in items))
-        warnings.append(sum(x[1] == "warning" for x in items))
-        failing.append(" ".join(dict.fromkeys(f"{i}:{lvl}" for i, lvl in ordered)))
-        failed.append(broken)
-    return {"rule_errors": np.array(errors, dtype=np.int64)[inverse] if n else np.zeros(0, np.int64),
-            "rule_warnings": np.array(warnings, dtype=np.int64)[inverse] if n else np.zeros(0, np.int64),
-            "failing_rules": np.array(failing, dtype=object)[inverse] if n else np.zeros(0, object),
-            "failed": np.array(failed, dtype=object)[inverse] if n else np.zeros(0, object)}
+    known = {} if known is None else known
+    combos = list(map(tuple, uniq.tolist()))
+    for combo in combos:
+        if combo not in known:
+            known[combo] = _verdict(combo, groups, memos, on_arrays, tuple(sound))
+    verdicts = [known[combo] for combo in combos]
+
+    def column(k: int, dtype) -> np.ndarray:
+        return np.array([v[k] for v in verdicts], dtype=dtype)[inverse]
+
+    return {"rule_errors": column(0, np.int64), "rule_warnings": column(1, np.int64),
+            "failing_rules": column(2, object), "failed": column(3, object)}
+
+
+def _verdict(combo: tuple, groups, memos: list[Memo], on_arrays: dict, sound: tuple) -> tuple[int, int, str, str]:
+    """(rule_errors, rule_warnings, failing_rules, the message of the first rule that raised or '') of the variants
+    whose row of :func:`rule_columns`' matrix is ``combo``: each memo's outcome number (an array rule's count, or
+    -(k + 1) for its failed input k), then each sound rule's count (``sound``: their (id, level))."""
+    items, broken = [], ""
+    for group, memo, number in zip(groups, memos, combo[:len(memos)]):
+        if group[0] in on_arrays:
+            if number >= 0:
+                items += [(on_arrays[group[0]].id, on_arrays[group[0]].level)] * int(number)
+                continue
+            outcomes = (memo.outcomes[-number - 1],)
+        else:
+            outcomes = memo.outcomes[number]
+        for outcome in outcomes:
+            if isinstance(outcome, tuple) and outcome[:1] == ("failed",):
+                broken = broken or outcome[1]
+                continue
+            items += list(outcome)
+    for (rule_id, level), count in zip(sound, combo[len(memos):]):
+        items += [(rule_id, level)] * int(count)
+    ordered = [x for x in items if x[1] == "error"] + [x for x in items if x[1] == "warning"]
+    return (sum(x[1] == "error" for x in items), sum(x[1] == "warning" for x in items),
+            " ".join(dict.fromkeys(f"{i}:{lvl}" for i, lvl in ordered)), broken)
 
 
 def distinct_rows(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -358,10 +369,12 @@ def slope_memo() -> Memo:
     return Memo(slope)
 
 
-def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo, seen: dict | None = None) -> dict:
+def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo, seen: dict | None = None,
+             known: dict | None = None) -> dict:
     """Every column of the chunk's variants: status, reason, f0_hz, band_low_hz, band_high_hz, model_valid,
     df0/dfield per axis (keyed by field), the load slope, and the rule columns when ``rules``; arrays. ``seen``:
-    the grid's validation messages so far (:func:`validate`)."""
+    the grid's validation messages so far (:func:`validate`); ``known``: its rule verdicts so far
+    (:func:`rule_columns`)."""
     n = len(chunk)
     reason = validate(chunk, base, seen)
     ok = np.flatnonzero(reason == "")
@@ -400,7 +413,7 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
     outcomes[:] = slope.outcomes
     out["load_slope"][ok] = outcomes[numbers]
     if rules:
-        verdicts = rule_columns(good, base, memos, v, f0, low, high, warned)
+        verdicts = rule_columns(good, base, memos, v, f0, low, high, warned, known)
         out["rule_errors"] = np.full(n, -1, dtype=np.int64)
         out["rule_warnings"] = np.full(n, -1, dtype=np.int64)
         out["failing_rules"] = np.full(n, None, dtype=object)

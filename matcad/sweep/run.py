@@ -259,7 +259,8 @@ def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, s
 
 
 _MEMOS: dict = {}
-"""This process's memos of the sweep it is working on: {sweep key: (rule memos, slope memo, validation messages)}."""
+"""This process's memos of the sweep it is working on: {sweep key: (rule memos, slope memo, validation messages,
+rule verdicts)}."""
 
 
 def array_chunks(tasks: list[dict]) -> list[dict]:
@@ -269,12 +270,12 @@ def array_chunks(tasks: list[dict]) -> list[dict]:
     for task in tasks:
         if task["key"] not in _MEMOS:
             _MEMOS.clear()
-            _MEMOS[task["key"]] = arrays.rule_memos(), arrays.slope_memo(), {}
+            _MEMOS[task["key"]] = arrays.rule_memos(), arrays.slope_memo(), {}, {}
         out.append(array_chunk(task, *_MEMOS[task["key"]]))
     return out
 
 
-def array_chunk(task: dict, rule_memos=None, slope_memo=None, seen=None) -> dict:
+def array_chunk(task: dict, rule_memos=None, slope_memo=None, seen=None, known=None) -> dict:
     """The rows of variants ``start:stop`` of the grid by :func:`matcad.sweep.arrays.evaluate`, as a
     :class:`Block`."""
     from matcad.spec import from_dict
@@ -283,7 +284,7 @@ def array_chunk(task: dict, rule_memos=None, slope_memo=None, seen=None) -> dict
     data, axes, model = task["data"], task["axes"], task["model"]
     chunk = arrays.GridChunk(data, axes, np.arange(task["start"], task["stop"]))
     out = arrays.evaluate(chunk, from_dict(data), model, task["rules"], rule_memos or arrays.rule_memos(),
-                          slope_memo or arrays.slope_memo(), seen)
+                          slope_memo or arrays.slope_memo(), seen, known)
     n, status = len(chunk), out["status"]
     valued = status != "invalid"
 
