@@ -736,15 +736,15 @@ def test_a_table_finds_many_codes_at_once_as_its_dict_does():
         assert len(table) == len(numbers) and all(c in table for c in numbers)
 
 
-def test_distinct_rows_are_numpys_unique_rows():
-    """distinct_rows(m) is np.unique(m, axis=0, return_inverse=True), rows and numbers, on small and huge ranges of
+def test_unique_rows_are_numpys_unique_rows():
+    """unique_rows(m) is np.unique(m, axis=0, return_inverse=True), rows and numbers, on small and huge ranges of
     values (fails if the mixed-radix key overflows or does not keep the rows' order)."""
-    from matcad.sweep.arrays import distinct_rows
+    from matcad.sweep.arrays import unique_rows
 
     rng = np.random.default_rng(3)
     for k in range(200):
         scale = (3, 100, 2**40, 2**62)[k % 4]
         matrix = rng.integers(-scale, scale, size=(int(rng.integers(0, 60)), int(rng.integers(1, 9))))
-        rows, numbers = distinct_rows(matrix)
+        rows, numbers = unique_rows(matrix)
         expected_rows, expected_numbers = np.unique(matrix, axis=0, return_inverse=True)
         assert np.array_equal(rows, expected_rows) and np.array_equal(numbers, expected_numbers.reshape(-1))

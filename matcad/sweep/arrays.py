@@ -264,7 +264,7 @@ def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0
                               chunk.field(base, "needle.outer_diameter"), speed_of_sound(d.air))
     matrix = np.stack(numbers + [np.asarray(c, dtype=np.int64) for c in sound.values()], axis=1) if n else \
         np.zeros((0, len(memos) + len(sound)), dtype=np.int64)
-    uniq, inverse = distinct_rows(matrix)
+    uniq, inverse = unique_rows(matrix)
     known = {} if known is None else known
     combos = list(map(tuple, uniq.tolist()))
     for combo in combos:
@@ -304,7 +304,7 @@ def _verdict(combo: tuple, groups, memos: list[Memo], on_arrays: dict, sound: tu
             " ".join(dict.fromkeys(f"{i}:{lvl}" for i, lvl in ordered)), broken)
 
 
-def distinct_rows(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def unique_rows(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(the distinct rows of the 2-D integer ``matrix`` in ascending order, each row's number among them): what
     ``np.unique(matrix, axis=0, return_inverse=True)`` gives, from one int64 key per row, its columns as the digits
     of a mixed radix (key and column renumbered densely first where the next digit could overflow), so one sort of
