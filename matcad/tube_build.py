@@ -92,7 +92,7 @@ def _write_report(report: dict, prediction, comparison, folder: Path) -> None:
     import json
 
     (folder / "report.json").write_text(json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    lines = [f"# {report['name']} — fipple-tube taxel (matcad)", "", "## Prediction", "", "```",
+    lines = [f"# {report['name']} — tube taxel, {prediction.mouth} mouth (matcad)", "", "## Prediction", "", "```",
              prediction.to_text(), "```", "", "## Design rules", ""]
     lines += [f"- **{f['level']}** `{f['id']}`: {f['message']}" for f in report["findings"]] or ["- none"]
     lines += ["", "## Parts", "", "| file | volume (mm³) | watertight | print pose |", "|---|---|---|---|"]

@@ -86,9 +86,11 @@ class TubeLoad:
 @dataclass(frozen=True)
 class TubePrediction:
     """The tube's unloaded f1 from each route (Hz), the chosen ``f0_hz`` and its ``band_hz``, the mouth correction
-    and the cap's compliance length (mm), the overblown mode (Hz), the edge-tone windows, notes, f(F) points."""
+    and the cap's compliance length (mm), the overblown mode (Hz), the edge-tone windows, notes, f(F) points; its
+    ``mouth`` (:data:`matcad.spec.tube.MOUTHS`)."""
 
     name: str
+    mouth: str
     column_mm: float
     mouth_correction_mm: float
     routes_hz: dict
@@ -102,14 +104,14 @@ class TubePrediction:
     loads: tuple[TubeLoad, ...] = ()
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "kind": "tube", "column_mm": self.column_mm,
+        return {"name": self.name, "kind": "tube", "mouth": self.mouth, "column_mm": self.column_mm,
                 "mouth_correction_mm": self.mouth_correction_mm, "routes_hz": self.routes_hz, "f0_hz": self.f0_hz,
                 "band_hz": list(self.band_hz), "band_sources": list(self.band_sources), "kappa_mm": self.kappa_mm,
                 "f_mode2_hz": self.f_mode2_hz, "edge_tone": [dataclasses.asdict(w) for w in self.windows],
                 "notes": list(self.notes), "loads": [dataclasses.asdict(p) for p in self.loads]}
 
     def to_text(self) -> str:
-        lines = [f"{self.name}: fipple tube, air column {self.column_mm:g} mm + mouth correction "
+        lines = [f"{self.name}: tube with a {self.mouth} mouth, air column {self.column_mm:g} mm + mouth correction "
                  f"{self.mouth_correction_mm:.2f} mm"]
         width = max(map(len, self.routes_hz))
         lines += [f"  {route:<{width}} {f:8.0f} Hz" for route, f in self.routes_hz.items()]
@@ -210,7 +212,7 @@ def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePredict
     windows = tuple(edgetone.window(f, mode, td.edge_distance, td.windway_height, td.windway_width)
                     for mode, f in ((1, f0), (2, f2)))
     loads = _loads(spec, td, f0, forces_n) if forces_n else ()
-    return TubePrediction(spec.name, td.column_mm, air.mouth_correction_mm(td), routes, f0, tuple(band),
+    return TubePrediction(spec.name, td.mouth, td.column_mm, air.mouth_correction_mm(td), routes, f0, tuple(band),
                           tuple(sources), kappa, f2, windows, tuple(notes), loads)
 
 
