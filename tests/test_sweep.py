@@ -748,3 +748,50 @@ def test_unique_rows_are_numpys_unique_rows():
         rows, numbers = unique_rows(matrix)
         expected_rows, expected_numbers = np.unique(matrix, axis=0, return_inverse=True)
         assert np.array_equal(rows, expected_rows) and np.array_equal(numbers, expected_numbers.reshape(-1))
+
+
+def test_memos_of_two_halves_merge_into_the_memo_of_the_whole():
+    """Memo.merge: two processes' memos of one function over disjoint halves of a grid, merged, give every variant
+    the outcome a memo of the whole grid gives it, and run nothing more (the warm-up's merge, matcad.sweep.warm)."""
+    from matcad.sweep.arrays import GridChunk
+    from matcad.sweep.memo import Memo
+
+    data = read_spec_data(PAPER)
+    axes = parse_axes(["cavity.length=3:6:4", "neck.diameter=1.5:2.4:5", "mold.draft_deg=0,0.5,1"])
+    whole = GridChunk(data, axes, np.arange(60))
+
+    def branch(spec):
+        return spec.neck.diameter if spec.cavity.length > 4.5 else -1.0
+
+    halves = [Memo(branch), Memo(branch)]
+    for memo, rows in zip(halves, (np.arange(0, 60, 2), np.arange(1, 60, 2))):
+        memo.apply(GridChunk(data, axes, rows))
+    merged = Memo(lambda spec: pytest.fail("a merged memo ran its function"))
+    for memo in halves:
+        merged.merge(memo.tables, memo.outcomes)
+    numbers = merged.apply(whole)
+    assert [merged.outcomes[k] for k in numbers] == [branch(whole.spec(j)) for j in range(60)]
+
+
+def test_warmed_workers_split_the_rules_and_give_the_one_process_table(tmp_path):
+    """On 2 processes the rules' distinct inputs are warmed once, split over both (matcad.sweep.warm), not run in
+    each: the warm-up covers every neck of a 2-chunk laser grid whose rules read the neck, and the sweep's table
+    is byte for byte the one process's."""
+    from matcad.sweep.warm import warmed
+
+    laser = ROOT / "templates" / "mat-laser-only.toml"
+    vary = ["cavity.length=2:10:25", "neck.diameter=0.8:2.4:20", "neck.length=1:8:10"]
+    data = read_spec_data(laser)
+    warm = warmed(data, parse_axes(vary), Executor(workers=2))
+    assert warm is not None
+    tables = [table for tables, _ in warm for axes, table in tables.items() if len(axes) == 2]
+    assert tables and max(len(t) for t in tables) == 20 * 10  # every neck (diameter x length), once
+    assert warmed(data, parse_axes(vary), Executor(workers=1)) is None
+    outs = []
+    for workers in ("1", "2"):
+        out = tmp_path / workers
+        code, _, err = run_cli("sweep", str(laser), *[x for v in vary for x in ("--vary", v)], "--workers", workers,
+                               "--out", str(out))
+        assert code == 0, err
+        outs.append((out / "sweep.csv").read_bytes())
+    assert outs[0] == outs[1] and outs[0].count(b"\n") == 25 * 20 * 10 + 1

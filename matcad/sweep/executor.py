@@ -161,11 +161,12 @@ def _dask(fn_chunk, tasks: list[dict], address: str) -> list[dict]:
         return _collect(chunks, futures)
 
 
-def stream(fn_chunk, tasks: list[dict], executor: Executor):
+def stream(fn_chunk, tasks: list[dict], executor: Executor, setup: tuple | None = None):
     """Like :func:`run`, but one task per chunk, yielding each task's result list in task order as it comes, with
     at most :data:`CHUNKS_PER_WORKER` tasks per worker in flight (a sweep streamed to disk holds no more). A task
     whose local worker died is run again alone in a fresh process (the pool is restarted and the tasks in flight
-    resubmitted); if that dies too, its result is the lost-worker rows."""
+    resubmitted); if that dies too, its result is the lost-worker rows. ``setup`` (a module-level function and its
+    arguments) runs once in each local process before its first task (not on a Dask cluster)."""
     if not tasks:
         return
     if executor.scheduler:
@@ -173,14 +174,19 @@ def stream(fn_chunk, tasks: list[dict], executor: Executor):
         return
     workers = min(executor.workers, len(tasks))
     if workers == 1:
+        if setup is not None:
+            setup[0](*setup[1])
         for task in tasks:
             yield fn_chunk([task])
         return
+    import functools
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     context = multiprocessing.get_context("spawn")
-    pool = ProcessPoolExecutor(workers, mp_context=context)
+    initial = {} if setup is None else {"initializer": setup[0], "initargs": setup[1]}
+    ProcessPool = functools.partial(ProcessPoolExecutor, mp_context=context, **initial)
+    pool = ProcessPool(workers)
     todo, pending = iter(tasks), collections.deque()
 
     def submit() -> None:
@@ -197,9 +203,9 @@ def stream(fn_chunk, tasks: list[dict], executor: Executor):
                 result = future.result()
             except Exception:  # noqa: BLE001 - a dead worker: restart the pool, resubmit, run this task alone
                 pool.shutdown(wait=True, cancel_futures=True)
-                pool = ProcessPoolExecutor(workers, mp_context=context)
+                pool = ProcessPool(workers)
                 pending = collections.deque((t, pool.submit(fn_chunk, [t])) for t, _ in pending)
-                alone = ProcessPoolExecutor(1, mp_context=context)
+                alone = ProcessPool(1)
                 try:
                     result = _results([alone.submit(fn_chunk, [task])])[0]
                 finally:

@@ -94,6 +94,10 @@ class Table:
         self._numbers[code] = number
         self._arrays = None
 
+    def items(self):
+        """(code, number) pairs."""
+        return self._numbers.items()
+
     def find(self, codes: np.ndarray) -> np.ndarray:
         """The number of each of ``codes`` (int64 array), -1 where the table has none."""
         if self._arrays is None:
@@ -123,6 +127,16 @@ class Memo:
         self.tables: dict[tuple[int, ...], Table] = {}
         self.outcomes: list = []
         self._number: dict = {}
+
+    def merge(self, tables: dict, outcomes: list) -> None:
+        """Adds another process's memo of the same function on the same grid (its ``tables`` over its
+        ``outcomes``): a code both know has the same outcome, a new one joins with its outcome renumbered here."""
+        number = [self._intern(outcome) for outcome in outcomes]
+        for axes, table in tables.items():
+            mine = self.tables.setdefault(axes, Table())
+            for code, k in table.items():
+                if code not in mine:
+                    mine[code] = number[k]
 
     def _intern(self, outcome) -> int:
         key = repr(outcome)

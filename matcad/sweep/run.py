@@ -232,13 +232,17 @@ def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, s
     they come); a chunk whose worker was lost is a row ``failed`` per variant."""
     import uuid
 
+    from matcad.sweep.warm import warmed
+
     size = math.prod(len(a.values) for a in axes)
     key = uuid.uuid4().hex  # the workers' memos are kept per sweep
     tasks = [{"index": k, "key": key, "data": data, "axes": tuple(axes), "start": lo,
               "stop": min(lo + arrays.CHUNK, size), "model": model, "rules": rules}
              for k, lo in enumerate(range(0, size, arrays.CHUNK))]
+    warm = warmed(data, axes, executor) if rules and len(tasks) > 1 else None
+    setup = None if warm is None else (install_memos, (key, warm))
     kept, counted, seconds = [], tally(()), 0.0
-    for task, results in zip(tasks, stream(array_chunks, tasks, executor)):
+    for task, results in zip(tasks, stream(array_chunks, tasks, executor, setup)):
         result = results[0]
         if "block" in result:
             block = result["block"]
@@ -261,6 +265,16 @@ def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, s
 _MEMOS: dict = {}
 """This process's memos of the sweep it is working on: {sweep key: (rule memos, slope memo, validation messages,
 rule verdicts)}."""
+
+
+def install_memos(key: str, warm: list) -> None:
+    """Executor setup: this process's memos of sweep ``key``, its rule memos started from ``warm``
+    (:func:`matcad.sweep.warm.warmed`)."""
+    memos = arrays.rule_memos()
+    for memo, (tables, outcomes) in zip(memos, warm):
+        memo.merge(tables, outcomes)
+    _MEMOS.clear()
+    _MEMOS[key] = memos, arrays.slope_memo(), {}, {}
 
 
 def array_chunks(tasks: list[dict]) -> list[dict]:
