@@ -86,38 +86,33 @@ class Mouth:
         outer = a + self.wall
         if self.kind == "unflanged":
             return np.maximum(np.maximum(r - outer, -z), bore)
-        if self.kind == "transverse":
-            return self._transverse(x, y, z, r, outer)
-        return self._fipple(x, y, z, r, outer)
+        cone = math.radians(SEAT_CONE_DEG)
+        floor = (np.minimum(z, 0.0) + a / math.tan(cone)) * math.tan(cone)  # the bore's radius, funnel below z = 0
+        carved = np.where(z < 0, (floor - r) * math.cos(cone), a - r)
+        body = np.minimum(outer - r, z + self.block_length)
+        openings = self._transverse(x, y, z) if self.kind == "transverse" else self._fipple(x, y, z)
+        return np.maximum.reduce([-body, carved, *openings])
 
-    def _fipple(self, x, y, z, r, outer):
+    def _fipple(self, x, y, z) -> tuple:
+        """The fipple's window through the wall over the windway's width and the labium's two bevels above it."""
         a, W, half = self.a, self.window_height, self.window_width / 2
         cone = math.radians(SEAT_CONE_DEG)
         bevel = math.radians(self.edge_angle)
         tip = a + EDGE_LAND_MM
-        floor = (np.minimum(z, 0.0) + a / math.tan(cone)) * math.tan(cone)  # the bore's radius, funnel below z = 0
-        carved = np.where(z < 0, (floor - r) * math.cos(cone), a - r)
         across = half - np.abs(y)
         window = np.minimum.reduce([across, x, z, W - z])
         # the labium's bevels, from halfway up the window (inside it there) so that no wall-less seam remains at z = W
         outside = np.minimum.reduce([across, z - W / 2, (x - tip - (z - W) * math.tan(bevel)) * math.cos(bevel)])
         inside = np.minimum.reduce([across, z - W / 2, x, (tip - (z - W) * math.tan(cone) - x) * math.cos(cone)])
-        body = np.minimum(outer - r, z + self.block_length)
-        return np.maximum.reduce([-body, carved, window, outside, inside])
+        return window, outside, inside
 
-    def _transverse(self, x, y, z, r, outer):
+    def _transverse(self, x, y, z) -> tuple:
         """The transverse window (:func:`matcad.parts.tube.transverse_tube`): through the wall on +x, W wide along
-        y, its sides ``window_height`` high under the gable at 30° from vertical; the funnel floor below z = 0.
-        Not the windway's boss beside it (it breaks the plane of symmetry y = 0; outside the tube, it moves δ
-        little)."""
-        a, half = self.a, self.window_width / 2
-        cone = math.radians(SEAT_CONE_DEG)
-        floor = (np.minimum(z, 0.0) + a / math.tan(cone)) * math.tan(cone)
-        carved = np.where(z < 0, (floor - r) * math.cos(cone), a - r)
+        y, its sides ``window_height`` high under the gable at 30° from vertical. Not the windway's boss beside it
+        (it breaks the plane of symmetry y = 0; outside the tube, it moves δ little)."""
+        half, cone = self.window_width / 2, math.radians(SEAT_CONE_DEG)
         roof = (self.window_height + (half - np.abs(y)) / math.tan(cone) - z) * math.sin(cone)
-        window = np.minimum.reduce([half - np.abs(y), x, z, roof])
-        body = np.minimum(outer - r, z + self.block_length)
-        return np.maximum.reduce([-body, carved, window])
+        return (np.minimum.reduce([half - np.abs(y), x, z, roof]),)
 
     def axes(self, level: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Grid lines (mm): cells a/level over the mouth and the tube's section, graded out to the far box."""
