@@ -193,22 +193,21 @@ def predict_tube(spec, forces_n=(), fem_level: int | None = None) -> TubePredict
         f0, kappa = results[1]
         band = [min(f for f, _ in results), max(f for f, _ in results)]
         sources = ["cap shear modulus range"]
+    k = kappa or 0.0
+    base = air.line_hz(td, k)  # each uncertainty below moves f0 by the rigid-cap line's ratio
+    shifted = [JET_RANGE[0] * f0, JET_RANGE[1] * f0]
     if td.mouth in WINDOW_STUDIES:
-        study, k = WINDOW_STUDIES[td.mouth], kappa or 0.0
-        for factor in study.ratio:
-            shifted = f0 * air.line_hz(td, k, correction_factor=factor) / air.line_hz(td, k)
-            band = [min(band[0], shifted), max(band[1], shifted)]
+        study = WINDOW_STUDIES[td.mouth]
+        shifted += [f0 * air.line_hz(td, k, correction_factor=factor) / base for factor in study.ratio]
         sources.append(f"{td.mouth} mouth correction x{study.ratio[0]:g}-{study.ratio[1]:g} ({study.source})")
         notes += _outside_mouth_study(td, study)
-    for made in _made(td, spec.machine.printer):
-        shifted = f0 * air.line_hz(made, kappa or 0.0) / air.line_hz(td, kappa or 0.0)
-        band = [min(band[0], shifted), max(band[1], shifted)]
+    shifted += [f0 * air.line_hz(made, k) / base for made in _made(td, spec.machine.printer)]
     temperature = "" if td.air.speed_of_sound_m_s is not None else f", air +-{TEMPERATURE_TOL_C:g} C"
     sources.append(f"printed bore +-{CAVITY_DIAMETER_TOL_MM[spec.machine.printer]:g} mm "
                    f"({spec.machine.printer}){temperature}")
-    band = [min(band[0], JET_RANGE[0] * f0), max(band[1], JET_RANGE[1] * f0)]
     sources.append(f"the jet: sounding x{JET_RANGE[0]:g}-{JET_RANGE[1]:g} of the resonance (four measured whistles)")
-    f2 = air.line_hz(td, kappa or 0.0, mode=2)
+    band = [min(band[0], *shifted), max(band[1], *shifted)]
+    f2 = air.line_hz(td, k, mode=2)
     windows = tuple(edgetone.window(f, mode, td.edge_distance, td.windway_height, td.windway_width)
                     for mode, f in ((1, f0), (2, f2)))
     loads = _loads(spec, td, f0, forces_n) if forces_n else ()
