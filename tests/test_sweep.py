@@ -498,6 +498,52 @@ def test_cli_two_axes_table_and_heat_maps_read_back(tmp_path):
     assert set(manifest["files"]) == {"sweep.csv", "sweep.json", *(f"maps/{m}" for m in maps)}
 
 
+def test_heat_map_cells_read_back(tmp_path):
+    """The f0 heat map read back pixel by pixel, its axes given out of order: inside each variant's cell (its grid
+    point's midpoints to its neighbours, placed by the plot's box) the colour is matplotlib's viridis of its f0 on
+    the map's range (within 6/255), in white diagonal hatching exactly where the variant has rule errors, and an
+    invalid variant's cell is blank."""
+    from matplotlib import colormaps
+    from PIL import Image
+
+    from matcad.sweep.maps import BOX
+
+    out = tmp_path / "hm"
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3:6:4", "--vary", "neck.diameter=2.1,1.5,3.3",
+                           "--model", "transmission_line", "--set", "microphone.sample_rate_hz=12000", "--out", out)
+    assert code == 0, err
+    with open(out / "sweep.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    f0 = [float(r["f0_hz"]) for r in rows if r["status"] == "ok"]
+    lo, hi = min(f0), max(f0)
+    xe, ye = [1.2, 1.8, 2.7, 3.9], [2.5, 3.5, 4.5, 5.5, 6.5]  # midpoints, half a step beyond the ends
+    left, top, right, bottom = BOX
+    with Image.open(out / "maps" / "f0.png") as im:
+        pixels = np.asarray(im.convert("RGB")).astype(int)
+    white = np.array([255, 255, 255])
+    kinds = set()
+    for r in rows:
+        j = [1.5, 2.1, 3.3].index(float(r["neck.diameter"]))
+        i = [3.0, 4.0, 5.0, 6.0].index(float(r["cavity.length"]))
+        x0, x1 = (left + (e - xe[0]) / (xe[-1] - xe[0]) * (right - left) for e in xe[j:j + 2])
+        y1, y0 = (bottom - (e - ye[0]) / (ye[-1] - ye[0]) * (bottom - top) for e in ye[i:i + 2])
+        cell = pixels[round(y0) + 2:round(y1) - 2, round(x0) + 2:round(x1) - 2].reshape(-1, 3)
+        is_white = (cell == white).all(axis=1)
+        if r["status"] != "ok":
+            assert is_white.all()
+            kinds.add("blank")
+            continue
+        expected = np.array(colormaps["viridis"]((float(r["f0_hz"]) - lo) / (hi - lo))[:3]) * 255
+        assert is_white.mean() < 0.5 and np.abs(cell[~is_white] - expected).max() <= 6
+        if int(r["rule_errors"]) > 0:
+            assert 0.12 < is_white.mean() < 0.22  # one pixel diagonal in six
+            kinds.add("hatched")
+        else:
+            assert not is_white.any()
+            kinds.add("plain")
+    assert kinds == {"blank", "hatched", "plain"}
+
+
 def test_cli_one_axis_line_maps(tmp_path, write_spec):
     out = tmp_path / "s1"
     code, _, err = run_cli("sweep", write_spec(MINIMAL), "--vary", "neck.length=2:8:7", "--out", out, "--workers", "1")
@@ -512,12 +558,13 @@ def test_cli_one_axis_line_maps(tmp_path, write_spec):
         ("neck.length [mm]", "df0/d(neck.length) [Hz/mm]", "df0_d_neck.length_hz_per_mm")
 
 
-def test_fast_sweep_imports_no_cad_kernel_nor_dask(tmp_path):
+def test_fast_sweep_imports_no_cad_kernel_dask_nor_matplotlib(tmp_path):
+    """A closed-form sweep with its maps loads neither the CAD kernel, the cluster, the FEMs nor matplotlib."""
     code = ("import sys; from matcad.cli import main; "
             "assert main(['sweep', %r, '--vary', 'cavity.length=3:6:5', '--no-rules', '--model', 'lumped', "
             "'--out', %r]) == 0; "
-            "bad = [m for m in ('build123d', 'OCP', 'trimesh', 'dask', 'distributed', 'skfem', 'felupe') "
-            "if m in sys.modules]; assert not bad, bad" % (str(PAPER), str(tmp_path / 's')))
+            "bad = [m for m in ('build123d', 'OCP', 'trimesh', 'dask', 'distributed', 'skfem', 'felupe', "
+            "'matplotlib') if m in sys.modules]; assert not bad, bad" % (str(PAPER), str(tmp_path / 's')))
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
 

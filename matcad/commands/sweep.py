@@ -41,7 +41,8 @@ def run(args) -> int:
     from matcad.sweep import Executor, parse_axes, sweep
     from matcad.output import staged_output
     from matcad.progress import line
-    from matcad.sweep.outputs import table_format, write_json, write_maps
+    from matcad.sweep.maps import write_maps
+    from matcad.sweep.outputs import table_format, write_json
 
     lo, hi = WORKERS
     if not lo <= args.workers <= hi:

@@ -1,12 +1,8 @@
 """A sweep's folder, written through :func:`matcad.output.staged_output` (manifest, never half-written):
 ``sweep.csv`` or ``sweep.parquet`` (the table, written chunk by chunk as the sweep streams it: :data:`TABLES`) and
 ``sweep.json`` (the axes, units and how it was made, and the rows too when the sweep kept them: up to
-:data:`matcad.sweep.grid.MAX_VARIANTS` variants, or any grid of one or two axes) and ``maps/*.png``.
-
-Maps (matplotlib, imported here only): one figure per quantity — f0, band low, band high, df0/dfield per axis,
-rule errors. One axis: a line over the field, rule-failing variants marked ×. Two axes: a heat map, variants with
-rule errors hatched, invalid or failed variants blank. Three or more axes: the table only. Each PNG carries its
-axes in its text chunks (``matcad:x``, ``matcad:y``, ``matcad:quantity``) for readers and tests.
+:data:`matcad.sweep.grid.MAX_VARIANTS` variants, or any grid of one or two axes). The maps are
+:mod:`matcad.sweep.maps`.
 """
 
 from __future__ import annotations
@@ -180,84 +176,3 @@ def write_json(result: SweepResult, folder: Path, table: str | None = None) -> l
         text = head[:cut] + (f"[\n  {body}\n ]" if rows else "[]") + head[cut + 2:]
     (folder / "sweep.json").write_text(text + "\n", encoding="utf-8")
     return ["sweep.json"]
-
-
-def quantities(result: SweepResult) -> list[tuple[str, str, str]]:
-    """(column, file stem, axis label) of every mapped quantity."""
-    out = [("f0_hz", "f0", f"f0 [Hz] ({result.model})"), ("band_low_hz", "band_low", "band low [Hz]"),
-           ("band_high_hz", "band_high", "band high [Hz]")]
-    out += [(sensitivity_column(a), f"df0_d_{a.field}", f"df0/d({a.field}) [Hz/{a.unit or 'unit'}]")
-            for a in result.axes]
-    if result.rules:
-        out.append(("rule_errors", "rule_errors", "design-rule errors"))
-    return out
-
-
-def _label(axis) -> str:
-    return f"{axis.field} [{axis.unit}]" if axis.unit else axis.field
-
-
-def write_maps(result: SweepResult, folder: Path) -> list[str]:
-    """The design-space maps into ``folder/maps``; returns their names (none for three or more axes)."""
-    if len(result.axes) not in (1, 2) or result.tally is not None:
-        return []
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-    from matplotlib.patches import PathPatch
-    from matplotlib.path import Path as Outline
-
-    (folder / "maps").mkdir()
-    errors = result.column("rule_errors") if result.rules else np.zeros(result.shape)
-    names = []
-    for column, stem, label in quantities(result):
-        values = result.column(column)
-        fig, ax = plt.subplots(figsize=(6.4, 4.8))
-        x_axis = result.axes[-1] if len(result.axes) == 2 else result.axes[0]
-        if len(result.axes) == 1:
-            x = np.array(x_axis.values)
-            ax.plot(x, values, "o-", ms=3, color="tab:blue")
-            if column == "f0_hz":
-                ax.fill_between(x, result.column("band_low_hz"), result.column("band_high_hz"), alpha=0.25,
-                                label="band")
-            bad = errors > 0
-            if bad.any():
-                ax.plot(x[bad], values[bad], "x", color="tab:red", ms=8, label="rule errors")
-            if ax.get_legend_handles_labels()[0]:
-                ax.legend()
-            y_label = label
-        else:
-            y_axis = result.axes[0]
-            mesh = ax.pcolormesh(_edges(x_axis.values), _edges(y_axis.values), np.ma.masked_invalid(values),
-                                 shading="flat", cmap="viridis")
-            fig.colorbar(mesh, ax=ax, label=label)
-            xe, ye = _edges(x_axis.values), _edges(y_axis.values)
-            cells = [Outline([(xe[j], ye[i]), (xe[j + 1], ye[i]), (xe[j + 1], ye[i + 1]), (xe[j], ye[i + 1]),
-                           (xe[j], ye[i])], closed=True) for i, j in zip(*np.nonzero(errors > 0))]
-            if cells:  # every hatched cell in one path: one fill however large the grid; added as an artist, not
-                # a patch, so its thousands of vertices are not walked again for limits the mesh has already set
-                ax.add_artist(PathPatch(Outline.make_compound_path(*cells), fill=False, hatch="///",
-                                        edgecolor="white", linewidth=0.0))
-            ax.set_title(f"{label}\nhatched: design-rule errors; blank: invalid or failed", fontsize=10)
-            y_label = _label(y_axis)
-        ax.set_xlabel(_label(x_axis))
-        ax.set_ylabel(y_label)
-        name = f"maps/{stem}.png"
-        fig.savefig(folder / name, dpi=100, metadata={"matcad:x": _label(x_axis), "matcad:y": y_label,
-                                                      "matcad:quantity": column})
-        plt.close(fig)
-        names.append(name)
-    return names
-
-
-def _edges(values) -> "np.ndarray":
-    """Cell edges around grid values (midpoints; half a step beyond the ends; ±0.5 for a single value)."""
-    import numpy as np
-
-    v = np.asarray(values, dtype=float)
-    if len(v) == 1:
-        return np.array([v[0] - 0.5, v[0] + 0.5])
-    mid = (v[1:] + v[:-1]) / 2
-    return np.concatenate([[v[0] - (mid[0] - v[0])], mid, [v[-1] + (v[-1] - mid[-1])]])
