@@ -471,6 +471,28 @@ def _png_axes(path):
         return im.text["matcad:x"], im.text["matcad:y"], im.text["matcad:quantity"]
 
 
+@pytest.mark.parametrize("varies", [["neck.diameter=20,30"],
+                                    ["neck.diameter=30,2", "cavity.length=3:6:200", "neck.length=1:8:21"]])
+def test_chunks_of_invalid_variants_only_are_rows_with_rules_on(tmp_path, varies):
+    """A grid whose variants are all invalid, and one whose first chunk of 4 096 is (a neck wider than the cavity),
+    with the rules on: exit 0, every invalid row names its reason and has no f0, slope or verdict, the valid ones
+    have all three (it was an internal error: the chunk had no rule columns)."""
+    out = tmp_path / "inv"
+    code, _, err = run_cli("sweep", PAPER, *[a for v in varies for a in ("--vary", v)], "--model",
+                           "transmission_line", "--out", out)
+    assert code == 0, err
+    with open(out / "sweep.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == (2 if len(varies) == 1 else 8400) and int(rows[-1]["index"]) == len(rows) - 1
+    slope = "df0_d_neck.diameter_hz_per_mm"
+    for r in rows:
+        if float(r["neck.diameter"]) == 2.0:
+            assert r["status"] == "ok" and r["f0_hz"] and r[slope] and r["rule_errors"].isdigit()
+        else:
+            assert r["status"] == "invalid" and "neck.diameter" in r["reason"]
+            assert r["f0_hz"] == r[slope] == r["rule_errors"] == r["failing_rules"] == ""
+
+
 def test_cli_two_axes_table_and_heat_maps_read_back(tmp_path):
     out = tmp_path / "s2"
     code, stdout, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3:6:4", "--vary", "neck.diameter=1.5,2.1,3.3",

@@ -380,7 +380,11 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
     ok = np.flatnonzero(reason == "")
     out = {"status": np.where(reason == "", "ok", "invalid").astype(object), "reason": reason,
            "f0_hz": np.full(n, np.nan), "band_low_hz": np.full(n, np.nan), "band_high_hz": np.full(n, np.nan),
-           "model_valid": np.full(n, None, dtype=object), "load_slope": np.full(n, None, dtype=object)}
+           "model_valid": np.full(n, None, dtype=object), "load_slope": np.full(n, None, dtype=object),
+           **{("slope", a.field): np.full(n, np.nan) for a in chunk.axes}}
+    if rules:  # -1/None where not judged (a chunk may hold no valid variant at all)
+        out |= {"rule_errors": np.full(n, -1, dtype=np.int64), "rule_warnings": np.full(n, -1, dtype=np.int64),
+                "failing_rules": np.full(n, None, dtype=object)}
     if not len(ok):
         return out
     good = chunk.subset(ok)
@@ -406,7 +410,6 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
     out["model_valid"][ok] = valid
     for a in chunk.axes:
         follows = good.follows_cavity if a.field == "cavity.diameter" else None
-        out[("slope", a.field)] = np.full(n, np.nan)
         out[("slope", a.field)][ok] = slope_of(a.field, follows)
     numbers = slope.apply(good)
     outcomes = np.empty(len(slope.outcomes), dtype=object)
@@ -414,9 +417,6 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
     out["load_slope"][ok] = outcomes[numbers]
     if rules:
         verdicts = rule_columns(good, base, memos, v, f0, low, high, warned, known)
-        out["rule_errors"] = np.full(n, -1, dtype=np.int64)
-        out["rule_warnings"] = np.full(n, -1, dtype=np.int64)
-        out["failing_rules"] = np.full(n, None, dtype=object)
         for key in ("rule_errors", "rule_warnings", "failing_rules"):
             out[key][ok] = verdicts[key]
         broken = ok[verdicts["failed"] != ""]

@@ -132,7 +132,7 @@ class SweepResult:
     def summary_text(self, folder, files) -> str:
         """What `matcad sweep` prints: the counts, the model and executor, the run time and the files."""
         c = self.counts()
-        return (f"{self.name}: {self.variants} variants ({c['ok']} ok, {c['invalid']} invalid, {c['failed']} failed; "
+        return (f"{self.name}: {self.variants} variant{'' if self.variants == 1 else 's'} ({c['ok']} ok, {c['invalid']} invalid, {c['failed']} failed; "
                 f"{c['rule_errors']} with design-rule errors) by {self.model} on {self.executor} in "
                 f"{self.seconds:.1f} s\n  {', '.join(files)} in {folder}/")
 
@@ -313,8 +313,7 @@ def array_chunk(task: dict, rule_memos=None, slope_memo=None, seen=None, known=N
                **{key: where(valued, out[key].astype(float).tolist()) for key in ("f0_hz", "band_low_hz",
                                                                                  "band_high_hz")},
                "model_valid": where(valued, [bool(v) for v in out["model_valid"]]),
-               **{sensitivity_column(a): where(valued, out[("slope", a.field)].tolist())
-                  for a in axes if ("slope", a.field) in out},
+               **{sensitivity_column(a): where(valued, out[("slope", a.field)].tolist()) for a in axes},
                LOAD_SENSITIVITY: where(has_load, load)}
     if task["rules"]:
         judged = status == "ok"
