@@ -132,7 +132,9 @@ class SweepResult:
     def summary_text(self, folder, files) -> str:
         """What `matcad sweep` prints: the counts, the model and executor, the run time and the files."""
         c = self.counts()
-        return (f"{self.name}: {self.variants} variant{'' if self.variants == 1 else 's'} ({c['ok']} ok, {c['invalid']} invalid, {c['failed']} failed; "
+        plural = "" if self.variants == 1 else "s"
+        return (f"{self.name}: {self.variants} variant{plural} ({c['ok']} ok, {c['invalid']} invalid, "
+                f"{c['failed']} failed; "
                 f"{c['rule_errors']} with design-rule errors) by {self.model} on {self.executor} in "
                 f"{self.seconds:.1f} s\n  {', '.join(files)} in {folder}/")
 
