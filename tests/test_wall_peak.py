@@ -97,6 +97,64 @@ def test_modal_sum_in_real_arithmetic_equals_the_complex_sum():
     np.testing.assert_allclose(peaks.modal_sum(rows, f), wall.dynamic_compliance_mm3_pa(f, modes, loss), rtol=1e-10)
 
 
+def test_drive_in_real_arithmetic_equals_the_complex_transfer_matrices():
+    """|D|² carried as real and imaginary parts equals the chain of complex transfer matrices written out here
+    (wall iωC at the closed end, cavity, side volume, neck, radiation load), to 1e-12, elastic or rigid."""
+    res, rng = _random_resonator(40, seed=11)
+    modes, loss = wall_modes(res, np.full(40, 4e5)), rng.uniform(0.05, 0.3, 40)
+    f = transmission_line_hz(res)[:, None] * np.geomspace(0.5, 2.0, 13)
+    compliance = wall.dynamic_compliance_mm3_pa(f, modes, loss)
+    net = [np.asarray(x, dtype=float)[:, None] for x in (res.c_m_s * np.ones(40), res.neck_area, res.cavity_area,
+                                                          _step_neck_length_mm(res), res.cavity_length)]
+    side = rng.uniform(0.0, 30.0, (40, 1))
+    for wall_c, volume in ((compliance, side), (0.0 * compliance, 0.0)):
+        c, neck_area, cavity_area, neck_l, cavity_l = net
+        cm, omega = c * 1e3, 2 * np.pi * f
+        k, rho = omega / cm, peaks.BULK_MODULUS_PA / (c * 1e3) ** 2
+        state = np.stack([np.ones_like(wall_c), 1j * omega * wall_c])  # (p, u) at the closed end
+        for length, area, joined in ((cavity_l, cavity_area, volume), (neck_l, neck_area, 0.0)):
+            z = rho * cm / area
+            cos, sin = np.cos(k * length), np.sin(k * length)
+            state = np.stack([cos * state[0] + 1j * z * sin * state[1], 1j * sin / z * state[0] + cos * state[1]])
+            state[1] = state[1] + 1j * omega * joined / peaks.BULK_MODULUS_PA * state[0]
+        mouth = state[0] + rho * cm * k * k / (2 * np.pi) * state[1]
+        real = peaks.drive_squared(f, *net, wall_c.real, wall_c.imag, volume)
+        np.testing.assert_allclose(real, np.abs(mouth) ** 2, rtol=1e-12)
+        np.testing.assert_allclose(peaks.cavity_end_response(f, *net, wall_c, volume), 1 / np.abs(mouth), rtol=1e-12)
+
+
+def test_distinct_rows_bit_for_bit_and_through_a_hash_collision(monkeypatch):
+    """:func:`peaks.distinct` finds every distinct row (compared bit for bit: -0.0 is not 0.0, a NaN row is its
+    own kind), gives each row its kind, and says None when all differ; with every hash colliding (multipliers
+    0) the answer is the same."""
+    rng = np.random.default_rng(3)
+    base = rng.uniform(-1, 1, (7, 5))
+    base[1, 2], base[2, 2], base[3] = 0.0, -0.0, np.nan
+    table = base[rng.integers(0, 7, 300)]
+    expected = {row.tobytes() for row in table}
+    for collide in (False, True):
+        if collide:
+            monkeypatch.setattr(peaks, "_multipliers", lambda n: np.zeros(n, dtype=np.uint64))
+        first, inverse = peaks.distinct(table)
+        assert len(first) == len(expected) and {table[i].tobytes() for i in first} == expected
+        assert table[first][inverse].tobytes() == table.tobytes()
+        assert peaks.distinct(base[:3]) is None
+
+
+def test_wall_table_interpolated_once_per_distinct_cap_gives_the_same_bits():
+    """A chunk's caps (a few shapes repeated) interpolated once per shape equal the table interpolated at every
+    row, bit for bit."""
+    rng = np.random.default_rng(5)
+    caps = rng.uniform(1.0, 4.0, (6, 5)) * [1.0, 2.0, 2.5, 0.6, 1.0]
+    pick = rng.integers(0, 6, (20, 30))  # a (20, 30) grid of variants drawn from six caps
+    shape = wall.CapShape(*(caps[pick, k] for k in range(5)))
+    once = wall._interpolated(shape)
+    every = wall._interpolated_at(np.broadcast_arrays(*wall._ratios(shape)))
+    for a, b in zip(once, every):
+        assert a.shape == b.shape and a.tobytes() == b.tobytes()
+    assert once[0].shape[:2] == (20, 30)
+
+
 def test_root_find_has_converged(monkeypatch):
     res, rng = _random_resonator(1500, seed=3)
     n = len(res.cavity_length)

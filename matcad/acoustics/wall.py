@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from matcad.acoustics.peaks import (SWEEP, cavity_end_response as _cavity_end_response,  # noqa: F401
-                                     dynamic_compliance_mm3_pa, grid_ratios as _grid, peaks as _peaks,
+                                     distinct, dynamic_compliance_mm3_pa, grid_ratios as _grid, peaks as _peaks,
                                      scanned_peaks as _scanned_peaks)
 
 TABLE_PATH = Path(__file__).parent / "wall_modes.json"
@@ -121,10 +121,23 @@ def _ratios(shape: CapShape):
 
 def _interpolated(shape: CapShape):
     """The table interpolated at the cap's ratios (arrays of caps too): log frequencies and shares (..., modes), and
-    the log static compliance (...), of the unit cap."""
+    the log static compliance (...), of the unit cap. Arrays of caps are interpolated once per distinct cap (a
+    sweep's chunk of 4 096 variants holds a few: the cap follows the cavity alone), the same numbers."""
+    ratios = np.broadcast_arrays(*(np.asarray(r, dtype=float) for r in _ratios(shape)))
+    kinds = distinct(np.column_stack([r.reshape(-1) for r in ratios])) if ratios[0].size > 1 else None
+    if kinds is None:
+        return _interpolated_at(ratios)
+    first, inverse = kinds
+    f, c, s = _interpolated_at([r.reshape(-1)[first] for r in ratios])
+    lead = ratios[0].shape
+    return f[inverse].reshape(lead + f.shape[-1:]), c[inverse].reshape(lead + c.shape[-1:]), s[inverse].reshape(lead)
+
+
+def _interpolated_at(ratios):
+    """:func:`_interpolated` at the shape ratios ``ratios`` (:func:`_ratios`' four, arrays of one shape)."""
     log_f, comps, static, log_static, axes, nodes = _table()
     corners = []
-    for name, v in zip(TABLE_AXES, _ratios(shape)):
+    for name, v in zip(TABLE_AXES, ratios):
         axis, node = axes[name], nodes[name]
         x = np.clip(v, axis[0], axis[-1])
         i = np.clip(np.searchsorted(axis, x) - 1, 0, len(axis) - 2)
