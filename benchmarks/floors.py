@@ -129,6 +129,11 @@ def rows(tmp: Path, quick: bool) -> list[Row]:
             "rules on, 1 process",
             ["sweep", PAPER, "--vary", "cavity.length=3:6:20", "--vary", "neck.diameter=1.5:2.4:20", "--vary",
              "neck.length=1:8:25", "--workers", "1", "--out", "{tmp}/spr"], None, "", "rate", "1e5/s", 1, 10_000),
+        Row("sweep-paper-2", "`sweep` mat-paper (silicone wall, its calibration anchor), 10^5 variants (3 axes), "
+            "rules on, Parquet, 2 processes (`--workers 2`), designs per wall second",
+            ["sweep", PAPER, "--vary", "cavity.length=3:6:40", "--vary", "neck.diameter=1.5:2.4:50", "--vary",
+             "neck.length=1:8:50", "--workers", "2", "--table", "parquet", "--out", "{tmp}/spr2"], None, "",
+            "wall_rate", "1e5/s", 1, 100_000),
         Row("sweep-million", "`sweep` laser-only, 10^6 variants (3 axes), rules on, 1 process: CPU and peak memory",
             ["sweep", LASER, "--vary", "cavity.length=2:10:100", "--vary", "neck.diameter=0.8:2.4:100",
              "--vary", "neck.length=1:8:100", "--workers", "1", "--out", "{tmp}/sm"], None, "", "rate", "1e5/s", 1,
@@ -262,7 +267,7 @@ def main() -> None:
                     help="also measure another checkout (alternated with this one)")
     ap.add_argument("--only", nargs="+", metavar="ROW", help="rows to run: predict laser build analyze "
                                                               "sweep-laser sweep-paper sweep-paper-rules "
-                                                              "sweep-million sweep-million-parquet "
+                                                              "sweep-paper-2 sweep-million sweep-million-parquet "
                                                               "sweep-million-2 fem")
     ap.add_argument("--runs", type=int, help="runs per command (default per row)")
     ap.add_argument("--quick", action="store_true", help="fewer runs per row")
