@@ -235,6 +235,24 @@ def test_calibrated_sweep_on_arrays_equals_the_per_variant_path(vary):
     assert row[col] == pytest.approx((f[1] - f[0]) / (2 * h), rel=1e-6, abs=PEAK_PRECISION * row["f0_hz"] / h)
 
 
+def test_a_sweeps_bending_reads_the_f0_it_already_has():
+    """plate.bending on a sweep's arrays takes the variants' f0 as built from the sweep rather than searching for
+    it again: the same pitch changes, bit for bit."""
+    from matcad.acoustics.registry import CHOSEN
+    from matcad.rules.plate import pitch_shift_hz
+    from matcad.sweep import arrays
+
+    data = read_spec_data(PAPER)
+    base = from_dict(data)
+    chunk = arrays.GridChunk(data, parse_axes(["neck.length=2:8:5", "cavity.length=3:6:4"]), np.arange(20))
+    v = arrays.variants(chunk, base)
+    built = fast.f0_hz(v, CHOSEN[base.wall.model])
+    bent = np.linspace(0.05, 0.5, 20)
+    searched = pitch_shift_hz(v.design(), bent, base.wall.model)
+    assert pitch_shift_hz(v.design(), bent, base.wall.model, built).tobytes() == searched.tobytes()
+    assert np.all(searched < 0)  # a narrower gap lengthens the mouth's end correction: the pitch falls
+
+
 def test_a_calibration_remembers_the_mount_gap_it_was_measured_with():
     """The calibrated taxel is its drawing as built (matcad.spec.drawn.DRAWN): a sweep of the mount gap on the paper
     template moves the calibrated f0 by the physics ratio to the gap it was measured with (it kept f(0) on every

@@ -32,9 +32,11 @@ class Finding:
 class ArrayRule:
     """How a sweep judges one spec rule on arrays of one-taxel variants (a module's ``ARRAY_RULES``): the finding
     it gives (``id``, ``level``), the function of the spec the sweep memoises for it (``inputs``: spec → a number)
-    and ``column(inputs, field, design, design_of, wall_model)``, the rule on the variants' arrays: how many such
-    findings each variant gets. ``field(dotted key)`` gives every variant's value, ``design`` their
-    :class:`matcad.acoustics.design.Design` of arrays, ``design_of(rows)`` that of the variants at ``rows``."""
+    and ``column(inputs, field, design, design_of, wall_model, physics_of)``, the rule on the variants' arrays: how
+    many such findings each variant gets. ``field(dotted key)`` gives every variant's value, ``design`` their
+    :class:`matcad.acoustics.design.Design` of arrays, ``design_of(rows)`` that of the variants at ``rows``,
+    ``physics_of(rows)`` their f0 (Hz) by the model `predict` chooses for the wall
+    (:data:`matcad.acoustics.registry.CHOSEN`) where the sweep has it, else None."""
 
     id: str
     level: str

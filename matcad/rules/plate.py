@@ -260,19 +260,21 @@ def bending_warnings(d, deflection_mm, force_n, sample_rate_hz, shift_hz) -> np.
     return ((np.asarray(force_n) > 0) & (~open_ | moved)).astype(np.int64)
 
 
-def bending_column(deflection_mm, field, d, design_of, wall_model: str) -> np.ndarray:
-    """:func:`bending_warnings` as a sweep asks it (:class:`matcad.rules.finding.ArrayRule`'s ``column``)."""
+def bending_column(deflection_mm, field, d, design_of, wall_model: str, physics_of) -> np.ndarray:
+    """:func:`bending_warnings` as a sweep asks it (:class:`matcad.rules.finding.ArrayRule`'s ``column``): the
+    variants' f0 as built from the sweep where it has them (``physics_of``), the same numbers."""
     def shift_hz(rows):
-        return pitch_shift_hz(design_of(rows), deflection_mm[rows], wall_model)
+        return pitch_shift_hz(design_of(rows), deflection_mm[rows], wall_model, physics_of(rows))
 
     return bending_warnings(d, deflection_mm, field("mechanics.max_force_n"), field("microphone.sample_rate_hz"),
                             shift_hz)
 
 
-def pitch_shift_hz(d, deflection_mm, wall_model: str):
+def pitch_shift_hz(d, deflection_mm, wall_model: str, built_hz=None):
     """f0 with the mount gap narrowed by ``deflection_mm`` minus f0 as built (Hz), by the model `predict` chooses
     for ``wall_model`` (:data:`matcad.acoustics.registry.CHOSEN`): a Design of arrays of variants, or one design under
-    an array of deflections (:func:`bendings`); each entry the arithmetic of that one design."""
+    an array of deflections (:func:`bendings`); each entry the arithmetic of that one design. ``built_hz``: f0 as
+    built by that model, when the caller has it (a sweep: the search is not run twice)."""
     from matcad.acoustics import registry
     from matcad.acoustics.resonator import resonator
 
@@ -285,7 +287,7 @@ def pitch_shift_hz(d, deflection_mm, wall_model: str):
         many = d.replace(gap_mm=np.broadcast_to(gap, shape), cavity_diameter=cavity)
         return np.broadcast_to(np.asarray(model.f0_hz(resonator(many), d.wall), dtype=float), shape)
 
-    return f0(built - deflection_mm) - f0(built)
+    return f0(built - deflection_mm) - (f0(built) if built_hz is None else np.broadcast_to(built_hz, shape))
 
 
 RULES = (plate_bending, support_posts)

@@ -231,30 +231,34 @@ def _array_rules() -> dict:
     return {rule: entry for module in SPEC_MODULES for rule, entry in getattr(module, "ARRAY_RULES", {}).items()}
 
 
-def _array_column(chunk: GridChunk, base, memo: Memo, v: fast.Variants, entry) -> np.ndarray:
+def _array_column(chunk: GridChunk, base, memo: Memo, v: fast.Variants, entry, physics_hz=None) -> np.ndarray:
     """An array rule's count of findings per variant (``entry``: its ArrayRule, ``memo``: its memoised inputs), or
-    -(k + 1) where its input failed with the memo's outcome k."""
+    -(k + 1) where its input failed with the memo's outcome k. ``physics_hz``: the variants' f0 by the chosen
+    physics (:func:`rule_columns`), or None."""
     numbers = memo.apply(chunk)
     outcomes = memo.outcomes
     failed = np.array([isinstance(o, tuple) for o in outcomes], dtype=bool)[numbers]
     inputs = np.array([0.0 if isinstance(o, tuple) else o for o in outcomes], dtype=float)[numbers]
     column = entry.column(inputs, lambda key: chunk.field(base, key), v.design(), lambda rows: v.take(rows).design(),
-                          base.wall.model)
+                          base.wall.model, lambda rows: None if physics_hz is None else physics_hz[rows])
     return np.where(failed, -(numbers + 1), column)
 
 
 def rule_columns(chunk: GridChunk, base, memos: list[Memo], v: fast.Variants, f0, low, high,
-                 model_warnings, known: dict | None = None) -> dict:
+                 model_warnings, known: dict | None = None, physics_hz=None) -> dict:
     """rule_errors, rule_warnings, failing_rules (and status/reason where a rule raised) of the chunk's valid
     variants, as :func:`matcad.sweep.tasks.rule_verdicts` gives them one by one (``memos``: :func:`rule_memos`;
     ``model_warnings``: each variant's count of its prediction's warnings from its own model; ``known``: the
-    verdicts of the grid's earlier chunks by row of outcome numbers and counts (:func:`_verdict`), filled in)."""
+    verdicts of the grid's earlier chunks by row of outcome numbers and counts (:func:`_verdict`), filled in;
+    ``physics_hz``: the variants' f0 by the model `predict` chooses for their wall
+    (:data:`matcad.acoustics.registry.CHOSEN`) when the sweep has computed it, which a rule then reads rather than
+    computing it again)."""
     from matcad.acoustics.design import speed_of_sound
     from matcad.rules import acoustic, jet
 
     n = len(chunk)
     groups, on_arrays = rule_groups(), _array_rules()
-    numbers = [_array_column(chunk, base, memo, v, on_arrays[group[0]]) if group[0] in on_arrays
+    numbers = [_array_column(chunk, base, memo, v, on_arrays[group[0]], physics_hz) if group[0] in on_arrays
                else memo.apply(chunk) for group, memo in zip(groups, memos)]
     d = v.design()
     sound = acoustic.array_counts(chunk.field(base, "microphone.sample_rate_hz"),
@@ -393,13 +397,17 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
         anchor = calibrated.CalibratedSweep(good, base, v)
         f0, low, high = anchor.columns()
         valid, warned = np.ones(len(f0), dtype=bool), np.zeros(len(f0), dtype=np.int64)
+        physics = anchor.physics_hz[0]
 
         def slope_of(field, follows):
             return anchor.sensitivity(field, follows)
     else:
         from matcad.acoustics.predict import warning_count
 
+        from matcad.acoustics.registry import CHOSEN
+
         f0 = fast.f0_hz(v, model)
+        physics = f0 if model == CHOSEN[base.wall.model] else None
         failed = fast.failed_checks(v, model, f0)
         valid, warned = failed == 0, warning_count(v.design(), f0, failed)
         low, high = fast.band_hz(v, model, f0, valid)
@@ -416,7 +424,7 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
     outcomes[:] = slope.outcomes
     out["load_slope"][ok] = outcomes[numbers]
     if rules:
-        verdicts = rule_columns(good, base, memos, v, f0, low, high, warned, known)
+        verdicts = rule_columns(good, base, memos, v, f0, low, high, warned, known, physics)
         for key in ("rule_errors", "rule_warnings", "failing_rules"):
             out[key][ok] = verdicts[key]
         broken = ok[verdicts["failed"] != ""]
