@@ -51,12 +51,13 @@ class CalibratedSweep:
             v = v.with_value(key, np.full(len(v), value))
         return v
 
-    def anchored_hz(self, v: fast.Variants) -> np.ndarray:
+    def anchored_hz(self, v: fast.Variants, drawing_moves: bool = True) -> np.ndarray:
         """f(0) x physics(variant) / physics(calibrated drawing) (Hz) of variants moved a little from the chunk's,
-        each physics followed from the chunk's own (:attr:`physics_hz`, :func:`matcad.sweep.fast.f0_hz`)."""
+        each physics followed from the chunk's own (:attr:`physics_hz`, :func:`matcad.sweep.fast.f0_hz`); unless
+        ``drawing_moves``, the drawings are the chunk's own and so is their physics."""
         variant, drawing = self.physics_hz
-        return self.anchor.f_cal * (fast.f0_hz(v, self.physics, variant)
-                                    / fast.f0_hz(self.drawn(v), self.physics, drawing))
+        drawn = fast.f0_hz(self.drawn(v), self.physics, drawing) if drawing_moves else drawing
+        return self.anchor.f_cal * (fast.f0_hz(v, self.physics, variant) / drawn)
 
     def f0_hz(self) -> np.ndarray:
         """The chunk's anchored f0 (Hz): f(0) x the physics ratio, and f(0) itself where ``same``."""
@@ -89,6 +90,8 @@ class CalibratedSweep:
 
     def sensitivity(self, field: str, follows: dict | None = None) -> np.ndarray:
         """df0/dfield of the chunk's anchored f0 (Hz per the field's unit) by :func:`matcad.sweep.fast.sensitivity`'s
-        central difference: the ratio's own derivative (a drawn field moves the variant only; any other field
-        moves the calibrated drawing too), each physics followed from the chunk's own."""
-        return fast.sensitivity(self.v, self.physics, field, follows, f0=self.anchored_hz)
+        central difference: the ratio's own derivative (a drawn field moves the variant only, the drawing's physics
+        is then the chunk's own; any other field moves the calibrated drawing too), each physics followed from the
+        chunk's own."""
+        moves = any(key not in self.drawing for key in (field, *(follows or {})))
+        return fast.sensitivity(self.v, self.physics, field, follows, f0=lambda v: self.anchored_hz(v, moves))
