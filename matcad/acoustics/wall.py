@@ -123,18 +123,20 @@ def _interpolated(shape: CapShape):
     """The table interpolated at the cap's ratios (arrays of caps too): log frequencies and shares (..., modes), and
     the log static compliance (...), of the unit cap. Arrays of caps are interpolated once per distinct cap (a
     sweep's chunk of 4 096 variants holds a few: the cap follows the cavity alone), the same numbers."""
-    ratios = np.broadcast_arrays(*(np.asarray(r, dtype=float) for r in _ratios(shape)))
-    kinds = distinct(np.column_stack([r.reshape(-1) for r in ratios])) if ratios[0].size > 1 else None
-    if kinds is None:
+    ratios = _ratios(shape)
+    lead = np.broadcast_shapes(*(np.shape(r) for r in ratios))
+    if not lead:
         return _interpolated_at(ratios)
-    first, inverse = kinds
-    f, c, s = _interpolated_at([r.reshape(-1)[first] for r in ratios])
-    lead = ratios[0].shape
+    ratios = [np.broadcast_to(r, lead).reshape(-1) for r in ratios]
+    kinds = distinct(np.column_stack(ratios))
+    first, inverse = kinds if kinds is not None else (slice(None), slice(None))
+    f, c, s = _interpolated_at([r[first] for r in ratios])
     return f[inverse].reshape(lead + f.shape[-1:]), c[inverse].reshape(lead + c.shape[-1:]), s[inverse].reshape(lead)
 
 
 def _interpolated_at(ratios):
-    """:func:`_interpolated` at the shape ratios ``ratios`` (:func:`_ratios`' four, arrays of one shape)."""
+    """:func:`_interpolated` at the shape ratios ``ratios`` (:func:`_ratios`' four: floats, or arrays that
+    broadcast together)."""
     log_f, comps, static, log_static, axes, nodes = _table()
     corners = []
     for name, v in zip(TABLE_AXES, ratios):
