@@ -106,9 +106,13 @@ the first :data:`FIRST_WIDTH` coarse steps wide, each next one as wide as the la
 finite-difference derivative and curvature: superlinear), at least :data:`SMALLEST_WIDTH` in log f."""
 DIRECT_WIDTH = 0.02
 """Width (log f) of the first parabola that refines a rigid wall's peak from f_TL."""
-FOLLOW_WIDTH = 1e-3
-"""Width (log f) of the first parabola that follows a peak from a known start (:func:`peaks`' ``start``): 1000× a
-sensitivity's step (:data:`matcad.sweep.fast.RELATIVE_STEP`), the distance its peak moves."""
+FOLLOW_WIDTH = 1e-4
+"""Width (log f) of the one parabola that follows a peak from a known start (:func:`peaks`' ``start``): 100× a
+sensitivity's step (:data:`matcad.sweep.fast.RELATIVE_STEP`), the distance its peak moves. One Newton step with a
+finite-difference derivative and curvature lands within ~3e-7 of the peak (the parabola's bias, from |D|²'s third
+derivative); the two designs of a central difference share that bias, so their slope is the derivative to ~1e-7
+(median; 1e-5 on 99 % of random variants), where six parabolas of shrinking width reached the peak itself to 1e-10
+but left 1e-6 / 7e-5 in the slope: their last widths, 1e-7 in log f, hit |D|²'s rounding (tests/test_wall_peak.py)."""
 FAST_BLOCK = 1024
 """Rows per numpy pass of the root find (1024 × 97 frequencies × ~22 modes: ~20 MB a temporary; 256 rows was
 1.5× slower, 2048 no faster)."""
@@ -124,8 +128,9 @@ def peaks(geometry: tuple, wall, loss_factor, start=None) -> np.ndarray:
     601-point scan :func:`scanned_peaks` to < 1e-4 on the templates and on 99.5 % of random variants; where they
     differ by more it is the scan's grid error (a 200 001-point search agrees with the root find to 1e-5; tested).
     ~5-9× faster than the scan (benchmarks/sweep.py). With a wall, ``start`` (log offsets from f_TL, broadcast
-    against the rows) follows each row's peak from there instead: no scan, the parabolas from
-    :data:`FOLLOW_WIDTH` (a design moved a little from one whose peak is known, as a sensitivity's are)."""
+    against the rows) follows each row's peak from there instead: no scan, one parabola of :data:`FOLLOW_WIDTH` (a
+    design moved a little from one whose peak is known, as a sensitivity's are: see FOLLOW_WIDTH for what it is
+    good to)."""
     rows, shape, n = rows_of(geometry, wall, loss_factor, start)
     rows, inverse = distinct_rows(rows) if wall is not None else (rows, None)
     m = len(rows["f_tl"])
@@ -207,8 +212,8 @@ def _block_peak(rows: dict, elastic: bool) -> np.ndarray:
     n = len(rows["f_tl"])
     if elastic and "start" not in rows:
         return rows["f_tl"] * np.exp(scanned_x(rows))
-    start, width = (rows["start"], FOLLOW_WIDTH) if elastic else (np.zeros(n), DIRECT_WIDTH)
-    x, _, _ = _refine(rows, start[:, None], np.ones((n, 1), dtype=bool), width, elastic)
+    start, width, steps = (rows["start"], FOLLOW_WIDTH, 1) if elastic else (np.zeros(n), DIRECT_WIDTH, None)
+    x, _, _ = _refine(rows, start[:, None], np.ones((n, 1), dtype=bool), width, elastic, steps)
     return rows["f_tl"] * np.exp(x[:, 0])
 
 
@@ -255,14 +260,15 @@ def scanned_x(rows: dict) -> np.ndarray:
     return np.take_along_axis(x, np.argmin(best, axis=-1)[:, None], axis=-1)[:, 0]
 
 
-def _refine(rows: dict, x, real, width: float, elastic: bool):
-    """Minima of |D|² refined from log offsets ``x`` (n, k) by :data:`REFINE_STEPS` parabolas: (x, |D|² at the
+def _refine(rows: dict, x, real, width: float, elastic: bool, steps: int | None = None):
+    """Minima of |D|² refined from log offsets ``x`` (n, k) by ``steps`` parabolas (default
+    :data:`REFINE_STEPS`): (x, |D|² at the
     last centre (inf where not ``real``), the last step's size)."""
     n, k = x.shape
     offsets = np.array([-1.0, 0.0, 1.0])
     lo, hi = math.log(SWEEP[0]), math.log(SWEEP[1])
     h = np.full(x.shape, width)
-    for _ in range(REFINE_STEPS):
+    for _ in range(REFINE_STEPS if steps is None else steps):
         y = d_squared(rows, (x[..., None] + h[..., None] * offsets).reshape(n, 3 * k), elastic).reshape(n, k, 3)
         shift = _vertex(y, h)
         x = np.clip(x + shift, lo, hi)
