@@ -21,8 +21,9 @@ from matcad.sweep.run import LOAD_SENSITIVITY, sensitivity_column
 from tests.conftest import MINIMAL, PAPER, ROOT, run_cli
 
 PEAK_PRECISION = 6e-11
-"""A silicone wall's peak, followed or searched, is found to this fraction of f0 (the 99th percentile over random
-variants, tests/test_wall_peak.py): a central difference of two peaks at step h is good to ~2 x this x f0 / 2h."""
+"""A silicone wall's searched peak is found to this fraction of f0 (the 99th percentile over random variants,
+tests/test_wall_peak.py): `predict`'s central difference of two searched peaks at step h is good to ~2 x this x f0 / 2h
+(a sweep's slope of followed peaks is the derivative to 3e-5 of itself, tests/test_wall_peak.py)."""
 
 
 def _random_specs(n, seed):
@@ -208,9 +209,8 @@ def test_calibrated_sweep_on_arrays_equals_the_per_variant_path(vary):
     variant by variant: status, f0, band, validity and every rule verdict equal, on grids that include the
     calibrated drawing itself (ratio 1, no model-ratio line), vary how it is built (the mount gap, the draft) and a
     field the drawing does not fix (the silicone's density: the calibrated drawing's physics moves too), and break
-    rules; the slope is the anchored f0's own derivative, to the precision of the peaks it differences (the sweep
-    follows the moved variants' peaks from the variant's own, predict searches for them: both find the same peak to
-    ~1e-11 of f0, tests/test_wall_peak.py)."""
+    rules; the slope is the anchored f0's own derivative, to the precision of the peaks predict differences (the
+    sweep follows the moved variants' peaks from the variant's own, predict searches for them; see PEAK_PRECISION)."""
     from matcad.prediction.anchor import CalibrationAnchor
     from matcad.spec.drawn import DRAWN, pinned
     from matcad.sweep.grid import variant_data
