@@ -132,7 +132,7 @@ def peaks(geometry: tuple, wall, loss_factor, start=None) -> np.ndarray:
     design moved a little from one whose peak is known, as a sensitivity's are: see FOLLOW_WIDTH for what it is
     good to)."""
     rows, shape, n = rows_of(geometry, wall, loss_factor, start)
-    rows, inverse = distinct_rows(rows) if wall is not None else (rows, None)
+    rows, inverse = distinct_rows(rows)
     m = len(rows["f_tl"])
     out = np.empty(m)
     for start in range(0, m, FAST_BLOCK):
