@@ -202,7 +202,7 @@ def d_squared(rows: dict, x, elastic: bool) -> np.ndarray:
     """|D|² = 1/|H|² of each row at log offsets ``x`` (n, k) from its f_TL."""
     f = rows["f_tl"][:, None] * np.exp(x)
     net = [rows[k][:, None] for k in ("c", "A", "S", "l", "L")]
-    wall = _modal_parts(rows, f) if elastic else (0.0, 0.0)
+    wall = modal_parts(rows, f) if elastic else (0.0, 0.0)
     return drive_squared(f, *net, *wall, rows["side"][:, None])
 
 
@@ -217,14 +217,7 @@ def _block_peak(rows: dict, elastic: bool) -> np.ndarray:
     return rows["f_tl"] * np.exp(x[:, 0])
 
 
-def modal_sum(rows: dict, f) -> np.ndarray:
-    """:func:`dynamic_compliance_mm3_pa` of each row at frequencies ``f`` (n, k) (:func:`_modal_parts` as one
-    complex array)."""
-    re, im = _modal_parts(rows, f)
-    return re + 1j * im
-
-
-def _modal_parts(rows: dict, f) -> tuple[np.ndarray, np.ndarray]:
+def modal_parts(rows: dict, f) -> tuple[np.ndarray, np.ndarray]:
     """(real, imaginary) parts of :func:`dynamic_compliance_mm3_pa` of each row at frequencies ``f`` (n, k), in
     real arithmetic: c/(1 + iη − u) = c(1 − u − iη)/((1 − u)² + η²) with u = f²/f_i² (the same sum, ~3× faster
     than numpy's complex division)."""

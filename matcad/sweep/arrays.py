@@ -403,7 +403,6 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
             return anchor.sensitivity(field, follows)
     else:
         from matcad.acoustics.predict import warning_count
-
         from matcad.acoustics.registry import CHOSEN
 
         f0 = fast.f0_hz(v, model)
