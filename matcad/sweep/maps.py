@@ -46,17 +46,20 @@ def label(axis) -> str:
 
 def write_maps(result: SweepResult, folder: Path) -> list[str]:
     """The design-space maps into ``folder/maps``; returns their names (none for three or more axes)."""
+    from matcad.canvas import saved_together
+
     if len(result.axes) not in (1, 2) or result.tally is not None:
         return []
     (folder / "maps").mkdir()
     errors = result.column("rule_errors") if result.rules else np.zeros(result.shape)
     names = []
-    for column, stem, text in quantities(result):
-        name = f"maps/{stem}.png"
-        draw = _line if len(result.axes) == 1 else _heat_map
-        canvas, x_label, y_label = draw(result, column, text, errors)
-        canvas.save(folder / name, {"matcad:x": x_label, "matcad:y": y_label, "matcad:quantity": column})
-        names.append(name)
+    with saved_together():
+        for column, stem, text in quantities(result):
+            name = f"maps/{stem}.png"
+            draw = _line if len(result.axes) == 1 else _heat_map
+            canvas, x_label, y_label = draw(result, column, text, errors)
+            canvas.save(folder / name, {"matcad:x": x_label, "matcad:y": y_label, "matcad:quantity": column})
+            names.append(name)
     return names
 
 
