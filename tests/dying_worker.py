@@ -17,3 +17,10 @@ def killed_on_index_1(tasks):
         os.kill(os.getpid(), signal.SIGKILL)
     time.sleep(BUSY_S)
     return [{"index": t["index"], "status": "ok", "reason": ""} for t in tasks]
+
+
+def process_of(tasks):
+    """Chunk function: each task's result names the process that ran it (after :data:`BUSY_S`/3, so both workers
+    take tasks)."""
+    time.sleep(BUSY_S / 3)
+    return [{"index": t["index"], "status": "ok", "reason": "", "pid": os.getpid()} for t in tasks]

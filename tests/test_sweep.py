@@ -394,6 +394,26 @@ def test_a_killed_worker_fails_only_its_own_chunk_at_ci_cost():
         assert "worker lost" in results[1]["reason"]
 
 
+def test_streams_on_shared_processes_reuse_them_and_outlive_a_killed_worker():
+    """A sweep's warm-up and grid stream on the same local processes (matcad.sweep.executor.Processes): the second
+    stream runs on the first one's processes, none spawned anew; a worker killed in one stream fails only its own
+    task there, and the next stream on the restarted processes runs whole."""
+    import os
+
+    from matcad.sweep.executor import Processes, stream
+    from tests.dying_worker import killed_on_index_1, process_of
+
+    tasks = [{"index": i} for i in range(4)]
+    with Processes(2) as shared:
+        pids = {r["pid"] for _ in range(2) for chunk in stream(process_of, tasks, Executor(2), shared)
+                for r in chunk}
+        killed = [r for chunk in stream(killed_on_index_1, tasks, Executor(2), shared) for r in chunk]
+        after = [r for chunk in stream(process_of, tasks, Executor(2), shared) for r in chunk]
+    assert 1 <= len(pids) <= 2 and os.getpid() not in pids  # two streams, at most the two processes
+    assert [r["status"] for r in killed] == ["ok", "failed", "ok", "ok"] and "worker lost" in killed[1]["reason"]
+    assert [r["status"] for r in after] == ["ok"] * 4 and not {r["pid"] for r in after} & pids
+
+
 @pytest.mark.slow
 def test_streamed_chunks_come_in_order_and_a_dead_worker_fails_only_its_own():
     from matcad.sweep.executor import stream
@@ -860,6 +880,30 @@ def test_memos_of_two_halves_merge_into_the_memo_of_the_whole():
     assert [merged.outcomes[k] for k in numbers] == [branch(whole.spec(j)) for j in range(60)]
 
 
+def test_the_warm_up_runs_each_memos_own_combinations_and_eq5s_slope():
+    """The paper's spec: one memo reads the cavity, others the neck, so together they read the whole grid, where the
+    warm-up used to give up. Each memo is warmed on its own combinations (every neck, every cavity; not every
+    neck with every cavity), Eq. 5's slope memo first, each exactly as a memo run over the whole grid fills it."""
+    from matcad.sweep.arrays import GridChunk, memos
+    from matcad.sweep.warm import warmed
+
+    vary = ["cavity.length=3:6:10", "neck.diameter=1.5:2.4:4", "neck.length=1:8:5"]
+    data, axes = read_spec_data(PAPER), parse_axes(vary)
+    warm = warmed(data, axes, True, Executor(workers=2))
+    assert warm is not None
+    sizes = [{key: len(table) for key, table in tables.items()} for tables, _ in warm]
+    assert sizes[0] == {(1, 2): 20} and {(0,): 10} in sizes and {(1,): 4} in sizes
+    assert all(len(key) < 3 for s in sizes for key in s)
+    whole = memos(True)
+    grid = GridChunk(data, axes, np.arange(200))
+    for memo in whole:
+        memo.apply(grid)
+    for memo, (tables, outcomes) in zip(whole, warm):
+        for key, table in tables.items():
+            assert {code: outcomes[k] for code, k in table.items()} == \
+                {code: memo.outcomes[k] for code, k in memo.tables[key].items()}
+
+
 def test_warmed_workers_split_the_rules_and_give_the_one_process_table(tmp_path):
     """On 2 processes the rules' distinct inputs are warmed once, split over both (matcad.sweep.warm), not run in
     each: the warm-up covers every neck of a 2-chunk laser grid whose rules read the neck, and the sweep's table
@@ -869,11 +913,11 @@ def test_warmed_workers_split_the_rules_and_give_the_one_process_table(tmp_path)
     laser = ROOT / "templates" / "mat-laser-only.toml"
     vary = ["cavity.length=2:10:25", "neck.diameter=0.8:2.4:20", "neck.length=1:8:10"]
     data = read_spec_data(laser)
-    warm = warmed(data, parse_axes(vary), Executor(workers=2))
+    warm = warmed(data, parse_axes(vary), True, Executor(workers=2))
     assert warm is not None
     tables = [table for tables, _ in warm for axes, table in tables.items() if len(axes) == 2]
     assert tables and max(len(t) for t in tables) == 20 * 10  # every neck (diameter x length), once
-    assert warmed(data, parse_axes(vary), Executor(workers=1)) is None
+    assert warmed(data, parse_axes(vary), True, Executor(workers=1)) is None
     outs = []
     for workers in ("1", "2"):
         out = tmp_path / workers

@@ -373,6 +373,11 @@ def slope_memo() -> Memo:
     return Memo(slope)
 
 
+def memos(rules: bool) -> list[Memo]:
+    """One sweep process's memos: :func:`slope_memo`'s, then :func:`rule_memos` when ``rules``."""
+    return [slope_memo(), *(rule_memos() if rules else ())]
+
+
 def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo, seen: dict | None = None,
              known: dict | None = None) -> dict:
     """Every column of the chunk's variants: status, reason, f0_hz, band_low_hz, band_high_hz, model_valid,

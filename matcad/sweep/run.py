@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from matcad.sweep import arrays, fast
-from matcad.sweep.executor import Executor, run as run_tasks, stream
+from matcad.sweep.executor import Executor, processes, run as run_tasks, stream
 from matcad.sweep.grid import MAX_VARIANTS, Axis, grid, variant_data
 from matcad.sweep.tasks import run_chunk
 
@@ -241,26 +241,28 @@ def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, s
     tasks = [{"index": k, "key": key, "data": data, "axes": tuple(axes), "start": lo,
               "stop": min(lo + arrays.CHUNK, size), "model": model, "rules": rules}
              for k, lo in enumerate(range(0, size, arrays.CHUNK))]
-    warm = warmed(data, axes, executor) if rules and len(tasks) > 1 else None
-    setup = None if warm is None else (install_memos, (key, warm))
     kept, counted, seconds = [], tally(()), 0.0
-    for task, results in zip(tasks, stream(array_chunks, tasks, executor, setup)):
-        result = results[0]
-        if "block" in result:
-            block = result["block"]
-            seconds += result["seconds"]
-        else:
-            block = Block.from_rows(
-                [{"index": i, **{a.field: v for a, v in zip(axes, values)}, "status": "failed",
-                  "reason": result["reason"], "model": model}
-                 for i, values in zip(range(task["start"], task["stop"]), grid(axes, task["start"], task["stop"]))])
-        tally(block, counted)
-        if progress is not None:
-            progress(task["stop"], size)
-        if sink is not None:
-            sink(block)
-        if keep:
-            kept += block.rows()
+    with processes(executor, len(tasks)) as shared:  # the warm-up and the grid on the same processes
+        warm = warmed(data, axes, rules, executor, shared) if len(tasks) > 1 else None
+        for task in tasks:
+            task["warm"] = warm  # installed by each process with the first task of the sweep it runs
+        for task, results in zip(tasks, stream(array_chunks, tasks, executor, shared)):
+            result = results[0]
+            if "block" in result:
+                block = result["block"]
+                seconds += result["seconds"]
+            else:
+                block = Block.from_rows(
+                    [{"index": i, **{a.field: v for a, v in zip(axes, values)}, "status": "failed",
+                      "reason": result["reason"], "model": model}
+                     for i, values in zip(range(task["start"], task["stop"]), grid(axes, task["start"], task["stop"]))])
+            tally(block, counted)
+            if progress is not None:
+                progress(task["stop"], size)
+            if sink is not None:
+                sink(block)
+            if keep:
+                kept += block.rows()
     return kept, counted, seconds
 
 
@@ -269,24 +271,24 @@ _MEMOS: dict = {}
 rule verdicts)}."""
 
 
-def install_memos(key: str, warm: list) -> None:
-    """Executor setup: this process's memos of sweep ``key``, its rule memos started from ``warm``
-    (:func:`matcad.sweep.warm.warmed`)."""
-    memos = arrays.rule_memos()
-    for memo, (tables, outcomes) in zip(memos, warm):
+def install_memos(key: str, rules: bool, warm: list | None) -> None:
+    """This process's memos of sweep ``key`` (the only ones it keeps; :func:`matcad.sweep.arrays.memos`), started
+    from ``warm`` (:func:`matcad.sweep.warm.warmed`) where given."""
+    memos = arrays.memos(rules)
+    for memo, (tables, outcomes) in zip(memos, warm or ()):
         memo.merge(tables, outcomes)
     _MEMOS.clear()
-    _MEMOS[key] = memos, arrays.slope_memo(), {}, {}
+    _MEMOS[key] = memos[1:], memos[0], {}, {}
 
 
 def array_chunks(tasks: list[dict]) -> list[dict]:
     """Executor function: each task (a chunk of the grid) → {"index", "rows", "seconds"}. The chunks of one sweep
-    that reach one process share its memos (keyed on the whole grid's values, so valid across chunks)."""
+    that reach one process share its memos (keyed on the whole grid's values, so valid across chunks), started
+    from the warm-up's (a task's ``warm``)."""
     out = []
     for task in tasks:
         if task["key"] not in _MEMOS:
-            _MEMOS.clear()
-            _MEMOS[task["key"]] = arrays.rule_memos(), arrays.slope_memo(), {}, {}
+            install_memos(task["key"], task["rules"], task.get("warm"))
         out.append(array_chunk(task, *_MEMOS[task["key"]]))
     return out
 
