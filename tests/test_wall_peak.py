@@ -77,6 +77,37 @@ def test_root_find_equals_the_scan_on_random_variants():
         assert abs(found[i] / truth - 1) < 1e-5 < abs(scanned[i] / truth - 1), i
 
 
+def _one_pass_x(rows: dict) -> np.ndarray:
+    """:func:`peaks.scanned_x` with the coarse scan's every point evaluated (one pass)."""
+    lo, hi = math.log(peaks.SWEEP[0]), math.log(peaks.SWEEP[1])
+    grid = np.linspace(lo, hi, peaks.COARSE_POINTS)
+    n = len(rows["f_tl"])
+    y = peaks.d_squared(rows, np.broadcast_to(grid, (n, len(grid))), True)
+    padded = np.pad(y, ((0, 0), (1, 1)), constant_values=np.inf)
+    minima = (y <= padded[:, :-2]) & (y < padded[:, 2:])
+    order = np.argsort(np.where(minima, y, np.inf), axis=-1)[:, :peaks.CANDIDATES]
+    step = grid[1] - grid[0]
+    x = grid[order] + peaks._vertex(padded[np.arange(n)[:, None, None], order[..., None] + np.arange(3)], step)
+    x, best, _ = peaks._refine(rows, x, np.take_along_axis(minima, order, axis=-1), peaks.FIRST_WIDTH * step, True)
+    return np.take_along_axis(x, np.argmin(best, axis=-1)[:, None], axis=-1)[:, 0]
+
+
+@pytest.mark.parametrize("seed,fewer", [(102, 2), (109, 3)])
+def test_the_two_pass_coarse_scan_finds_the_one_pass_peaks(seed, fewer, monkeypatch):
+    """The coarse scan's two passes (49 points, then 16 near the 4 lowest minima) give the peaks of all 97 points to
+    < 1e-8 on 20 000 random variants; with fewer windows a design among these is found on another peak (seed 102:
+    a deeper minimum behind a coarse one that ranked third; 109: four near-tie peaks)."""
+    res, rng = _random_resonator(20_000, seed=seed)
+    n = len(res.cavity_length)
+    f_tl, *net, modes, loss, side = _arguments(res, np.exp(rng.uniform(math.log(3e4), math.log(5e6), n)),
+                                               rng.uniform(wall.SELECT_LOSS, 0.4, n))
+    rows, _, _ = peaks.rows_of((f_tl, *net, side), modes, loss)
+    one = _one_pass_x(dict(rows))
+    assert np.max(np.abs(peaks.scanned_x(dict(rows)) - one)) < 1e-8
+    monkeypatch.setattr(peaks, "WINDOWS", fewer)
+    assert np.max(np.abs(peaks.scanned_x(dict(rows)) - one)) > 0.1
+
+
 def test_a_row_alone_equals_the_row_in_a_batch():
     res, rng = _random_resonator(40, seed=5)
     args = _arguments(res, np.exp(rng.uniform(math.log(1e5), math.log(2e6), 40)), rng.uniform(0.08, 0.3, 40))

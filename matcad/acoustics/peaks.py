@@ -96,6 +96,14 @@ BLOCK_ROWS = 32
 COARSE_POINTS = 97
 """Points of the coarse scan over :data:`SWEEP`'s range that brackets the peaks before they are refined (a step of
 1.45 % in f: two peaks 2.8 % apart, a near-tie doublet, stay two candidates; 49 points merged them)."""
+WINDOWS = 4
+WINDOW_POINTS = 4
+"""The coarse scan in two passes: its even points (every second: 49), then its odd points nearest the
+:data:`WINDOWS` lowest local minima of those, :data:`WINDOW_POINTS` around each (±3 steps: 16 points). An odd point
+not evaluated takes the larger of its two neighbours, which cannot make or unmake a local minimum; near the
+minima the grid is the full one. The candidates so found are the 97-point grid's: on 200 000 random variants the
+peaks agree with the one-pass scan's to < 1e-8 (and 4 windows are needed: with 2 or 3, one in ~10^5 found another
+of four near-tie peaks), with 65 evaluations instead of 97 (tests/test_wall_peak.py)."""
 CANDIDATES = 2
 """Local maxima of the coarse scan refined per row (the highest two); the highest refined one is the peak."""
 FIRST_WIDTH = 0.2
@@ -237,13 +245,13 @@ def modal_parts(rows: dict, f) -> tuple[np.ndarray, np.ndarray]:
 
 
 def scanned_x(rows: dict) -> np.ndarray:
-    """Log peak offsets from f_TL of rows with a wall: the coarse scan's :data:`CANDIDATES` lowest local minima of
-    |D|², each refined, the lowest kept."""
+    """Log peak offsets from f_TL of rows with a wall: the coarse scan's (:data:`COARSE_POINTS`, in the two passes
+    of :data:`WINDOWS`) :data:`CANDIDATES` lowest local minima of |D|², each refined, the lowest kept."""
     lo, hi = math.log(SWEEP[0]), math.log(SWEEP[1])
     step = (hi - lo) / (COARSE_POINTS - 1)
     n = len(rows["f_tl"])
     grid = np.linspace(lo, hi, COARSE_POINTS)
-    y = d_squared(rows, np.broadcast_to(grid, (n, COARSE_POINTS)), True)
+    y = _two_pass(rows, grid)
     padded = np.pad(y, ((0, 0), (1, 1)), constant_values=np.inf)
     minima = (y <= padded[:, :-2]) & (y < padded[:, 2:])
     order = np.argsort(np.where(minima, y, np.inf), axis=-1)[:, :CANDIDATES]
@@ -251,6 +259,26 @@ def scanned_x(rows: dict) -> np.ndarray:
     real = np.take_along_axis(minima, order, axis=-1)  # fewer local minima than candidates: the rest drop out
     x, best, _ = _refine(rows, x, real, FIRST_WIDTH * step, True)
     return np.take_along_axis(x, np.argmin(best, axis=-1)[:, None], axis=-1)[:, 0]
+
+
+def _two_pass(rows: dict, grid: np.ndarray) -> np.ndarray:
+    """|D|² of each row on ``grid`` (odd length) as :data:`WINDOWS` says: exact on the even points and on the odd
+    points near the lowest minima of those, elsewhere the larger neighbour."""
+    n, odd = len(rows["f_tl"]), len(grid) // 2
+    even = d_squared(rows, np.broadcast_to(grid[::2], (n, odd + 1)), True)
+    padded = np.pad(even, ((0, 0), (1, 1)), constant_values=np.inf)
+    minima = (even <= padded[:, :-2]) & (even < padded[:, 2:])
+    order = np.argsort(np.where(minima, even, np.inf), axis=-1)[:, :WINDOWS]
+    near = np.arange(-WINDOW_POINTS // 2, WINDOW_POINTS // 2)  # odd point k lies between even points k and k + 1
+    at = np.clip(order[..., None] + near, 0, odd - 1).reshape(n, -1)
+    y = np.empty((n, len(grid)))
+    y[:, ::2] = even
+    y[:, 1::2] = np.maximum(even[:, :-1], even[:, 1:])
+    found = d_squared(rows, grid[2 * at + 1], True)
+    keep = np.repeat(np.take_along_axis(minima, order, axis=-1), WINDOW_POINTS, axis=-1)  # no minimum: no window
+    odd_y = y[:, 1::2]
+    np.put_along_axis(odd_y, at, np.where(keep, found, np.take_along_axis(odd_y, at, axis=-1)), axis=-1)
+    return y
 
 
 def _refine(rows: dict, x, real, width: float, elastic: bool, steps: int | None = None):
