@@ -118,9 +118,10 @@ FOLLOW_WIDTH = 1e-4
 """Width (log f) of the one parabola that follows a peak from a known start (:func:`peaks`' ``start``): 100× a
 sensitivity's step (:data:`matcad.sweep.fast.RELATIVE_STEP`), the distance its peak moves. One Newton step with a
 finite-difference derivative and curvature lands within ~3e-7 of the peak (the parabola's bias, from |D|²'s third
-derivative); the two designs of a central difference share that bias, so their slope is the derivative to ~1e-7
-(median; 1e-5 on 99 % of random variants), where six parabolas of shrinking width reached the peak itself to 1e-10
-but left 1e-6 / 7e-5 in the slope: their last widths, 1e-7 in log f, hit |D|²'s rounding (tests/test_wall_peak.py)."""
+derivative); the two designs of a central difference share that bias, so, the wall's peak and the rigid one it is
+divided by both followed, their slope is the derivative to ~3e-8 (median; 3e-6 on 99 % of random variants), where
+six parabolas of shrinking width reached the peak itself to 1e-10 but left 1e-6 / 7e-5 in the slope: their last
+widths, 1e-7 in log f, hit |D|²'s rounding (tests/test_wall_peak.py)."""
 FAST_BLOCK = 1024
 """Rows per numpy pass of the root find (1024 × 97 frequencies × ~22 modes: ~20 MB a temporary; 256 rows was
 1.5× slower, 2048 no faster)."""
@@ -135,10 +136,10 @@ def peaks(geometry: tuple, wall, loss_factor, start=None) -> np.ndarray:
     curvature), the lowest refined one kept; a rigid wall has one peak, refined from f_TL. The same f0 as the
     601-point scan :func:`scanned_peaks` to < 1e-4 on the templates and on 99.5 % of random variants; where they
     differ by more it is the scan's grid error (a 200 001-point search agrees with the root find to 1e-5; tested).
-    ~5-9× faster than the scan (benchmarks/sweep.py). With a wall, ``start`` (log offsets from f_TL, broadcast
-    against the rows) follows each row's peak from there instead: no scan, one parabola of :data:`FOLLOW_WIDTH` (a
-    design moved a little from one whose peak is known, as a sensitivity's are: see FOLLOW_WIDTH for what it is
-    good to)."""
+    ~5-9× faster than the scan (benchmarks/sweep.py). ``start`` (log offsets from f_TL, broadcast against the
+    rows) follows each row's peak from there instead, with a wall or without: no search, one parabola of
+    :data:`FOLLOW_WIDTH` (a design moved a little from one whose peak is known, as a sensitivity's are: see
+    FOLLOW_WIDTH for what it is good to)."""
     rows, shape, n = rows_of(geometry, wall, loss_factor, start)
     rows, inverse = distinct_rows(rows)
     m = len(rows["f_tl"])
@@ -201,8 +202,8 @@ def rows_of(geometry: tuple, wall, loss_factor, start=None):
         rows["comps"] = np.broadcast_to(wall.compliances_mm3_pa, shape + (m,)).reshape(n, m)
         rows["static"] = np.broadcast_to(wall.static_mm3_pa, shape).reshape(n)
         rows["loss"] = np.broadcast_to(loss_factor, shape).reshape(n)
-        if start is not None:
-            rows["start"] = np.broadcast_to(start, shape).reshape(n)
+    if start is not None:
+        rows["start"] = np.broadcast_to(start, shape).reshape(n)
     return rows, shape, n
 
 
@@ -220,7 +221,7 @@ def _block_peak(rows: dict, elastic: bool) -> np.ndarray:
     n = len(rows["f_tl"])
     if elastic and "start" not in rows:
         return rows["f_tl"] * np.exp(scanned_x(rows))
-    start, width, steps = (rows["start"], FOLLOW_WIDTH, 1) if elastic else (np.zeros(n), DIRECT_WIDTH, None)
+    start, width, steps = (rows["start"], FOLLOW_WIDTH, 1) if "start" in rows else (np.zeros(n), DIRECT_WIDTH, None)
     x, _, _ = _refine(rows, start[:, None], np.ones((n, 1), dtype=bool), width, elastic, steps)
     return rows["f_tl"] * np.exp(x[:, 0])
 

@@ -39,7 +39,7 @@ class AcousticModel:
     walls), 'static' the static shear modulus, 'dynamic' the kHz storage modulus and the loss factor, each at the
     middle of the spec's range. ``describe`` (``"module:function"`` of (evaluation, f0) → text) words the source
     with the numbers of one evaluation; without it the source is ``source``. ``follows``: its f0 is a peak that
-    a nearby design's f0 lets it follow rather than search for (``near_hz`` of :meth:`f0_hz`)."""
+    a nearby design's peaks let it follow rather than search for (``near`` of :meth:`f0_hz`)."""
 
     name: str
     rung: int
@@ -70,17 +70,17 @@ class AcousticModel:
             return material.static_moduli_pa()[1], 0.0
         return None, 0.0
 
-    def f0_hz(self, res, material=None, shear_modulus_pa=None, loss_factor=None, near_hz=None):
+    def f0_hz(self, res, material=None, shear_modulus_pa=None, loss_factor=None, near=None):
         """f0 (Hz) of a closed-form rung on a resonator (floats, or arrays of variants; the wall rungs also at arrays
         of moduli and loss factors), at the middle of ``material``'s ranges unless a modulus (Pa) and loss factor
-        are given. ``near_hz`` (Hz: the f0 of designs these were moved a little from) is followed by a rung that
-        ``follows``; a closed form has nothing to follow."""
+        are given. ``near`` (:class:`matcad.acoustics.resonator.Branch`: the peaks of designs these were moved a
+        little from) is followed by a rung that ``follows``; a closed form has nothing to follow."""
         if not self.cheap:
             raise ValueError(f"model {self.name!r} solves a mesh: evaluate it through its result()")
         if shear_modulus_pa is None and material is not None:
             shear_modulus_pa, loss_factor = self.wall_arguments(material)
-        near = {"near_hz": near_hz} if self.follows and near_hz is not None else {}
-        return self.function()(res, shear_modulus_pa, 0.0 if loss_factor is None else loss_factor, **near)
+        follow = {"near": near} if self.follows and near is not None else {}
+        return self.function()(res, shear_modulus_pa, 0.0 if loss_factor is None else loss_factor, **follow)
 
     def result(self, ev, f_guess_hz: float | None = None, level: int | None = None) -> ModelResult:
         """This rung on one :class:`matcad.acoustics.evaluation.Evaluation`: f0 (Hz), checks, source. A mesh rung

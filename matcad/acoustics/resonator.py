@@ -146,16 +146,35 @@ def soft_wall_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0):
                                        res.cavity_length, n, extra, res.side_volume, _cone(res))
 
 
-def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor=0.0, near_hz=None):
+@dataclass(frozen=True)
+class Branch:
+    """Where a design's elastic-wall f0 was found (Hz, floats or arrays of designs): ``f0_hz``, and ``rigid_hz`` the
+    rigid network's peak its ratio divides by (:func:`rigid_network_hz`; None for a model with no peak to follow).
+    A design moved a little from it follows both peaks from there (:func:`elastic_wall_hz`'s ``near``) instead of
+    searching for them."""
+
+    f0_hz: np.ndarray
+    rigid_hz: np.ndarray | None
+
+
+def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor=0.0, near: Branch | None = None):
     """The transmission line coupled to the cap's wall modes at the (dynamic) shear modulus (Pa) and loss factor:
     peak of the driven response (Hz). Arrays of designs, or one design at arrays of moduli and loss factors, give
-    arrays, each entry the same arithmetic as one call (:func:`matcad.acoustics.wall.peak_ratio`). ``near_hz``
-    (Hz, the f0 of a design this one was moved a little from) follows that design's peak instead of searching."""
+    arrays, each entry the same arithmetic as one call (:func:`matcad.acoustics.wall.peak_ratio`). ``near`` (the
+    branch of a design this one was moved a little from) follows that design's peaks instead of searching."""
     f_tl = transmission_line_hz(res)
-    near = None if near_hz is None else np.asarray(near_hz, dtype=float) / f_tl
+    follow = {} if near is None else {"near": np.asarray(near.f0_hz, dtype=float) / f_tl,
+                                      "near_rigid": np.asarray(near.rigid_hz, dtype=float) / f_tl}
     return f_tl * wall.peak_ratio(f_tl, res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
                                   res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor, res.side_volume,
-                                  near=near)
+                                  **follow)
+
+
+def rigid_network_hz(res: Resonator):
+    """The peak of the driven response with a rigid wall (Hz): what :func:`elastic_wall_hz`'s ratio divides by."""
+    f_tl = transmission_line_hz(res)
+    return f_tl * wall.rigid_peak_ratio(f_tl, res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
+                                        res.cavity_length, res.side_volume)
 
 
 def elastic_wall_doublet_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0) -> float | None:

@@ -198,7 +198,7 @@ def _losses(loss_factor: float) -> np.ndarray:
 
 
 def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
-               loss_factor, side_volume=0.0, scan: bool = False, near=None):
+               loss_factor, side_volume=0.0, scan: bool = False, near=None, near_rigid=None):
     """Peak of the cavity pressure with the elastic wall over the peak with a rigid wall (same network, air of
     ``side_volume`` mm³ joined at the neck in both): a float for one design, an array for arrays of designs, moduli
     or loss factors (each row the same arithmetic as one design: the root find of :func:`matcad.acoustics.peaks.peaks`, so the
@@ -208,7 +208,9 @@ def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
     it is not the resonance the jet drives. Its peaks are found by a root find (:mod:`matcad.acoustics.peaks`), or with ``scan``
     by the 601-point reference scan. ``near`` (the ratio of a design close to this one, broadcast against it) makes
     the root find follow the peak from that ratio instead of searching the band: a sensitivity's moved designs, whose
-    peak lies on the branch of the design they were moved from (below SELECT_LOSS each design is followed anyway)."""
+    peak lies on the branch of the design they were moved from (below SELECT_LOSS each design is followed anyway);
+    ``near_rigid`` (that design's rigid-wall peak over this f_TL, :func:`rigid_peak_ratio`) follows the rigid
+    network's peak from there too."""
     geometry = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
         f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume)))
     if np.any(np.asarray(loss_factor) < SELECT_LOSS):  # row by row, each following its Helmholtz branch
@@ -224,9 +226,19 @@ def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
                                      Modes(freqs[i], comps[i], float(static[i])), float(loss[i]), float(rows[6][i]))
         return float(out) if out.ndim == 0 else out
     search = _scanned_peaks if scan else _peaks
-    rigid = search(tuple(geometry), None, 0.0)
+    rigid = search(tuple(geometry), None, 0.0, **({} if near_rigid is None or scan else
+                                                  {"start": np.log(np.asarray(near_rigid, dtype=float))}))
     follow = {} if near is None or scan else {"start": np.log(np.asarray(near, dtype=float) * rigid / geometry[0])}
     ratio = search(tuple(geometry), wall, loss_factor, **follow) / rigid
+    return float(ratio) if ratio.ndim == 0 else ratio
+
+
+def rigid_peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume=0.0):
+    """The peak of the cavity pressure with a rigid wall over f_TL: what :func:`peak_ratio` divides by (arrays of
+    designs give arrays; the same root find)."""
+    geometry = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
+        f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume)))
+    ratio = _peaks(tuple(geometry), None, 0.0) / geometry[0]
     return float(ratio) if ratio.ndim == 0 else ratio
 
 

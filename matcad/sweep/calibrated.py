@@ -42,7 +42,9 @@ class CalibratedSweep:
         """Variants that draw the calibrated taxel: the ratio is exactly 1, and the band has no model-ratio line."""
         self.base = base
         self.v = v
-        self.physics_hz = (fast.f0_hz(v, self.physics), fast.f0_hz(self.drawn(v), self.physics))
+        self.branches = (fast.branch(v, self.physics), fast.branch(self.drawn(v), self.physics))
+        """The physics peaks of the variants and of their calibrated drawings (:func:`matcad.sweep.fast.branch`)."""
+        self.physics_hz = tuple(b.f0_hz for b in self.branches)
         """The physics f0 of the variants and of their calibrated drawings (Hz)."""
 
     def drawn(self, v: fast.Variants) -> fast.Variants:
@@ -55,8 +57,8 @@ class CalibratedSweep:
         """f(0) x physics(variant) / physics(calibrated drawing) (Hz) of variants moved a little from the chunk's,
         each physics followed from the chunk's own (:attr:`physics_hz`, :func:`matcad.sweep.fast.f0_hz`); unless
         ``drawing_moves``, the drawings are the chunk's own and so is their physics."""
-        variant, drawing = self.physics_hz
-        drawn = fast.f0_hz(self.drawn(v), self.physics, drawing) if drawing_moves else drawing
+        variant, drawing = self.branches
+        drawn = fast.f0_hz(self.drawn(v), self.physics, drawing) if drawing_moves else drawing.f0_hz
         return self.anchor.f_cal * (fast.f0_hz(v, self.physics, variant) / drawn)
 
     def f0_hz(self) -> np.ndarray:

@@ -18,6 +18,7 @@ import numpy as np
 from matcad.acoustics import checks, registry, uncertainty
 from matcad.acoustics.design import Air, Design, Making, WallMaterial, gap_radius_mm
 from matcad.acoustics.evaluation import Evaluation
+from matcad.acoustics.resonator import Branch, rigid_network_hz
 
 VECTORISED = tuple(m.name for m in registry.MODELS if m.cheap)
 """The registered rungs that are closed forms of the design (no FEM): lumped, end_corrected, transmission_line and
@@ -112,17 +113,30 @@ def _model(model: str):
     return registry.model(model)
 
 
-def f0_hz(v: Variants, model: str, near_hz=None) -> np.ndarray:
+def f0_hz(v: Variants, model: str, near: Branch | None = None) -> np.ndarray:
     """f0 (Hz) of every variant by one of :data:`VECTORISED` (paper Eq. 1; Rayleigh/Ingard; Selamet 1997; the
-    silicone wall at the middle of its modulus and loss ranges). ``near_hz`` (per variant, Hz: the f0 of the
-    variants these were moved a little from) lets a model that searches for its peak follow it from there."""
+    silicone wall at the middle of its modulus and loss ranges). ``near`` (per variant: the peaks of the variants
+    these were moved a little from, :func:`branch`) lets a model that searches for its peak follow it from there."""
     m = _model(model)
 
-    def chunk(part, *near):
+    def chunk(part, *peaks):
         d = part.design()
-        return np.asarray(m.f0_hz(Evaluation(d).res, d.wall, near_hz=near[0] if near else None), dtype=float)
+        return np.asarray(m.f0_hz(Evaluation(d).res, d.wall, near=Branch(*peaks) if peaks else None), dtype=float)
 
-    return _chunked(chunk, v, *(() if near_hz is None else (np.asarray(near_hz, dtype=float),)))
+    follow = near is not None and m.follows
+    return _chunked(chunk, v, *((np.asarray(near.f0_hz, dtype=float), np.asarray(near.rigid_hz, dtype=float))
+                                if follow else ()))
+
+
+def branch(v: Variants, model: str, f0=None) -> Branch:
+    """The peaks the variants' f0 by ``model`` was found from (Hz), for moved variants to follow: f0 (``f0``,
+    computed when not given) and, for a model that follows its peak, the rigid network's peak
+    (:func:`matcad.acoustics.resonator.rigid_network_hz`; else None)."""
+    def rigid(part):
+        return np.asarray(rigid_network_hz(Evaluation(part.design()).res), dtype=float)
+
+    return Branch(f0_hz(v, model) if f0 is None else np.asarray(f0, dtype=float),
+                  _chunked(rigid, v) if _model(model).follows else None)
 
 
 def failed_checks(v: Variants, model: str, f0) -> np.ndarray:
@@ -163,8 +177,9 @@ def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None
     vectorised model, step :data:`RELATIVE_STEP` × the value; exactly 0 for a field the model does not read.
     ``follows`` ({field: factor}) moves the fields whose default follows this one with it (the cap's size follows
     the cavity diameter); ``f0`` (variants → Hz), when given, is differentiated instead of the model's f0. A model
-    that searches for its peak follows it from the variants' own f0 (``at_hz``, Hz; computed when not given) to the
-    moved variants' rather than searching again: the derivative of the branch the variant sings on."""
+    that searches for its peak follows it (and the rigid network's peak its ratio divides by) from the variants' own
+    (:func:`branch`, f0 ``at_hz`` Hz when given) to the moved variants' rather than searching again: the derivative
+    of the branch the variant sings on."""
     if field not in v.values:
         return np.zeros(len(v))
     x = v.values[field]
@@ -177,9 +192,9 @@ def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None
         return out
 
     if f0 is None:
-        near = (f0_hz(v, model) if at_hz is None else at_hz) if _model(model).follows else None
+        near = branch(v, model, at_hz)
 
         def f0(moved_v):
-            return f0_hz(moved_v, model, near_hz=near)
+            return f0_hz(moved_v, model, near=near)
 
     return (f0(moved(x + h)) - f0(moved(x - h))) / (2 * h)
