@@ -106,6 +106,10 @@ peaks agree with the one-pass scan's to < 1e-8 (and 4 windows are needed: with 2
 of four near-tie peaks), with 65 evaluations instead of 97 (tests/test_wall_peak.py)."""
 CANDIDATES = 2
 """Local maxima of the coarse scan refined per row (the highest two); the highest refined one is the peak."""
+RIVAL = 3.0
+"""A candidate after the highest is refined only where its coarse |D|² is within this factor of the highest's: a
+parabola's refinement lowers a minimum by far less (on 60 000 random variants the second candidate won only where
+its coarse value was within 1.09× of the first's; 11 % of rows have one within 3×)."""
 FIRST_WIDTH = 0.2
 REFINE_STEPS = 6
 SMALLEST_WIDTH = 1e-7
@@ -258,8 +262,18 @@ def scanned_x(rows: dict) -> np.ndarray:
     order = np.argsort(np.where(minima, y, np.inf), axis=-1)[:, :CANDIDATES]
     x = grid[order] + _vertex(padded[np.arange(n)[:, None, None], order[..., None] + np.arange(3)], step)
     real = np.take_along_axis(minima, order, axis=-1)  # fewer local minima than candidates: the rest drop out
-    x, best, _ = _refine(rows, x, real, FIRST_WIDTH * step, True)
-    return np.take_along_axis(x, np.argmin(best, axis=-1)[:, None], axis=-1)[:, 0]
+    coarse = np.take_along_axis(y, order, axis=-1)
+    rival = real & (coarse <= RIVAL * coarse[:, :1])  # the lowest always refined; another where it may win
+    peak, best, _ = _refine(rows, x[:, :1], real[:, :1], FIRST_WIDTH * step, True)
+    peak, best = peak[:, 0], best[:, 0]
+    for k in range(1, order.shape[1]):
+        some = np.flatnonzero(rival[:, k])
+        if some.size:
+            x_k, best_k, _ = _refine({name: value[some] for name, value in rows.items()}, x[some, k:k + 1],
+                                     real[some, k:k + 1], FIRST_WIDTH * step, True)
+            wins = best_k[:, 0] < best[some]
+            peak[some[wins]], best[some[wins]] = x_k[wins, 0], best_k[wins, 0]
+    return peak
 
 
 def _two_pass(rows: dict, grid: np.ndarray) -> np.ndarray:
