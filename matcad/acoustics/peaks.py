@@ -127,16 +127,16 @@ divided by both followed, their slope is the derivative to ~3e-8 (median; 3e-6 o
 six parabolas of shrinking width reached the peak itself to 1e-10 but left 1e-6 / 7e-5 in the slope: their last
 widths, 1e-7 in log f, hit |D|²'s rounding (tests/test_wall_peak.py)."""
 FAST_BLOCK = 1024
-"""Rows per numpy pass of the root find (1024 × 97 frequencies × ~22 modes: ~20 MB a temporary; 256 rows was
-1.5× slower, 2048 no faster)."""
+"""Rows per numpy pass of the root find (1024 × 49 frequencies × ~22 modes: ~9 MB a temporary; with the one-pass
+scan's 97, 256 rows was 1.5× slower, 2048 no faster)."""
 
 
 def peaks(geometry: tuple, wall, loss_factor, start=None) -> np.ndarray:
     """Peak frequency (Hz) of the driven response per row: ``geometry`` = (f_TL, c, A, S, l_eff, L, V_side) arrays
     of one shape, and the wall (None: rigid) with its loss, broadcast against it. The peak is a minimum of
     |D(f)|² = 1/|H|² (the mouth's pressure per unit closed-end pressure): bracketed by a coarse scan of
-    :data:`COARSE_POINTS`, then each of the :data:`CANDIDATES` lowest local minima refined by parabolas through
-    |D|² in log f of shrinking width (:data:`REFINE_STEPS`: Newton's step with a finite-difference derivative and
+    :data:`COARSE_POINTS` (in the two passes of :data:`WINDOWS`), then each of the :data:`CANDIDATES` lowest local
+    minima that may win (:data:`RIVAL`) refined by parabolas through |D|² in log f of shrinking width (:data:`REFINE_STEPS`: Newton's step with a finite-difference derivative and
     curvature), the lowest refined one kept; a rigid wall has one peak, refined from f_TL. The same f0 as the
     601-point scan :func:`scanned_peaks` to < 1e-4 on the templates and on 99.5 % of random variants; where they
     differ by more it is the scan's grid error (a 200 001-point search agrees with the root find to 1e-5; tested).

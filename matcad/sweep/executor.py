@@ -88,20 +88,15 @@ def run(fn_chunk, tasks: list[dict], executor: Executor, progress=None) -> list[
             out += fn_chunk(chunk)
             progress(len(out), len(tasks))
         return out
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    # spawn: workers start clean (no inherited threads or CAD-kernel state), the same on every platform
-    context = multiprocessing.get_context("spawn")
     chunks = _chunks(tasks, workers)
-    with ProcessPoolExecutor(workers, mp_context=context) as pool:
-        futures = [pool.submit(fn_chunk, c) for c in chunks]
+    with Processes(workers) as procs:
+        futures = [procs.pool.submit(fn_chunk, c) for c in chunks]
         done = _results(futures, chunks, progress)
     lost = [k for k, r in enumerate(done) if isinstance(r, BaseException)]
     if lost:  # a dead worker broke the pool: every chunk that did not come back again, one fresh process each
         for start in range(0, len(lost), workers):
             batch = lost[start:start + workers]
-            pools = [ProcessPoolExecutor(1, mp_context=context) for _ in batch]
+            pools = [procs.fresh(1) for _ in batch]
             try:
                 again = _results([p.submit(fn_chunk, chunks[k]) for p, k in zip(pools, batch)])
             finally:
