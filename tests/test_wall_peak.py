@@ -113,6 +113,33 @@ def test_the_two_pass_coarse_scan_finds_the_one_pass_peaks(seed, fewer, monkeypa
     assert np.max(np.abs(peaks.scanned_x(dict(rows)) - one)) > 0.1
 
 
+def test_rows_past_single_precision_are_scanned_in_double_without_a_warning(monkeypatch):
+    """Rows whose coarse scan overflows single precision (here f_TL at 1e30 Hz: f² past float32's 3e38) are scanned
+    again in double, unwarned, and get the peaks of a coarse scan all in double; a near-massless cap (density
+    1e-297 kg/m³: wall modes ~1e150 Hz, past float32, their stiff limit) stays in single precision, unwarned, with
+    the same peaks."""
+    import dataclasses
+    import warnings
+
+    res, rng = _random_resonator(200, seed=13)
+    n = len(res.cavity_length)
+    res = dataclasses.replace(res, silicone_density=np.where(np.arange(n) % 7 == 0, 1e-297, res.silicone_density))
+    f_tl, *net, modes, loss, side = _arguments(res, np.exp(rng.uniform(math.log(3e4), math.log(5e6), n)),
+                                               rng.uniform(wall.SELECT_LOSS, 0.4, n))
+    f_tl = np.where(np.arange(n) % 5 == 0, 1e30, f_tl)
+    rows, _, _ = peaks.rows_of((f_tl, *net, side), modes, loss)
+    grid = np.linspace(math.log(peaks.SWEEP[0]), math.log(peaks.SWEEP[1]), peaks.COARSE_POINTS)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        single = peaks._two_pass(dict(rows), grid, np.float32)
+        found = peaks.scanned_x(dict(rows))
+    assert set(np.flatnonzero(~np.isfinite(single).all(axis=-1))) == set(range(0, n, 5))
+    two_pass = peaks._two_pass
+    monkeypatch.setattr(peaks, "_two_pass", lambda rows, grid, dtype: two_pass(rows, grid, np.float64))
+    with np.errstate(all="ignore"):
+        assert np.max(np.abs(found - peaks.scanned_x(dict(rows)))) < 1e-8
+
+
 def test_a_row_alone_equals_the_row_in_a_batch():
     res, rng = _random_resonator(40, seed=5)
     args = _arguments(res, np.exp(rng.uniform(math.log(1e5), math.log(2e6), 40)), rng.uniform(0.08, 0.3, 40))

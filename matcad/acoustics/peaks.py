@@ -263,7 +263,10 @@ def scanned_x(rows: dict) -> np.ndarray:
     step = (hi - lo) / (COARSE_POINTS - 1)
     n = len(rows["f_tl"])
     grid = np.linspace(lo, hi, COARSE_POINTS)
-    y = _two_pass(rows, grid)
+    y = _two_pass(rows, grid, np.float32)
+    wild = np.flatnonzero(~np.isfinite(y).all(axis=-1))  # past single precision's range: these rows in double
+    if wild.size:
+        y[wild] = _two_pass({name: rows[name][wild] for name in INPUTS}, grid, np.float64)
     padded = np.pad(y, ((0, 0), (1, 1)), constant_values=np.inf)
     minima = (y <= padded[:, :-2]) & (y < padded[:, 2:])
     order = np.argsort(np.where(minima, y, np.inf), axis=-1)[:, :CANDIDATES]
@@ -287,22 +290,24 @@ INPUTS = ("f_tl", "c", "A", "S", "l", "L", "side", "freqs", "comps", "static", "
 """The inputs of a row with a wall (:func:`rows_of`)."""
 
 
-def _two_pass(rows: dict, grid: np.ndarray) -> np.ndarray:
-    """|D|² of each row on ``grid`` (odd length) as :data:`WINDOWS` says, in single precision: on the even points
-    and on the odd points near the lowest minima of those, elsewhere the larger neighbour."""
+def _two_pass(rows: dict, grid: np.ndarray, dtype) -> np.ndarray:
+    """|D|² of each row on ``grid`` (odd length) as :data:`WINDOWS` says, in ``dtype``: on the even points and on
+    the odd points near the lowest minima of those, elsewhere the larger neighbour. In single precision a value
+    past its range is left inf or NaN, unwarned (:func:`scanned_x` takes such a row again in double)."""
     n, odd = len(rows["f_tl"]), len(grid) // 2
-    single = {name: rows[name].astype(np.float32) for name in INPUTS}
-    grid = grid.astype(np.float32)
-    even = d_squared(single, np.broadcast_to(grid[::2], (n, odd + 1)), True).astype(float)
-    padded = np.pad(even, ((0, 0), (1, 1)), constant_values=np.inf)
-    minima = (even <= padded[:, :-2]) & (even < padded[:, 2:])
-    order = np.argsort(np.where(minima, even, np.inf), axis=-1)[:, :WINDOWS]
-    near = np.arange(-WINDOW_POINTS // 2, WINDOW_POINTS // 2)  # odd point k lies between even points k and k + 1
-    at = np.clip(order[..., None] + near, 0, odd - 1).reshape(n, -1)
-    y = np.empty((n, len(grid)))
-    y[:, ::2] = even
-    y[:, 1::2] = np.maximum(even[:, :-1], even[:, 1:])
-    found = d_squared(single, grid[2 * at + 1], True)
+    with np.errstate(**({"all": "ignore"} if dtype == np.float32 else {})):
+        values = {name: np.asarray(rows[name], dtype=dtype) for name in INPUTS}
+        grid = grid.astype(dtype)
+        even = d_squared(values, np.broadcast_to(grid[::2], (n, odd + 1)), True).astype(float)
+        padded = np.pad(even, ((0, 0), (1, 1)), constant_values=np.inf)
+        minima = (even <= padded[:, :-2]) & (even < padded[:, 2:])
+        order = np.argsort(np.where(minima, even, np.inf), axis=-1)[:, :WINDOWS]
+        near = np.arange(-WINDOW_POINTS // 2, WINDOW_POINTS // 2)  # odd point k lies between even points k, k + 1
+        at = np.clip(order[..., None] + near, 0, odd - 1).reshape(n, -1)
+        y = np.empty((n, len(grid)))
+        y[:, ::2] = even
+        y[:, 1::2] = np.maximum(even[:, :-1], even[:, 1:])
+        found = d_squared(values, grid[2 * at + 1], True)
     keep = np.repeat(np.take_along_axis(minima, order, axis=-1), WINDOW_POINTS, axis=-1)  # no minimum: no window
     odd_y = y[:, 1::2]
     np.put_along_axis(odd_y, at, np.where(keep, found, np.take_along_axis(odd_y, at, axis=-1)), axis=-1)
