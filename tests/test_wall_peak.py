@@ -95,10 +95,11 @@ def _one_pass_x(rows: dict) -> np.ndarray:
 @pytest.mark.parametrize("seed,fewer", [(102, 2), (109, 3)])
 def test_the_two_pass_coarse_scan_finds_the_one_pass_peaks(seed, fewer, monkeypatch):
     """The coarse scan's two passes (49 points, then 16 near the 4 lowest minima) in single precision, and the second
-    candidate refined only where its coarse value is within :data:`peaks.RIVAL` of the first's, give the peaks of all
-    97 points in double precision with both candidates refined to < 1e-8 on 20 000 random variants. With fewer windows a design among these is found on
-    another peak (seed 102: a deeper minimum behind a coarse one that ranked third; 109: four near-tie peaks), and so
-    it is without the second candidate (RIVAL 1: a near tie the second wins)."""
+    candidate refined only where its coarse value is within :data:`peaks.RIVAL` of the first's, give the peaks of
+    all 97 points in double precision with both candidates refined to < 1e-8 on 20 000 random variants. With fewer
+    windows a design among these is found on another peak (seed 102: a deeper minimum behind a coarse one that
+    ranked third; 109: four near-tie peaks), and so it is without the second candidate (RIVAL 1: a near tie the
+    second wins)."""
     res, rng = _random_resonator(20_000, seed=seed)
     n = len(res.cavity_length)
     f_tl, *net, modes, loss, side = _arguments(res, np.exp(rng.uniform(math.log(3e4), math.log(5e6), n)),
@@ -251,7 +252,7 @@ def test_a_slope_of_followed_peaks_is_the_derivative():
     shear, loss = np.exp(rng.uniform(math.log(3e4), math.log(5e6), n)), rng.uniform(wall.SELECT_LOSS, 0.4, n)
     args = _arguments(res, shear, loss)
     unmoved = wall.peak_ratio(*args)
-    rigid_hz = args[0] * wall.rigid_peak_ratio(*args[:6], args[8])
+    rigid_hz = args[0] * wall.peak_ratios(*args)[1]
 
     def moved(step):
         return _arguments(dataclasses.replace(res, cavity_length=res.cavity_length * (1 + step)), shear, loss)

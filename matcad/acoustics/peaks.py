@@ -140,17 +140,17 @@ scan's 97, 256 rows was 1.5× slower, 2048 no faster)."""
 
 def peaks(geometry: tuple, wall, loss_factor, start=None) -> np.ndarray:
     """Peak frequency (Hz) of the driven response per row: ``geometry`` = (f_TL, c, A, S, l_eff, L, V_side) arrays
-    of one shape, and the wall (None: rigid) with its loss, broadcast against it. The peak is a minimum of
-    |D(f)|² = 1/|H|² (the mouth's pressure per unit closed-end pressure): bracketed by a coarse scan of
-    :data:`COARSE_POINTS` (in the two passes of :data:`WINDOWS`), then each of the :data:`CANDIDATES` lowest local
-    minima that may win (:data:`RIVAL`) refined by parabolas through |D|² in log f of shrinking width (:data:`REFINE_STEPS`: Newton's step with a finite-difference derivative and
-    curvature), the lowest refined one kept; a rigid wall has one peak, refined from f_TL. The same f0 as the
-    601-point scan :func:`scanned_peaks` to < 1e-4 on the templates and on 99.5 % of random variants; where they
-    differ by more it is the scan's grid error (a 200 001-point search agrees with the root find to 1e-5; tested).
-    ~5-9× faster than the scan (benchmarks/sweep.py). ``start`` (log offsets from f_TL, broadcast against the
-    rows) follows each row's peak from there instead, with a wall or without: no search, one parabola of
-    :data:`FOLLOW_WIDTH` (a design moved a little from one whose peak is known, as a sensitivity's are: see
-    FOLLOW_WIDTH for what it is good to)."""
+    of one shape, and the wall (None: rigid) with its loss, broadcast against it. The peak is a minimum of |D(f)|² =
+    1/|H|² (the mouth's pressure per unit closed-end pressure): bracketed by a coarse scan of :data:`COARSE_POINTS`
+    (in the two passes of :data:`WINDOWS`), then each of the :data:`CANDIDATES` lowest local minima that may win
+    (:data:`RIVAL`) refined by parabolas through |D|² in log f of shrinking width (:data:`REFINE_STEPS`: Newton's
+    step with a finite-difference derivative and curvature), the lowest refined one kept; a rigid wall has one peak,
+    refined from f_TL. The same f0 as the 601-point scan :func:`scanned_peaks` to < 1e-4 on the templates and on
+    99.5 % of random variants; where they differ by more it is the scan's grid error (a 200 001-point search agrees
+    with the root find to 1e-5; tested). ~10× faster than the scan (benchmarks/sweep.py). ``start`` (log offsets
+    from f_TL, broadcast against the rows) follows each row's peak from there instead, with a wall or without: no
+    search, one parabola of :data:`FOLLOW_WIDTH` (a design moved a little from one whose peak is known, as a
+    sensitivity's are: see FOLLOW_WIDTH for what it is good to)."""
     rows, shape, n = rows_of(geometry, wall, loss_factor, start)
     rows, inverse = distinct_rows(rows)
     m = len(rows["f_tl"])

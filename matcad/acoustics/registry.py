@@ -38,8 +38,10 @@ class AcousticModel:
     """One rung (see the module docstring). ``wall`` says which silicone modulus its f0 takes: '' none (rigid
     walls), 'static' the static shear modulus, 'dynamic' the kHz storage modulus and the loss factor, each at the
     middle of the spec's range. ``describe`` (``"module:function"`` of (evaluation, f0) → text) words the source
-    with the numbers of one evaluation; without it the source is ``source``. ``follows``: its f0 is a peak that
-    a nearby design's peaks let it follow rather than search for (``near`` of :meth:`f0_hz`)."""
+    with the numbers of one evaluation; without it the source is ``source``. ``branch`` (``"module:function"`` of the
+    same arguments as ``evaluate`` → :class:`matcad.acoustics.resonator.Branch`): its f0 is a peak, and these are the
+    peaks it was found from, which a nearby design follows rather than searching again (``near`` of
+    :meth:`f0_hz`)."""
 
     name: str
     rung: int
@@ -50,7 +52,12 @@ class AcousticModel:
     checks: tuple[str, ...] = ()
     wall: str = ""
     describe: str | None = None
-    follows: bool = False
+    branch: str | None = None
+
+    @property
+    def follows(self) -> bool:
+        """Whether its f0 is a peak that a nearby design can follow (it declares its ``branch``)."""
+        return self.branch is not None
 
     @property
     def cheap(self) -> bool:
@@ -81,6 +88,12 @@ class AcousticModel:
             shear_modulus_pa, loss_factor = self.wall_arguments(material)
         follow = {"near": near} if self.follows and near is not None else {}
         return self.function()(res, shear_modulus_pa, 0.0 if loss_factor is None else loss_factor, **follow)
+
+    def branch_of(self, res, material=None):
+        """The :class:`matcad.acoustics.resonator.Branch` of a rung that ``follows``, as :meth:`f0_hz` takes its
+        arguments (its f0 with the peaks it was found from, one search of each)."""
+        shear_modulus_pa, loss_factor = self.wall_arguments(material) if material is not None else (None, 0.0)
+        return _load(self.branch)(res, shear_modulus_pa, loss_factor)
 
     def result(self, ev, f_guess_hz: float | None = None, level: int | None = None) -> ModelResult:
         """This rung on one :class:`matcad.acoustics.evaluation.Evaluation`: f0 (Hz), checks, source. A mesh rung
@@ -121,7 +134,8 @@ MODELS: tuple[AcousticModel, ...] = (
     AcousticModel("elastic_wall", 5, ("silicone",), False, "matcad.acoustics.resonator:elastic_wall_hz",
                   "transmission line coupled to the cap's wall modes (from the coupled FEM's elastic operator, "
                   "wall_modes.json)", PLANE + ("wall_shape_in_table", "no_wall_mode_near_f"), "dynamic",
-                  "matcad.acoustics.evaluation:describe_elastic_wall", follows=True),
+                  "matcad.acoustics.evaluation:describe_elastic_wall",
+                  "matcad.acoustics.resonator:elastic_wall_branch"),
     AcousticModel("fem", 6, ("rigid", "silicone"), True, "matcad.acoustics.fem_model:fem_result",
                   "axisymmetric P2 FEM (scikit-fem); with silicone the elastic cap coupled to the air"),
 )

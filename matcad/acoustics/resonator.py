@@ -149,7 +149,7 @@ def soft_wall_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0):
 @dataclass(frozen=True)
 class Branch:
     """Where a design's elastic-wall f0 was found (Hz, floats or arrays of designs): ``f0_hz``, and ``rigid_hz`` the
-    rigid network's peak its ratio divides by (:func:`rigid_network_hz`; None for a model with no peak to follow).
+    rigid network's peak its ratio divides by (:func:`elastic_wall_branch`; None for a model with no peak to follow).
     A design moved a little from it follows both peaks from there (:func:`elastic_wall_hz`'s ``near``) instead of
     searching for them."""
 
@@ -170,11 +170,13 @@ def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor=0.0, near: Bra
                                   **follow)
 
 
-def rigid_network_hz(res: Resonator):
-    """The peak of the driven response with a rigid wall (Hz): what :func:`elastic_wall_hz`'s ratio divides by."""
+def elastic_wall_branch(res: Resonator, shear_modulus_pa, loss_factor=0.0) -> Branch:
+    """:func:`elastic_wall_hz` and the rigid network's peak it divides by (Hz), from the one search of each: what a
+    design moved a little from this one follows (its ``near``)."""
     f_tl = transmission_line_hz(res)
-    return f_tl * wall.rigid_peak_ratio(f_tl, res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
-                                        res.cavity_length, res.side_volume)
+    ratio, rigid = wall.peak_ratios(f_tl, res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
+                                    res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor, res.side_volume)
+    return Branch(f_tl * ratio, f_tl * rigid)
 
 
 def elastic_wall_doublet_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0) -> float | None:

@@ -209,10 +209,20 @@ def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
     by the 601-point reference scan. ``near`` (the ratio of a design close to this one, broadcast against it) makes
     the root find follow the peak from that ratio instead of searching the band: a sensitivity's moved designs, whose
     peak lies on the branch of the design they were moved from (below SELECT_LOSS each design is followed anyway);
-    ``near_rigid`` (that design's rigid-wall peak over this f_TL, :func:`rigid_peak_ratio`) follows the rigid
-    network's peak from there too."""
+    ``near_rigid`` (that design's rigid-wall peak over this f_TL, :func:`peak_ratios`) follows the rigid network's
+    peak from there too."""
+    return peak_ratios(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall, loss_factor,
+                       side_volume, scan, near, near_rigid)[0]
+
+
+def peak_ratios(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,
+                loss_factor, side_volume=0.0, scan: bool = False, near=None, near_rigid=None):
+    """(:func:`peak_ratio`, the rigid network's peak over f_TL that it divides by), from one search of each."""
     geometry = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
         f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume)))
+    search = _scanned_peaks if scan else _peaks
+    rigid = search(tuple(geometry), None, 0.0, **({} if near_rigid is None or scan else
+                                                  {"start": np.log(np.asarray(near_rigid, dtype=float))}))
     if np.any(np.asarray(loss_factor) < SELECT_LOSS):  # row by row, each following its Helmholtz branch
         shape = np.broadcast_shapes(geometry[0].shape, np.shape(wall.static_mm3_pa), np.shape(loss_factor))
         m = wall.frequencies_hz.shape[-1]
@@ -220,26 +230,15 @@ def peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_l
         comps = np.broadcast_to(wall.compliances_mm3_pa, shape + (m,))
         static, loss = np.broadcast_to(wall.static_mm3_pa, shape), np.broadcast_to(loss_factor, shape)
         rows = [np.broadcast_to(g, shape) for g in geometry]
-        out = np.empty(shape)
+        ratio = np.empty(shape)
         for i in np.ndindex(shape):
-            out[i] = _followed_ratio(*(float(g[i]) for g in rows[:6]),
-                                     Modes(freqs[i], comps[i], float(static[i])), float(loss[i]), float(rows[6][i]))
-        return float(out) if out.ndim == 0 else out
-    search = _scanned_peaks if scan else _peaks
-    rigid = search(tuple(geometry), None, 0.0, **({} if near_rigid is None or scan else
-                                                  {"start": np.log(np.asarray(near_rigid, dtype=float))}))
-    follow = {} if near is None or scan else {"start": np.log(np.asarray(near, dtype=float) * rigid / geometry[0])}
-    ratio = search(tuple(geometry), wall, loss_factor, **follow) / rigid
-    return float(ratio) if ratio.ndim == 0 else ratio
-
-
-def rigid_peak_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume=0.0):
-    """The peak of the cavity pressure with a rigid wall over f_TL: what :func:`peak_ratio` divides by (arrays of
-    designs give arrays; the same root find)."""
-    geometry = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
-        f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, side_volume)))
-    ratio = _peaks(tuple(geometry), None, 0.0) / geometry[0]
-    return float(ratio) if ratio.ndim == 0 else ratio
+            ratio[i] = _followed_ratio(*(float(g[i]) for g in rows[:6]),
+                                       Modes(freqs[i], comps[i], float(static[i])), float(loss[i]), float(rows[6][i]))
+    else:
+        follow = {} if near is None or scan else {"start": np.log(np.asarray(near, dtype=float) * rigid / geometry[0])}
+        ratio = search(tuple(geometry), wall, loss_factor, **follow) / rigid
+    rigid = np.broadcast_to(rigid / geometry[0], np.shape(ratio))
+    return tuple(float(x) if np.ndim(x) == 0 else np.asarray(x) for x in (ratio, rigid))
 
 
 def _followed_ratio(f_tl_hz, c_m_s, neck_area, cavity_area, neck_length_eff, cavity_length, wall: Modes,

@@ -410,14 +410,15 @@ def evaluate(chunk: GridChunk, base, model: str, rules: bool, memos, slope: Memo
         from matcad.acoustics.predict import warning_count
         from matcad.acoustics.registry import CHOSEN
 
-        f0 = fast.f0_hz(v, model)
+        near = fast.branch(v, model)
+        f0 = near.f0_hz
         physics = f0 if model == CHOSEN[base.wall.model] else None
         failed = fast.failed_checks(v, model, f0)
         valid, warned = failed == 0, warning_count(v.design(), f0, failed)
         low, high = fast.band_hz(v, model, f0, valid)
 
         def slope_of(field, follows):
-            return fast.sensitivity(v, model, field, follows, at_hz=f0)
+            return fast.sensitivity(v, model, field, follows, near=near)
     out["f0_hz"][ok], out["band_low_hz"][ok], out["band_high_hz"][ok] = f0, low, high
     out["model_valid"][ok] = valid
     for a in chunk.axes:

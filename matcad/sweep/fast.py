@@ -18,7 +18,7 @@ import numpy as np
 from matcad.acoustics import checks, registry, uncertainty
 from matcad.acoustics.design import Air, Design, Making, WallMaterial, gap_radius_mm
 from matcad.acoustics.evaluation import Evaluation
-from matcad.acoustics.resonator import Branch, rigid_network_hz
+from matcad.acoustics.resonator import Branch
 
 VECTORISED = tuple(m.name for m in registry.MODELS if m.cheap)
 """The registered rungs that are closed forms of the design (no FEM): lumped, end_corrected, transmission_line and
@@ -128,15 +128,20 @@ def f0_hz(v: Variants, model: str, near: Branch | None = None) -> np.ndarray:
                                 if follow else ()))
 
 
-def branch(v: Variants, model: str, f0=None) -> Branch:
-    """The peaks the variants' f0 by ``model`` was found from (Hz), for moved variants to follow: f0 (``f0``,
-    computed when not given) and, for a model that follows its peak, the rigid network's peak
-    (:func:`matcad.acoustics.resonator.rigid_network_hz`; else None)."""
-    def rigid(part):
-        return np.asarray(rigid_network_hz(Evaluation(part.design()).res), dtype=float)
+def branch(v: Variants, model: str) -> Branch:
+    """The f0 (Hz) of every variant by ``model`` with, for a model that follows its peak, the peaks it was found
+    from (:meth:`matcad.acoustics.registry.AcousticModel.branch_of`; else ``rigid_hz`` None): what moved variants
+    follow. The same f0 as :func:`f0_hz`."""
+    m = _model(model)
+    if not m.follows:
+        return Branch(f0_hz(v, model), None)
 
-    return Branch(f0_hz(v, model) if f0 is None else np.asarray(f0, dtype=float),
-                  _chunked(rigid, v) if _model(model).follows else None)
+    def chunk(part):
+        d = part.design()
+        b = m.branch_of(Evaluation(d).res, d.wall)
+        return np.asarray(b.f0_hz, dtype=float), np.asarray(b.rigid_hz, dtype=float)
+
+    return Branch(*_chunked(chunk, v))
 
 
 def failed_checks(v: Variants, model: str, f0) -> np.ndarray:
@@ -172,14 +177,14 @@ def band_hz(v: Variants, model: str, f0, ok) -> tuple[np.ndarray, np.ndarray]:
 
 
 def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None, f0=None,
-                at_hz=None) -> np.ndarray:
+                near: Branch | None = None) -> np.ndarray:
     """df0/dfield per variant (Hz per the field's unit: Hz/mm for lengths) by a central difference of the
     vectorised model, step :data:`RELATIVE_STEP` × the value; exactly 0 for a field the model does not read.
     ``follows`` ({field: factor}) moves the fields whose default follows this one with it (the cap's size follows
     the cavity diameter); ``f0`` (variants → Hz), when given, is differentiated instead of the model's f0. A model
     that searches for its peak follows it (and the rigid network's peak its ratio divides by) from the variants' own
-    (:func:`branch`, f0 ``at_hz`` Hz when given) to the moved variants' rather than searching again: the derivative
-    of the branch the variant sings on."""
+    (``near``, :func:`branch`; found when not given) to the moved variants' rather than searching again: the
+    derivative of the branch the variant sings on."""
     if field not in v.values:
         return np.zeros(len(v))
     x = v.values[field]
@@ -192,7 +197,7 @@ def sensitivity(v: Variants, model: str, field: str, follows: dict | None = None
         return out
 
     if f0 is None:
-        near = branch(v, model, at_hz)
+        near = branch(v, model) if near is None else near
 
         def f0(moved_v):
             return f0_hz(moved_v, model, near=near)

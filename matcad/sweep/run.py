@@ -201,10 +201,11 @@ def sweep(data: dict, axes: tuple[Axis, ...], model: str | None = None, executor
     vectorised = model in fast.VECTORISED and arrays.one_sheet(base, axes)  # a riser: each variant on its own
     if vectorised and ok:
         v = fast.from_specs([specs[i] for i in ok])
-        f0 = fast.f0_hz(v, model)
+        near = fast.branch(v, model)
+        f0 = near.f0_hz
         valid = fast.valid(v, model, f0)
         low, high = fast.band_hz(v, model, f0, valid)
-        slopes = {sensitivity_column(a): fast.sensitivity(v, model, a.field, at_hz=f0) for a in axes}
+        slopes = {sensitivity_column(a): fast.sensitivity(v, model, a.field, near=near) for a in axes}
         for j, i in enumerate(ok):
             rows[i].update(f0_hz=float(f0[j]), band_low_hz=float(low[j]), band_high_hz=float(high[j]),
                            model_valid=bool(valid[j]), **{k: float(s[j]) for k, s in slopes.items()})

@@ -4,9 +4,10 @@ Each process of an array sweep memoises the design rules and Eq. 5's slope per d
 fields they read (:mod:`matcad.sweep.memo`), and a process meets nearly every combination in its first chunks (the
 grid's inner axes cycle through them in each chunk), so on N processes they ran N times over. Warmed, the
 combinations are split over the N processes once (the processes the grid then runs on), their memos merged, and
-every process of the sweep starts from the merge (:func:`matcad.sweep.run.array_chunks`). A combination the warm-up did not meet (a rule that reads another field
-on another variant) is still run where it is met: the outputs are those of an unwarmed sweep, byte for byte. Not
-on a Dask cluster (its workers are not known ahead) nor in one process (nothing to split).
+every process of the sweep starts from the merge (:func:`matcad.sweep.run.array_chunks`). A combination the warm-up
+did not meet (a rule that reads another field on another variant) is still run where it is met: the outputs are
+those of an unwarmed sweep, byte for byte. Not on a Dask cluster (its workers are not known ahead) nor in one
+process (nothing to split).
 """
 
 from __future__ import annotations
@@ -25,12 +26,12 @@ meets mostly new combinations anyway, and the warm-up would be most of the sweep
 
 def warmed(data: dict, axes, rules: bool, executor: Executor, shared: Processes | None = None) -> list | None:
     """The sweep's memos (:func:`matcad.sweep.arrays.memos`: Eq. 5's slope, and the design rules when ``rules``)
-    filled on every combination of the axes each memo
-    reads on the grid's first valid variant, the other axes at that variant's values (a rule reading the neck meets
-    every neck, one reading the cavity every cavity, not every neck with every cavity), split over the executor's local
-    processes (``shared``: the sweep's own, :func:`matcad.sweep.executor.processes`) and merged: [(tables,
-    outcomes)] per memo, as :meth:`matcad.sweep.memo.Memo.merge` takes them; None where warming does not pay (one process, a Dask cluster, no valid variant in the first chunk, or inputs that
-    hardly repeat)."""
+    filled on every combination of the axes each memo reads on the grid's first valid variant, the other axes at
+    that variant's values (a rule reading the neck meets every neck, one reading the cavity every cavity, not every
+    neck with every cavity), split over the executor's local processes (``shared``: the sweep's own,
+    :func:`matcad.sweep.executor.processes`) and merged: [(tables, outcomes)] per memo, as
+    :meth:`matcad.sweep.memo.Memo.merge` takes them; None where warming does not pay (one process, a Dask cluster,
+    no valid variant in the first chunk, or inputs that hardly repeat)."""
     from matcad.spec import from_dict
 
     if executor.scheduler or executor.workers <= 1:
