@@ -162,21 +162,25 @@ def elastic_wall_hz(res: Resonator, shear_modulus_pa, loss_factor=0.0, near: Bra
     peak of the driven response (Hz). Arrays of designs, or one design at arrays of moduli and loss factors, give
     arrays, each entry the same arithmetic as one call (:func:`matcad.acoustics.wall.peak_ratio`). ``near`` (the
     branch of a design this one was moved a little from) follows that design's peaks instead of searching."""
-    f_tl = transmission_line_hz(res)
+    f_tl, network = _wall_network(res, shear_modulus_pa, loss_factor)
     follow = {} if near is None else {"near": np.asarray(near.f0_hz, dtype=float) / f_tl,
                                       "near_rigid": np.asarray(near.rigid_hz, dtype=float) / f_tl}
-    return f_tl * wall.peak_ratio(f_tl, res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
-                                  res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor, res.side_volume,
-                                  **follow)
+    return f_tl * wall.peak_ratio(*network, **follow)
 
 
 def elastic_wall_branch(res: Resonator, shear_modulus_pa, loss_factor=0.0) -> Branch:
     """:func:`elastic_wall_hz` and the rigid network's peak it divides by (Hz), from the one search of each: what a
     design moved a little from this one follows (its ``near``)."""
-    f_tl = transmission_line_hz(res)
-    ratio, rigid = wall.peak_ratios(f_tl, res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res),
-                                    res.cavity_length, wall_modes(res, shear_modulus_pa), loss_factor, res.side_volume)
+    f_tl, network = _wall_network(res, shear_modulus_pa, loss_factor)
+    ratio, rigid = wall.peak_ratios(*network)
     return Branch(f_tl * ratio, f_tl * rigid)
+
+
+def _wall_network(res: Resonator, shear_modulus_pa, loss_factor) -> tuple:
+    """(f_TL (Hz), the arguments of :func:`matcad.acoustics.wall.peak_ratio` for ``res`` with its wall)."""
+    f_tl = transmission_line_hz(res)
+    return f_tl, (f_tl, res.c_m_s, res.neck_area, res.cavity_area, _step_neck_length_mm(res), res.cavity_length,
+                  wall_modes(res, shear_modulus_pa), loss_factor, res.side_volume)
 
 
 def elastic_wall_doublet_hz(res: Resonator, shear_modulus_pa, loss_factor: float = 0.0) -> float | None:

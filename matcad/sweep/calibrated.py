@@ -44,8 +44,11 @@ class CalibratedSweep:
         self.v = v
         self.branches = (fast.branch(v, self.physics), fast.branch(self.drawn(v), self.physics))
         """The physics peaks of the variants and of their calibrated drawings (:func:`matcad.sweep.fast.branch`)."""
-        self.physics_hz = tuple(b.f0_hz for b in self.branches)
+
+    @property
+    def physics_hz(self) -> tuple[np.ndarray, np.ndarray]:
         """The physics f0 of the variants and of their calibrated drawings (Hz)."""
+        return self.branches[0].f0_hz, self.branches[1].f0_hz
 
     def drawn(self, v: fast.Variants) -> fast.Variants:
         """The variants with the calibrated drawing's fields (:data:`matcad.spec.drawn.DRAWN`; their others kept)."""
@@ -55,7 +58,7 @@ class CalibratedSweep:
 
     def anchored_hz(self, v: fast.Variants, drawing_moves: bool = True) -> np.ndarray:
         """f(0) x physics(variant) / physics(calibrated drawing) (Hz) of variants moved a little from the chunk's,
-        each physics followed from the chunk's own (:attr:`physics_hz`, :func:`matcad.sweep.fast.f0_hz`); unless
+        each physics followed from the chunk's own (:attr:`branches`, :func:`matcad.sweep.fast.f0_hz`); unless
         ``drawing_moves``, the drawings are the chunk's own and so is their physics."""
         variant, drawing = self.branches
         drawn = fast.f0_hz(self.drawn(v), self.physics, drawing) if drawing_moves else drawing.f0_hz
