@@ -81,6 +81,22 @@ def test_nesting_follows_the_laser_bed():
     assert narrow[2] - narrow[0] < wide[2] - wide[0] and narrow[3] - narrow[1] > 2 * (wide[3] - wide[1]) - 1
 
 
+
+@pytest.mark.parametrize("template", [t for t in TEMPLATES if "tube" not in t.stem], ids=lambda p: p.stem)
+def test_sheet_sizes_are_the_nested_sheets(template):
+    """The sizes laser.bed judges (kit_sheet_sizes, no hole moved) are the nested cut files' own, bit for bit:
+    name, parts in nesting order and extents, on every template and on beds narrow enough to break its rows."""
+    from matcad.export.sheets import kit_sheet_sizes, kit_sheets
+
+    layouts = set()
+    for bed_x in (300.0, 90.0, 60.0, 30.0):
+        spec = spec_with(template, machine__laser_bed_x=bed_x)
+        nested = {sheet: (plan.flat.name, plan.parts, plan.extents) for sheet, plan in kit_sheets(spec).items()}
+        assert {sheet: tuple(size) for sheet, size in kit_sheet_sizes(spec).items()} == nested
+        layouts.add(tuple(sorted(nested.items())))
+    assert len(layouts) >= 2  # the narrow beds nest some sheet in more rows
+
+
 def test_beam_deflection_against_statics():
     """Roark's case 1e (matcad.mechanics.plate) against the Euler-Bernoulli beam solved from statics alone: the
     bending moment of a simply supported span under a point load, M = W b x / l before the load and W a (l - x) / l

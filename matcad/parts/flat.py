@@ -199,25 +199,40 @@ def drawn_holes(flat: Flat, kerf: float) -> list[tuple[Hole, float]]:
     return sorted(((h, drawn_diameter_mm(h.diameter, kerf)) for h in flat.holes), key=lambda hd: hd[1])
 
 
+def check_drawable(flat: Flat) -> None:
+    """Raises :class:`DrawnSizeError` when a hole of ``flat`` would be drawn at a diameter ≤ 0 (a hole smaller than
+    the kerf): the design rule ``laser.drawn_size`` reports the same thing, naming the spec field, before any
+    build."""
+    for hole, drawn in drawn_holes(flat, flat.kerf):
+        if drawn <= 0:
+            raise DrawnSizeError(f"{flat.name}: {hole.purpose} hole of {hole.diameter:g} mm would be drawn at "
+                                 f"{drawn:g} mm after the {flat.kerf:g} mm kerf; it must be drawn > 0 mm")
+
+
+def _copies_x(flat: Flat, spacing: float) -> list[float]:
+    """x offset of each of the ``quantity`` copies of ``flat`` laid side by side ``spacing`` apart (mm)."""
+    return [i * (flat.width + flat.kerf + spacing) for i in range(flat.quantity)]
+
+
+def cut_outlines(flat: Flat, spacing: float = 3.0) -> tuple[tuple[float, float, float, float, float], ...]:
+    """The outline of each copy of ``flat`` as the laser follows it, grown by kerf/2 (x0, y0, x1, y1, corner radius;
+    mm), copies side by side ``spacing`` apart: :func:`cut_plan`'s outlines."""
+    half = flat.kerf / 2
+    return tuple((dx - flat.width / 2 - half, -flat.depth / 2 - half, dx + flat.width / 2 + half,
+                  flat.depth / 2 + half, flat.corner_radius + half) for dx in _copies_x(flat, spacing))
+
+
 def cut_plan(flat: Flat, reference_square: bool, spacing: float = 3.0) -> CutPlan:
     """Apply the sheet's kerf compensation (outline +kerf/2, holes −kerf/2) and lay out ``quantity`` copies.
 
-    Raises :class:`DrawnSizeError` when a hole would be drawn at a diameter ≤ 0 (a hole smaller than the kerf):
-    the design rule ``laser.drawn_size`` reports the same thing, naming the spec field, before any build.
+    Raises :class:`DrawnSizeError` when a hole would be drawn at a diameter ≤ 0 (:func:`check_drawable`).
     """
+    check_drawable(flat)
     kerf = flat.kerf
-    for hole, drawn in drawn_holes(flat, kerf):
-        if drawn <= 0:
-            raise DrawnSizeError(f"{flat.name}: {hole.purpose} hole of {hole.diameter:g} mm would be drawn at "
-                                 f"{drawn:g} mm after the {kerf:g} mm kerf; it must be drawn > 0 mm")
     half = kerf / 2
-    outlines, circles = [], []
-    for i in range(flat.quantity):
-        dx = i * (flat.width + kerf + spacing)
-        outlines.append((dx - flat.width / 2 - half, -flat.depth / 2 - half,
-                         dx + flat.width / 2 + half, flat.depth / 2 + half, flat.corner_radius + half))
-        circles += [CutCircle(dx + h.x, h.y, drawn_diameter_mm(h.diameter, kerf), h.diameter, -kerf, h.purpose)
-                    for h in flat.holes]
+    outlines = cut_outlines(flat, spacing)
+    circles = [CutCircle(dx + h.x, h.y, drawn_diameter_mm(h.diameter, kerf), h.diameter, -kerf, h.purpose)
+               for dx in _copies_x(flat, spacing) for h in flat.holes]
     x_max = outlines[-1][2]
     square = None
     if reference_square:
@@ -225,4 +240,4 @@ def cut_plan(flat: Flat, reference_square: bool, spacing: float = 3.0) -> CutPla
         x_max = square[0] + REFERENCE_SQUARE_MM
     y_max = max(flat.depth / 2 + half, -flat.depth / 2 + REFERENCE_SQUARE_MM if square else 0)
     extents = (outlines[0][0], -flat.depth / 2 - half, x_max, y_max)
-    return CutPlan(flat, kerf, tuple(outlines), tuple(circles), flat.engrave, square, extents)
+    return CutPlan(flat, kerf, outlines, tuple(circles), flat.engrave, square, extents)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from matcad.acoustics.uncertainty import sheet_tolerance_mm
-from matcad.export.sheets import BED_MARGIN_MM, kit_sheets, usable_bed_mm
+from matcad.export.sheets import BED_MARGIN_MM, kit_sheet_sizes, usable_bed_mm
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.features import is_stock_sheet, sheet_row_key
 from matcad.parts.flat import DrawnSizeError, Flat, drawn_holes
@@ -136,17 +136,17 @@ def dowel_fit(spec) -> list[Finding]:
 
 
 def laser_bed(spec) -> list[Finding]:
-    """Every acrylic sheet's nested cut file (:func:`matcad.export.sheets.kit_sheets`, the layout the build writes,
-    kerf and reference square included) must fit the laser's bed less its margins (``machine.laser_bed_x/y``),
-    either way round: a part off the bed cannot be cut. A hole that cannot be drawn is ``laser.drawn_size``'s."""
+    """Every acrylic sheet's nested cut file (:func:`matcad.export.sheets.kit_sheet_sizes`: the layout the build
+    writes, kerf and reference square included) must fit the laser's bed less its margins
+    (``machine.laser_bed_x/y``), either way round: a part off the bed cannot be cut. A hole that cannot be drawn is
+    ``laser.drawn_size``'s."""
     try:
-        sheets = kit_sheets(spec)
+        sheets = kit_sheet_sizes(spec)
     except DrawnSizeError:
         return []
     usable = usable_bed_mm(spec)
     out = []
-    for sheet, plan in sheets.items():
-        x0, y0, x1, y1 = plan.extents
+    for sheet, (name, parts, (x0, y0, x1, y1)) in sheets.items():
         size = (x1 - x0, y1 - y0)
         if fits_bed(size, usable):
             continue
@@ -156,7 +156,7 @@ def laser_bed(spec) -> list[Finding]:
                "or make the plate smaller (fewer taxels, plate.width/depth)" if alone else
                "every part fits alone: cut the sheet in several runs (split the cut file), or enter a larger bed")
         out.append(Finding("laser.bed", "error", [round(v, 3) for v in size], [round(v, 3) for v in usable],
-                           f"{plan.flat.name}: the nested sheet ({', '.join(dict.fromkeys(plan.parts))}) is "
+                           f"{name}: the nested sheet ({', '.join(dict.fromkeys(parts))}) is "
                            f"{size[0]:.1f} x {size[1]:.1f} mm; the laser bed machine.laser_bed_x/y = "
                            f"{spec.machine.laser_bed_x:g} x {spec.machine.laser_bed_y:g} mm less {BED_MARGIN_MM:g} mm "
                            f"margins holds {usable[0]:g} x {usable[1]:g} mm (either way round)", fix))
