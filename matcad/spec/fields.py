@@ -91,10 +91,24 @@ def _number(path: str, value: Any, meta: dict) -> float:
         raise SpecError(path, value, f"must be {_range_text(meta)}") from None
     if x != 0 and abs(x) < sys.float_info.min:  # subnormal: no physical value, and 1/x overflows
         raise SpecError(path, value, f"must be {_range_text(meta)}, not a subnormal number")
-    lo_ok = x > meta["lo"] if meta["lo_open"] else x >= meta["lo"]
-    if not (math.isfinite(x) and lo_ok and x <= meta["hi"]):
+    if not _within(x, meta):
         raise SpecError(path, value, f"must be {_range_text(meta)}")
     return x
+
+
+def _within(x: float, meta: dict) -> bool:
+    """Whether the finite float ``x`` lies in the declared range (the low end open where ``lo_open``); False for
+    inf and NaN."""
+    lo_ok = x > meta["lo"] if meta["lo_open"] else x >= meta["lo"]
+    return math.isfinite(x) and lo_ok and x <= meta["hi"]
+
+
+def _valid_float(value: Any, meta: dict) -> bool:
+    """Whether ``value`` is already what :func:`convert` makes of a number field: a float, in range, not subnormal
+    (then it is kept as it is, with no path formatted for an error that cannot come: a section remade by
+    ``dataclasses.replace`` re-validates its numbers at this cost)."""
+    return (type(value) is float and meta["kind"] == "number" and (value == 0 or abs(value) >= sys.float_info.min)
+            and _within(value, meta))
 
 
 def convert(path: str, value: Any, meta: dict) -> Any:
@@ -181,7 +195,8 @@ class Section:
                 continue
             if value is None and default is dataclasses.MISSING:
                 raise SpecError(f"{path}.{name}", MISSING, f"is required ({meta['doc']})")
-            object.__setattr__(self, name, convert(f"{path}.{name}", value, meta))
+            if not _valid_float(value, meta):
+                object.__setattr__(self, name, convert(f"{path}.{name}", value, meta))
 
 
 @functools.cache

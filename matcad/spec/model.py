@@ -8,6 +8,7 @@ silicone values from its grade); :func:`to_dict` gives the resolved spec as plai
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
@@ -24,6 +25,12 @@ from matcad.spec.sections import (CAP_OUTER_PER_D, CAP_TOP_PER_D, MAX_TAXELS, Ai
                                   Outputs, Plate, Reference, Riser, Silicone, Spacer, TaxelEntry, Wall)
 
 
+def _default(cls: type):
+    """A Spec field whose default is the table ``cls()``, made once and shared: tables are frozen, so a spec's tables
+    left to their defaults are validated once per process, not once per spec (a sweep makes one per variant)."""
+    return field(default_factory=functools.cache(cls))
+
+
 @dataclass(frozen=True)
 class Spec:
     """A whole taxel design. Lengths in mm."""
@@ -31,23 +38,23 @@ class Spec:
     name: str = param("design name; the build folder is out/<name>", kind="name")
     cavity: Cavity = field(default=None)  # type: ignore[assignment]
     neck: Neck = field(default=None)  # type: ignore[assignment]
-    plate: Plate = field(default_factory=Plate)
+    plate: Plate = _default(Plate)
     riser: Riser | None = None
-    guide: Guide = field(default_factory=Guide)
-    spacer: Spacer = field(default_factory=Spacer)
-    end_cap: EndCap = field(default_factory=EndCap)
-    fasteners: Fasteners = field(default_factory=Fasteners)
-    needle: Needle = field(default_factory=Needle)
-    mount: Mount = field(default_factory=Mount)
-    mold: Mold = field(default_factory=Mold)
-    machine: Machine = field(default_factory=Machine)
-    outputs: Outputs = field(default_factory=Outputs)
-    air: Air = field(default_factory=Air)
-    wall: Wall = field(default_factory=Wall)
-    microphone: Microphone = field(default_factory=Microphone)
-    silicone: Silicone = field(default_factory=Silicone)
+    guide: Guide = _default(Guide)
+    spacer: Spacer = _default(Spacer)
+    end_cap: EndCap = _default(EndCap)
+    fasteners: Fasteners = _default(Fasteners)
+    needle: Needle = _default(Needle)
+    mount: Mount = _default(Mount)
+    mold: Mold = _default(Mold)
+    machine: Machine = _default(Machine)
+    outputs: Outputs = _default(Outputs)
+    air: Air = _default(Air)
+    wall: Wall = _default(Wall)
+    microphone: Microphone = _default(Microphone)
+    silicone: Silicone = _default(Silicone)
     calibration: Calibration | None = None
-    mechanics: Mechanics = field(default_factory=Mechanics)
+    mechanics: Mechanics = _default(Mechanics)
     reference: Reference | None = None
     array: Array | None = None
     taxel: tuple[TaxelEntry, ...] = ()
