@@ -1,5 +1,6 @@
-"""A chunk function for the sweep executor's fast dead-worker test, in a module of its own: a spawned worker imports
-only this one (the test module would cost each worker numpy, scipy and matcad's prediction, ~0.7 s of CPU)."""
+"""Chunk functions for the sweep executor's tests (a dead worker, shared processes, their initializer), in a module of
+their own: a spawned worker imports only this one (the test module would cost each worker numpy, scipy and
+matcad's prediction, ~0.7 s of CPU)."""
 
 import os
 import signal
@@ -24,3 +25,12 @@ def process_of(tasks):
     take tasks)."""
     time.sleep(BUSY_S / 3)
     return [{"index": t["index"], "status": "ok", "reason": "", "pid": os.getpid()} for t in tasks]
+
+
+def heap_kept(tasks):
+    """Chunk function: each task's result says whether its process had :func:`matcad.sweep.heap.keep_freed_memory`
+    run (its only import)."""
+    from matcad.sweep import heap
+
+    kept = heap.keep_freed_memory.cache_info().currsize == 1
+    return [{"index": t["index"], "status": "ok", "reason": "", "kept": kept} for t in tasks]

@@ -163,14 +163,16 @@ class Processes:
     start (Python, numpy and matcad imported: ~0.5 s) is paid once. A context manager; the processes start with the
     first task (:attr:`pool`), :meth:`restart` replaces those a dead worker took down."""
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, initializer=None):
         import functools
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
         self.workers = workers
-        self.fresh = functools.partial(ProcessPoolExecutor, mp_context=multiprocessing.get_context("spawn"))
-        """A new pool of the given number of processes."""
+        self.fresh = functools.partial(ProcessPoolExecutor, mp_context=multiprocessing.get_context("spawn"),
+                                       initializer=initializer)
+        """A new pool of the given number of processes, each starting with ``initializer()`` (a module-level
+        function) when given."""
         self._pool = None
 
     @property
@@ -195,13 +197,13 @@ class Processes:
         self.close()
 
 
-def processes(executor: Executor, tasks: int) -> Processes | contextlib.nullcontext:
+def processes(executor: Executor, tasks: int, initializer=None) -> Processes | contextlib.nullcontext:
     """The local processes of ``executor`` for :func:`stream` calls over up to ``tasks`` tasks to share (a context
-    manager giving a :class:`Processes`), or a context giving None where it has none (one process or one task, a
-    Dask cluster)."""
+    manager giving a :class:`Processes`, each process starting with ``initializer()``), or a context giving None
+    where it has none (one process or one task: the tasks run in this one; a Dask cluster)."""
     if executor.scheduler or min(executor.workers, tasks) <= 1:
         return contextlib.nullcontext()
-    return Processes(min(executor.workers, tasks))
+    return Processes(min(executor.workers, tasks), initializer)
 
 
 def stream(fn_chunk, tasks: list[dict], executor: Executor, shared: Processes | None = None):

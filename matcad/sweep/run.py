@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matcad.sweep import arrays, fast
+from matcad.sweep import arrays, fast, heap
 from matcad.sweep.executor import Executor, processes, run as run_tasks, stream
 from matcad.sweep.grid import MAX_VARIANTS, Axis, grid, variant_data
 from matcad.sweep.tasks import run_chunk
@@ -243,7 +243,9 @@ def _array_rows(data: dict, axes, model: str, rules: bool, executor: Executor, s
               "stop": min(lo + arrays.CHUNK, size), "model": model, "rules": rules}
              for k, lo in enumerate(range(0, size, arrays.CHUNK))]
     kept, counted, seconds = [], tally(()), 0.0
-    with processes(executor, len(tasks)) as shared:  # the warm-up and the grid on the same processes
+    with processes(executor, len(tasks), heap.keep_freed_memory) as shared:  # the warm-up and the grid share them
+        if shared is None and not executor.scheduler:  # the chunks run in this process
+            heap.keep_freed_memory()
         warm = warmed(data, axes, rules, executor, shared) if len(tasks) > 1 else None
         for task in tasks:
             task["warm"] = warm  # installed by each process with the first task of the sweep it runs
