@@ -89,11 +89,15 @@ def _number(path: str, value: Any, meta: dict) -> float:
         x = float(value)
     except OverflowError:  # an integer of >= 309 digits
         raise SpecError(path, value, f"must be {_range_text(meta)}") from None
-    if x != 0 and abs(x) < sys.float_info.min:  # subnormal: no physical value, and 1/x overflows
+    if _subnormal(x):  # no physical value, and 1/x overflows
         raise SpecError(path, value, f"must be {_range_text(meta)}, not a subnormal number")
     if not _within(x, meta):
         raise SpecError(path, value, f"must be {_range_text(meta)}")
     return x
+
+
+def _subnormal(x: float) -> bool:
+    return x != 0 and abs(x) < sys.float_info.min
 
 
 def _within(x: float, meta: dict) -> bool:
@@ -107,8 +111,7 @@ def _valid_float(value: Any, meta: dict) -> bool:
     """Whether ``value`` is already what :func:`convert` makes of a number field: a float, in range, not subnormal
     (then it is kept as it is, with no path formatted for an error that cannot come: a section remade by
     ``dataclasses.replace`` re-validates its numbers at this cost)."""
-    return (type(value) is float and meta["kind"] == "number" and (value == 0 or abs(value) >= sys.float_info.min)
-            and _within(value, meta))
+    return type(value) is float and meta["kind"] == "number" and not _subnormal(value) and _within(value, meta)
 
 
 def convert(path: str, value: Any, meta: dict) -> Any:
