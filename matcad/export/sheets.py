@@ -138,8 +138,9 @@ class SheetSize(NamedTuple):
 def kit_sheet_sizes(spec) -> dict[str, SheetSize]:
     """Each of :func:`kit_sheets`' sheets, its name, parts and extents, without drawing it: the same layout
     (:func:`_layout`) of the same outlines (:func:`matcad.parts.flat.cut_outlines`), so the same numbers, with no
-    hole or engraving moved into place (~5x faster: the design rule ``laser.bed`` runs on every combination of a
-    sweep's plate dimensions). Raises as :func:`kit_sheets` does (DrawnSizeError, ValueError)."""
+    hole or engraving moved into place (the parts made, 33 µs against 117 µs: the design rule ``laser.bed`` runs on
+    every combination of a sweep's plate dimensions). Raises as :func:`kit_sheets` does (DrawnSizeError,
+    ValueError)."""
     from matcad.parts.catalogue import laser_parts
     from matcad.parts.flat import check_drawable, cut_outlines
 
