@@ -11,9 +11,8 @@ import shutil
 import tempfile
 from contextlib import contextmanager
 
-import pytest
+from tests.conftest import missing_client
 
-REQUIRED = os.environ.get("MATCAD_REQUIRE_CLIENTS") == "1"
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
 FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
@@ -21,9 +20,8 @@ FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-background-ne
 
 
 def _missing(why: str):
-    if REQUIRED:
-        pytest.fail(f"{why} but MATCAD_REQUIRE_CLIENTS=1 (.ci/run installs chromium and chromium-driver)")
-    pytest.skip(f"{why}: apt-get install chromium chromium-driver, pip install selenium (the dev extra)")
+    missing_client(why, "apt-get install chromium chromium-driver, pip install selenium (the dev extra)",
+                   ".ci/run installs chromium and chromium-driver")
 
 
 @contextmanager

@@ -1,5 +1,6 @@
 """Shared test helpers: paths, a spec writer, and a CLI runner in a fresh interpreter."""
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -41,6 +42,18 @@ displacement_mm = 1.0
 steps = 4
 """
 """MINIMAL with a cheap cap-mechanics run (coarse neo-Hookean, 4 steps to 1 mm): seconds, not tens."""
+
+
+REQUIRE_CLIENTS = os.environ.get("MATCAD_REQUIRE_CLIENTS") == "1"
+"""Set by .ci/run, which installs every client a test drives (a browser, bash, Debian's readers)."""
+
+
+def missing_client(why: str, here: str, ci: str) -> None:
+    """A client a test needs is missing: fail under :data:`REQUIRE_CLIENTS` (``ci`` says what CI should have
+    done), else skip (``here`` says how to install it to run the test here)."""
+    if REQUIRE_CLIENTS:
+        pytest.fail(f"{why} but MATCAD_REQUIRE_CLIENTS=1 ({ci})")
+    pytest.skip(f"{why}: {here}")
 
 
 def spec_with(path, **over):

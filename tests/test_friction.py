@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import shutil
 import subprocess
 import sys
@@ -17,7 +16,7 @@ from matcad import spec as spec_mod
 from matcad.prediction import predict
 from matcad.build import build
 from matcad.spec import frequency_notes, spec_notes
-from tests.conftest import MINIMAL, PAPER, ROOT, run_cli
+from tests.conftest import MINIMAL, PAPER, ROOT, missing_client, run_cli
 
 LASER_ONLY = ROOT / "templates" / "mat-laser-only.toml"
 
@@ -111,9 +110,7 @@ def test_option_names_are_distinct_and_fem_level_needs_fem():
 def test_bash_completion_completes_commands_and_options():
     bash = shutil.which("bash")
     if bash is None:
-        if os.environ.get("MATCAD_REQUIRE_CLIENTS") == "1":
-            pytest.fail("bash missing but MATCAD_REQUIRE_CLIENTS=1 (.ci/run runs under bash)")
-        pytest.skip("bash not installed: the completion script is bash's")
+        missing_client("bash missing", "install bash: the completion script is bash's", ".ci/run runs under bash")
     code, script, _ = run_cli("completion", "bash")
     assert code == 0
 

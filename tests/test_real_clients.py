@@ -21,19 +21,17 @@ from matcad.build import build, build_coupon
 from matcad.parts.catalogue import laser_parts
 from matcad.parts.coupon import coupon_sheets, laser_coupon
 from matcad.parts.flat import cut_plan
-from tests.conftest import SINGLE_TEMPLATES, TEMPLATES
+from tests.conftest import SINGLE_TEMPLATES, TEMPLATES, missing_client
 from tests.readback import expected_bodies
 
 TOOLS = ("admesh", "prusa-slicer", "librecad", "pdftoppm")
-REQUIRED = os.environ.get("MATCAD_REQUIRE_CLIENTS") == "1"
 DPI = 254  # 10 pixels per mm
 
 
 def need(tool):
     if shutil.which(tool) is None:
-        if REQUIRED:
-            pytest.fail(f"{tool} missing but MATCAD_REQUIRE_CLIENTS=1 (.ci/run installs it)")
-        pytest.skip(f"{tool} is a Debian package that .ci/run installs; apt-get install it to run this here")
+        missing_client(f"{tool} missing", f"a Debian package that .ci/run installs; apt-get install {tool}",
+                       ".ci/run installs it")
 
 
 @pytest.fixture(scope="module")
