@@ -110,10 +110,16 @@ def nest(plans: list[CutPlan], sheet: str, reference_square: bool, row_width_mm:
 def sheet_plans(plans: list[CutPlan], reference_square: bool, row_width_mm: float) -> dict[str, CutPlan]:
     """Sheet key → the nested plan of every part ``plans`` cuts from it (:func:`nest`, rows at most
     ``row_width_mm`` wide), sheets in the parts' order; each plan's ``parts`` names the parts on it."""
-    by_sheet: dict[str, list[CutPlan]] = {}
-    for plan in plans:
-        by_sheet.setdefault(plan.flat.sheet, []).append(plan)
-    return {sheet: nest(group, sheet, reference_square, row_width_mm) for sheet, group in by_sheet.items()}
+    return {sheet: nest(group, sheet, reference_square, row_width_mm)
+            for sheet, group in _by_sheet(plans, lambda plan: plan.flat.sheet).items()}
+
+
+def _by_sheet(items, sheet_of) -> dict[str, list]:
+    """``items`` grouped by the sheet each is cut from (``sheet_of(item)``), sheets in the items' order."""
+    groups: dict[str, list] = {}
+    for item in items:
+        groups.setdefault(sheet_of(item), []).append(item)
+    return groups
 
 
 def kit_sheets(spec, plans: list[CutPlan] | None = None) -> dict[str, CutPlan]:
@@ -144,13 +150,12 @@ def kit_sheet_sizes(spec) -> dict[str, SheetSize]:
     from matcad.parts.catalogue import laser_parts
     from matcad.parts.flat import check_drawable, cut_outlines
 
-    by_sheet: dict[str, list] = {}
-    for flat in laser_parts(spec):
+    flats = laser_parts(spec)
+    for flat in flats:
         check_drawable(flat)
-        by_sheet.setdefault(flat.sheet, []).append(flat)
     row_width = usable_bed_mm(spec)[0]
     out = {}
-    for sheet, flats in by_sheet.items():
+    for sheet, flats in _by_sheet(flats, lambda flat: flat.sheet).items():
         _same_sheet(sheet, flats)
         boxes = [_box(cut_outlines(f)) for f in flats]
         placed = _layout(boxes, row_width)
