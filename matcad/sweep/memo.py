@@ -29,15 +29,15 @@ def _record(key: str) -> None:
 
 @functools.cache
 def _traced_class(cls: type) -> type:
-    names = frozenset(f.name for f in dataclasses.fields(cls))
-    table = cls.table
+    keys = {f.name: f"{cls.table}.{f.name}" for f in dataclasses.fields(cls)}
+    keys["__dict__"] = f"{cls.table}.*"  # every field at once
+    key_of, attribute = keys.get, object.__getattribute__
 
     def __getattribute__(self, name):
-        if name in names:
-            _record(f"{table}.{name}")
-        elif name == "__dict__":  # every field at once
-            _record(f"{table}.*")
-        return object.__getattribute__(self, name)
+        key = key_of(name)
+        if key is not None:
+            _record(key)
+        return attribute(self, name)
 
     return type(f"Traced{cls.__name__}", (cls,), {"__getattribute__": __getattribute__})
 
