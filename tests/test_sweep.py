@@ -558,33 +558,36 @@ def test_cli_two_axes_table_and_heat_maps_read_back(tmp_path):
     assert set(manifest["files"]) == {"sweep.csv", "sweep.json", *(f"maps/{m}" for m in maps)}
 
 
-def test_heat_map_cells_read_back(tmp_path):
-    """The f0 heat map read back pixel by pixel, its axes given out of order: inside each variant's cell (its grid
-    point's midpoints to its neighbours, placed by the plot's box) the colour is matplotlib's viridis of its f0 on
-    the map's range (within 6/255), in white diagonal hatching exactly where the variant has rule errors, and an
-    invalid variant's cell is blank."""
+def _cell_edges(values) -> list[float]:
+    """Midpoints between ascending grid values, half a step beyond the ends (as a heat map's cells span)."""
+    v = sorted(values)
+    mid = [(a + b) / 2 for a, b in zip(v, v[1:])]
+    return [v[0] - (mid[0] - v[0]), *mid, v[-1] + (v[-1] - mid[-1])]
+
+
+def _assert_heat_map_cells(png, rows, y_field, x_field, quantity="f0_hz") -> set:
+    """Read the heat map ``png`` back pixel by pixel against the CSV ``rows`` it shows (``y_field`` up,
+    ``x_field`` across): inside each variant's cell (its grid point's midpoints to its neighbours, placed by the
+    plot's box) the colour is matplotlib's viridis of its value on the map's range (within 6/255), in white
+    diagonal hatching exactly where the variant has rule errors, and an invalid variant's cell is blank. Returns
+    the kinds of cells seen (blank, hatched, plain)."""
     from matplotlib import colormaps
     from PIL import Image
 
     from matcad.sweep.maps import BOX
 
-    out = tmp_path / "hm"
-    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3:6:4", "--vary", "neck.diameter=2.1,1.5,3.3",
-                           "--model", "transmission_line", "--set", "microphone.sample_rate_hz=12000", "--out", out)
-    assert code == 0, err
-    with open(out / "sweep.csv", newline="") as f:
-        rows = list(csv.DictReader(f))
-    f0 = [float(r["f0_hz"]) for r in rows if r["status"] == "ok"]
-    lo, hi = min(f0), max(f0)
-    xe, ye = [1.2, 1.8, 2.7, 3.9], [2.5, 3.5, 4.5, 5.5, 6.5]  # midpoints, half a step beyond the ends
+    ys, xs = sorted({float(r[y_field]) for r in rows}), sorted({float(r[x_field]) for r in rows})
+    assert len(rows) == len(ys) * len(xs)
+    values = [float(r[quantity]) for r in rows if r["status"] == "ok"]
+    lo, hi = min(values), max(values)
+    xe, ye = _cell_edges(xs), _cell_edges(ys)
     left, top, right, bottom = BOX
-    with Image.open(out / "maps" / "f0.png") as im:
+    with Image.open(png) as im:
         pixels = np.asarray(im.convert("RGB")).astype(int)
     white = np.array([255, 255, 255])
     kinds = set()
     for r in rows:
-        j = [1.5, 2.1, 3.3].index(float(r["neck.diameter"]))
-        i = [3.0, 4.0, 5.0, 6.0].index(float(r["cavity.length"]))
+        j, i = xs.index(float(r[x_field])), ys.index(float(r[y_field]))
         x0, x1 = (left + (e - xe[0]) / (xe[-1] - xe[0]) * (right - left) for e in xe[j:j + 2])
         y1, y0 = (bottom - (e - ye[0]) / (ye[-1] - ye[0]) * (bottom - top) for e in ye[i:i + 2])
         cell = pixels[round(y0) + 2:round(y1) - 2, round(x0) + 2:round(x1) - 2].reshape(-1, 3)
@@ -593,15 +596,62 @@ def test_heat_map_cells_read_back(tmp_path):
             assert is_white.all()
             kinds.add("blank")
             continue
-        expected = np.array(colormaps["viridis"]((float(r["f0_hz"]) - lo) / (hi - lo))[:3]) * 255
+        expected = np.array(colormaps["viridis"]((float(r[quantity]) - lo) / (hi - lo))[:3]) * 255
         assert is_white.mean() < 0.5 and np.abs(cell[~is_white] - expected).max() <= 6
-        if int(r["rule_errors"]) > 0:
+        if int(r["rule_errors"] or 0) > 0:
             assert 0.12 < is_white.mean() < 0.22  # one pixel diagonal in six
             kinds.add("hatched")
         else:
             assert not is_white.any()
             kinds.add("plain")
+    return kinds
+
+
+def test_heat_map_cells_read_back(tmp_path):
+    """The f0 heat map read back pixel by pixel (:func:`_assert_heat_map_cells`), its axes given out of order:
+    blank, hatched and plain cells all where the table puts them."""
+    out = tmp_path / "hm"
+    code, _, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3:6:4", "--vary", "neck.diameter=2.1,1.5,3.3",
+                           "--model", "transmission_line", "--set", "microphone.sample_rate_hz=12000", "--out", out)
+    assert code == 0, err
+    with open(out / "sweep.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert _cell_edges([1.5, 2.1, 3.3]) == pytest.approx([1.2, 1.8, 2.7, 3.9])
+    assert _assert_heat_map_cells(out / "maps" / "f0.png", rows, "cavity.length", "neck.diameter") == \
+        {"blank", "hatched", "plain"}
+
+
+def test_three_axes_map_every_pair_through_the_middle_of_the_others(tmp_path):
+    """Three axes: a folder of maps per pair of axes, each the slice of the grid with the third axis at the median
+    of its values (given out of order: 5, 1, 3 holds 3, neither the first nor the lowest), named in the PNG's text
+    chunks; each slice's f0 and rule-error maps read back cell by cell against the table's rows at that value."""
+    out = tmp_path / "s3"
+    code, stdout, err = run_cli("sweep", PAPER, "--vary", "cavity.length=3:6:4", "--vary", "neck.diameter=2.1,1.5,3.3",
+                                "--vary", "neck.length=5,1,3", "--model", "transmission_line", "--set",
+                                "microphone.sample_rate_hz=12000", "--out", out)
+    assert code == 0, err
+    assert "18 maps in maps/" in stdout
+    with open(out / "sweep.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    pairs = {"cavity.length-neck.diameter": ("neck.length", 3.0), "cavity.length-neck.length": ("neck.diameter", 2.1),
+             "neck.diameter-neck.length": ("cavity.length", 4.0)}
+    assert sorted(p.name for p in (out / "maps").iterdir()) == sorted(pairs)
+    kinds = set()
+    for folder, (held, value) in pairs.items():
+        y_field, x_field = folder.split("-")
+        assert sorted(p.name for p in (out / "maps" / folder).iterdir()) == sorted(
+            ["f0.png", "band_low.png", "band_high.png", f"df0_d_{y_field}.png", f"df0_d_{x_field}.png",
+             "rule_errors.png"])
+        from PIL import Image
+
+        with Image.open(out / "maps" / folder / "f0.png") as im:
+            assert im.text["matcad:held"] == f"{held}={value!r}" and im.text["matcad:quantity"] == "f0_hz"
+            assert (im.text["matcad:y"], im.text["matcad:x"]) == (f"{y_field} [mm]", f"{x_field} [mm]")
+        plane = [r for r in rows if float(r[held]) == value]
+        kinds |= _assert_heat_map_cells(out / "maps" / folder / "f0.png", plane, y_field, x_field)
     assert kinds == {"blank", "hatched", "plain"}
+    manifest = json.loads((out / ".matcad-manifest.json").read_text())
+    assert sum(name.startswith("maps/") for name in manifest["files"]) == 18
 
 
 def test_cli_one_axis_line_maps(tmp_path, write_spec):
@@ -804,7 +854,8 @@ def test_a_table_format_that_does_not_exist_is_exit_2_and_writes_nothing(tmp_pat
 
 def test_large_grid_streams_to_the_csv(tmp_path):
     """A three-axis grid beyond MAX_VARIANTS on arrays: the CSV holds every variant in grid order with the rows an
-    in-memory sweep gives, the JSON the counts (no rows), no maps; the sweep kept no rows."""
+    in-memory sweep gives, the JSON the counts (no rows); the sweep kept no rows, and its maps, drawn from the
+    stream, show the table's rows at the middle of the third axis."""
     vary = ["cavity.length=2:10:30", "neck.diameter=0.8:2.4:30", "neck.length=1:8:25"]  # 22 500 variants
     out = tmp_path / "big"
     code, stdout, err = run_cli("sweep", ROOT / "templates" / "mat-laser-only.toml", *[x for v in vary
@@ -816,7 +867,10 @@ def test_large_grid_streams_to_the_csv(tmp_path):
     assert summary["variants"] == len(rows) == 22_500 and [int(r["index"]) for r in rows] == list(range(22_500))
     doc = json.loads((out / "sweep.json").read_text())
     assert "rows" not in doc and doc["rows_in"] == "sweep.csv" and doc["counts"]["ok"] == summary["ok"]
-    assert summary["ok"] == sum(r["status"] == "ok" for r in rows) and not (out / "maps").exists()
+    assert summary["ok"] == sum(r["status"] == "ok" for r in rows)
+    plane = [r for r in rows if r["neck.length"] == rows[12]["neck.length"]]  # the 13th of 25 lengths: the median
+    _assert_heat_map_cells(out / "maps" / "cavity.length-neck.diameter" / "f0.png", plane, "cavity.length",
+                           "neck.diameter")
     assert summary["rule_errors"] == sum(r["rule_errors"] not in ("", "0") for r in rows) > 0
     data = read_spec_data(ROOT / "templates" / "mat-laser-only.toml")
     kept = []
@@ -825,6 +879,39 @@ def test_large_grid_streams_to_the_csv(tmp_path):
     for row, line in zip(kept[::997], rows[::997]):
         assert line["failing_rules"] == (row.get("failing_rules") or "")
         assert float(line["f0_hz"]) == row["f0_hz"] and line["status"] == row["status"]
+
+
+def test_map_planes_keep_only_the_slices_whatever_the_grid():
+    """The maps' sink on an 8·10^6-variant grid (200 x 200 x 199): its arrays hold each pair of axes' values, at
+    most 200 x 200 numbers a quantity, allocated once; a streamed block puts each of its rows on the planes it lies
+    on (the other axis at its median) at its grid point, and nowhere else (row order does not matter)."""
+    from matcad.sweep.maps import Planes
+    from matcad.sweep.run import Block
+
+    axes = parse_axes(["cavity.length=3:6:200", "neck.diameter=1:2:200", "neck.length=1:8:199"])
+    planes = Planes(axes, rules=True)
+    sizes = {id(v): v.shape for _, _, p in planes.planes for v in p.values.values()}
+    assert sorted({shape for shape in sizes.values()}) == [(200, 199), (200, 200)]
+    assert sum(math.prod(s) for s in sizes.values()) == 6 * (200 * 200 + 2 * 200 * 199)
+    rng = np.random.default_rng(3)
+    shape = (200, 200, 199)
+    middle = (99, 99, 99)  # the lower middle of 200 ascending values, the middle of 199
+    on = [np.ravel_multi_index((i, j, middle[2]), shape) for i, j in rng.integers(0, 199, (50, 2))] + \
+        [np.ravel_multi_index((middle[0], j, k), shape) for j, k in rng.integers(0, 199, (50, 2))]
+    index = rng.permutation(np.unique(np.concatenate([on, rng.integers(0, math.prod(shape), 4000)])))
+    f0 = index * 1e-3
+    planes(Block({"index": index.tolist(), "f0_hz": f0.tolist(), "rule_errors": [None] * len(index)}))
+    by_index = dict(zip(index.tolist(), f0.tolist()))
+    for pair, held, plane in planes.planes:
+        got = plane.values["f0_hz"]
+        expected = np.full(got.shape, np.nan)
+        for k in index.tolist():
+            at = np.unravel_index(k, shape)
+            if all(at[m] == i for m, i in held.items()):
+                expected[tuple(at[m] for m in pair)] = by_index[k]
+        assert np.array_equal(got, expected, equal_nan=True) and np.isnan(plane.values["rule_errors"]).all()
+        assert held == {m: middle[m] for m in range(3) if m not in pair}
+    assert {id(v): v.shape for _, _, p in planes.planes for v in p.values.values()} == sizes
 
 
 def test_a_table_finds_many_codes_at_once_as_its_dict_does():

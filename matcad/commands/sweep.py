@@ -41,8 +41,9 @@ def run(args) -> int:
     from matcad.sweep import Executor, parse_axes, sweep
     from matcad.output import staged_output
     from matcad.progress import line
-    from matcad.sweep.maps import write_maps
+    from matcad.sweep.maps import Planes, write_maps
     from matcad.sweep.outputs import table_format, write_json
+    from matcad.sweep.run import Block
 
     lo, hi = WORKERS
     if not lo <= args.workers <= hi:
@@ -56,9 +57,16 @@ def run(args) -> int:
     target = Path(args.out or Path("out") / f"{spec.name}-sweep")
     with staged_output(target) as tmp, line("sweep", "variants", quiet=args.json) as progress:
         table = writer(tmp, axes, not args.no_rules)  # the table streams into tmp; on an error nothing is left
+        planes = Planes(axes, not args.no_rules)  # and what the maps show is kept from the same stream
+
+        def sink(rows) -> None:
+            block = rows if isinstance(rows, Block) else Block.from_rows(rows)
+            table(block)
+            planes(block)
+
         result = sweep(data, axes, model=args.model, executor=executor, rules=not args.no_rules, cad=args.cad,
-                       fem_level=args.fem_level, sink=table, progress=progress)
-        files = table.close() + write_json(result, tmp, table.name) + write_maps(result, tmp)
+                       fem_level=args.fem_level, sink=sink, progress=progress)
+        files = table.close() + write_json(result, tmp, table.name) + write_maps(planes, tmp, result.model)
     if args.json:
         print_json(result.summary_dict(target, files))
     else:

@@ -96,7 +96,7 @@ class Block:
 class SweepResult:
     """The table (one dict per variant, grid order: the first axis varies slowest) and how it was made. A sweep
     streamed to a sink keeps no rows when it has three or more axes and more than :data:`MAX_VARIANTS` variants
-    (no maps are drawn then): ``tally`` then holds its counts."""
+    (its maps are drawn from the stream, :class:`matcad.sweep.maps.Planes`): ``tally`` then holds its counts."""
 
     name: str
     model: str
@@ -133,10 +133,13 @@ class SweepResult:
         """What `matcad sweep` prints: the counts, the model and executor, the run time and the files."""
         c = self.counts()
         plural = "" if self.variants == 1 else "s"
+        maps = sum(name.startswith("maps/") for name in files)
+        shown = [name for name in files if not name.startswith("maps/")]
+        shown += [f"{maps} maps in maps/"] if maps else []
         return (f"{self.name}: {self.variants} variant{plural} ({c['ok']} ok, {c['invalid']} invalid, "
                 f"{c['failed']} failed; "
                 f"{c['rule_errors']} with design-rule errors) by {self.model} on {self.executor} in "
-                f"{self.seconds:.1f} s\n  {', '.join(files)} in {folder}/")
+                f"{self.seconds:.1f} s\n  {', '.join(shown)} in {folder}/")
 
     def column(self, name: str) -> np.ndarray:
         """A numeric column as a float array in grid shape (NaN where a variant has no value)."""
