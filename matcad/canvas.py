@@ -249,7 +249,7 @@ class Axes:
         inside = ((i >= 0) & (i < len(y_edges) - 1))[:, None] & ((j >= 0) & (j < len(x_edges) - 1))[None, :]
         rows, cols = np.clip(i, 0, len(y_edges) - 2), np.clip(j, 0, len(x_edges) - 2)
 
-        def per_pixel(cell_values, dtype):  # each pixel's cell's value: two takes, ~10x faster than np.ix_ indexing
+        def per_pixel(cell_values, dtype):  # each pixel's cell's value, by two takes (a map's cells: 6 -> 2.3 ms)
             return np.asarray(cell_values, dtype=dtype).take(rows, axis=0).take(cols, axis=1)
 
         show = inside if blank is None else inside & ~per_pixel(blank, bool)
