@@ -164,7 +164,12 @@ def peaks(geometry: tuple, wall, loss_factor, start=None) -> np.ndarray:
 def distinct_rows(rows: dict) -> tuple[dict, np.ndarray | None]:
     """The distinct rows of :func:`rows_of`'s inputs and, for each input row, the index of its distinct row
     (None when every row is distinct). A peak depends on its own row only, so searching each distinct row once gives
-    the same numbers: a calibrated sweep's drawn taxel is one design repeated over every variant of a chunk."""
+    the same numbers: a calibrated sweep's drawn taxel is one design repeated over every variant of a chunk. Rows
+    that differ in their scalar inputs differ, so those are compared first: a sweep's variants, all distinct, are
+    told so without their wall's modes (a tenth of the columns)."""
+    scalars = [np.asarray(v, dtype=float) for v in rows.values() if np.ndim(v) == 1]
+    if scalars and distinct(np.column_stack(scalars)) is None:
+        return rows, None
     kinds = distinct(np.column_stack([np.asarray(v, dtype=float).reshape(len(v), -1) for v in rows.values()]))
     if kinds is None:
         return rows, None
@@ -179,6 +184,9 @@ def distinct(table: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     (``np.unique(axis=0)``, a sort of whole rows ~10x slower on a sweep's chunk, where the hashes collide)."""
     bits = np.ascontiguousarray(table, dtype=float).view(np.uint64).reshape(len(table), -1)
     hashes = (bits * _multipliers(bits.shape[1])).sum(axis=1)  # modulo 2^64
+    ordered = np.sort(hashes)
+    if not (ordered[1:] == ordered[:-1]).any():  # distinct hashes: distinct rows (equal rows hash alike)
+        return None
     _, first, inverse = np.unique(hashes, return_index=True, return_inverse=True)
     inverse = inverse.reshape(-1)
     if not np.array_equal(bits[first][inverse], bits):
