@@ -621,6 +621,29 @@ def test_heat_map_cells_read_back(tmp_path):
         {"blank", "hatched", "plain"}
 
 
+def test_a_constant_map_is_mid_scale_in_its_cells_and_on_its_bar(tmp_path):
+    """A quantity with one value on every variant (df0/d of a field f0 does not read: exactly 0): every cell is
+    viridis's middle colour, and so is the colour bar at the height of that value (the cells were the bottom colour
+    while the bar showed the top one above the value)."""
+    from matplotlib import colormaps
+    from PIL import Image
+
+    from matcad.sweep.maps import BAR, BOX
+
+    out = tmp_path / "c"
+    code, _, err = run_cli("sweep", PAPER, "--vary", "neck.length=2,3", "--vary", "mold.count=1,2", "--no-rules",
+                           "--model", "transmission_line", "--out", out)
+    assert code == 0, err
+    with open(out / "sweep.csv", newline="") as f:
+        assert {float(r["df0_d_mold.count_hz_per_unit"]) for r in csv.DictReader(f)} == {0.0}
+    with Image.open(out / "maps" / "df0_d_mold.count.png") as im:
+        pixels = np.asarray(im.convert("RGB")).astype(int)
+    middle = np.array(colormaps["viridis"](0.5)[:3]) * 255
+    left, top, right, bottom = BOX
+    assert np.abs(pixels[top + 3:bottom - 3, left + 3:right - 3] - middle).max() <= 6
+    assert np.abs(pixels[(top + bottom) // 2, (BAR[0] + BAR[1]) // 2] - middle).max() <= 6
+
+
 def test_three_axes_map_every_pair_through_the_middle_of_the_others(tmp_path):
     """Three axes: a folder of maps per pair of axes, each the slice of the grid with the third axis at the median
     of its values (given out of order: 5, 1, 3 holds 3, neither the first nor the lowest), named in the PNG's text

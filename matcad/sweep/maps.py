@@ -213,6 +213,8 @@ def _heat_map(plane: Plane, column: str, text: str):
     xe, ye = edges(np.asarray(x_axis.values, dtype=float)[cols]), edges(np.asarray(y_axis.values, dtype=float)[rows])
     finite = np.isfinite(values)
     lo, hi = (float(values[finite].min()), float(values[finite].max())) if finite.any() else (0.0, 1.0)
+    if hi <= lo:  # one value everywhere (a field f0 does not read): mid-scale, in the cells as on the bar
+        lo, hi = lo - 0.5, hi + 0.5
     canvas = Canvas(*SIZE)
     ax = canvas.axes(BOX, (xe[0], xe[-1]), (ye[0], ye[-1]))
     ax.cells(xe, ye, colour_map(np.where(finite, values, lo), lo, hi, VIRIDIS), blank=~finite,
@@ -221,7 +223,7 @@ def _heat_map(plane: Plane, column: str, text: str):
     ax.frame(xlabel=label(x_axis), ylabel=label(y_axis), size=11,
              title=f"{text}{held}\nhatched: design-rule errors; blank: invalid or failed")
     top, bottom = BOX[1], BOX[3]
-    bar = canvas.axes((BAR[0], top, BAR[1], bottom), (0.0, 1.0), (lo, hi) if hi > lo else (lo - 0.5, hi + 0.5))
+    bar = canvas.axes((BAR[0], top, BAR[1], bottom), (0.0, 1.0), (lo, hi))
     ramp = np.linspace(bar.ylim[1], bar.ylim[0], bottom - top)[:, None]
     bar.image(colour_map(ramp, lo, hi, VIRIDIS))
     canvas.draw.rectangle((BAR[0], top, BAR[1], bottom), outline="black")
