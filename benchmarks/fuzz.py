@@ -454,7 +454,7 @@ def cat_sweep(n: int, rng: random.Random, work: Path):
     for i in range(n):
         out = work / f"s{i}"
         argv = ["sweep", spec, "--out", out, "--no-rules"] if rng.random() < 0.7 else ["sweep", spec, "--out", out]
-        for _ in range(rng.randint(1, 2)):
+        for _ in range(rng.randint(1, 3)):  # three axes: the maps of every pair's slice
             argv += ["--vary", rng.choice(varies)]
         kind = rng.choice(["scheduler", "workers", "plain"])
         if kind == "scheduler":
