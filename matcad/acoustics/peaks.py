@@ -180,8 +180,9 @@ def distinct_rows(rows: dict) -> tuple[dict, np.ndarray | None]:
 def distinct(table: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """(first, inverse) of the 2-D float ``table``'s distinct rows, compared bit for bit: the index of one row of
     each kind, and each row's kind (``table[first][inverse]`` is ``table``); None when every row is distinct. One
-    hash of each row's bits and one sort of the hashes, every row then checked against its kind's first row
-    (``np.unique(axis=0)``, a sort of whole rows ~10x slower on a sweep's chunk, where the hashes collide)."""
+    hash of each row's bits and one sort of the hashes: distinct hashes are distinct rows; where some repeat, every
+    row is checked against its kind's first row (``np.unique(axis=0)``, a sort of whole rows ~10x slower on a
+    sweep's chunk, where the hashes collide)."""
     bits = np.ascontiguousarray(table, dtype=float).view(np.uint64).reshape(len(table), -1)
     hashes = (bits * _multipliers(bits.shape[1])).sum(axis=1)  # modulo 2^64
     ordered = np.sort(hashes)
