@@ -60,7 +60,7 @@ def run(args) -> int:
         planes = Planes(axes, not args.no_rules)  # and what the maps show is kept from the same stream
 
         def sink(rows) -> None:
-            block = rows if isinstance(rows, Block) else Block.from_rows(rows)
+            block = Block.of(rows)
             table(block)
             planes(block)
 

@@ -88,7 +88,7 @@ class Planes:
             self.planes.append((pair, held, Plane([self.axes[m] for m in pair], values, rules)))
 
     def __call__(self, rows) -> None:
-        block = rows if isinstance(rows, Block) else Block.from_rows(rows)
+        block = Block.of(rows)
         if not len(block):
             return
         at = np.unravel_index(np.asarray(block.columns["index"], dtype=np.int64), self.shape)

@@ -57,7 +57,7 @@ class TableWriter:
         self.columns = None
 
     def __call__(self, rows) -> None:
-        block = rows if isinstance(rows, Block) else Block.from_rows(rows)
+        block = Block.of(rows)
         if self.columns is None:
             self.columns = table_columns(self.axes, self.rules, [dict.fromkeys(block.columns)])
             self._open()

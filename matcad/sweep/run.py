@@ -58,7 +58,7 @@ def tally(rows, into: dict | None = None) -> dict:
     """Variants by status (ok, invalid, failed) and how many break a design rule, added to ``into``; ``rows``: row
     dicts or a :class:`Block`."""
     out = into if into is not None else {"ok": 0, "invalid": 0, "failed": 0, "rule_errors": 0}
-    columns = (rows if isinstance(rows, Block) else Block.from_rows(rows)).columns
+    columns = Block.of(rows).columns
     for status in ("ok", "invalid", "failed"):
         out[status] += columns.get("status", []).count(status)
     out["rule_errors"] += sum(map(bool, filter(None, columns.get("rule_errors", ()))))
@@ -72,6 +72,11 @@ class Block:
     sends lists of numbers, not a dict per variant."""
 
     columns: dict[str, list]
+
+    @classmethod
+    def of(cls, rows) -> Block:
+        """``rows`` as a block: a :class:`Block` as it is, row dicts by :meth:`from_rows` (what a sink is given)."""
+        return rows if isinstance(rows, Block) else cls.from_rows(rows)
 
     @classmethod
     def from_rows(cls, rows) -> Block:
